@@ -1,0 +1,78 @@
+#include "core/convergence_fit.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace stepbench {
+
+double roundoff_bound(long steps, double scale) {
+  return 8.0 * std::numeric_limits<double>::epsilon() * static_cast<double>(std::max(1L, steps)) * scale;
+}
+
+namespace {
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+}  // namespace
+
+fit_result fit_order(const fit_input& in) {
+  fit_result out;
+  out.order = std::numeric_limits<double>::quiet_NaN();
+  const int n = static_cast<int>(in.dt.size());
+
+  bool all_roundoff = n > 0;
+  for (int k = 0; k < n; ++k)
+    if (in.diverged[k] || !(in.error[k] <= roundoff_bound(in.steps[k], in.scale))) all_roundoff = false;
+  if (all_roundoff) {
+    out.state = fit_result::status::exact;
+    out.note = "error at round-off at every level: the method is exact for this problem";
+    return out;
+  }
+
+  auto usable = [&](int k) {
+    return !in.diverged[k] && std::isfinite(in.error[k]) && in.error[k] > 100.0 * roundoff_bound(in.steps[k], in.scale) &&
+           in.error[k] < 0.1 * in.scale;
+  };
+  int last = n - 1;
+  while (last >= 0 && !usable(last)) --last;
+  if (last < 2 || !usable(last - 1)) {
+    out.note = "fewer than two usable levels (diverged, at round-off or pre-asymptotic)";
+    return out;
+  }
+  auto slope = [&](int k) { return std::log(in.error[k] / in.error[k + 1]) / std::log(in.dt[k] / in.dt[k + 1]); };
+  std::vector<double> slopes{slope(last - 1)};
+  int first = last - 1;
+  while (first > 0 && usable(first - 1) && std::abs(slope(first - 1) - median(slopes)) <= 0.2) {
+    --first;
+    slopes.push_back(slope(first));
+  }
+  if (last - first + 1 < 3) {
+    out.note = "fewer than three levels in the asymptotic range";
+    return out;
+  }
+  // Least squares for log10 e = p log10 dt + c.
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  const int m = last - first + 1;
+  for (int k = first; k <= last; ++k) {
+    const double x = std::log10(in.dt[k]), y = std::log10(in.error[k]);
+    sx += x, sy += y, sxx += x * x, sxy += x * y;
+    out.levels.push_back(k);
+  }
+  out.order = (m * sxy - sx * sy) / (m * sxx - sx * sx);
+  out.intercept = (sy - out.order * sx) / m;
+  double ss = 0;
+  for (int k = first; k <= last; ++k) {
+    const double r = std::log10(in.error[k]) - (out.order * std::log10(in.dt[k]) + out.intercept);
+    ss += r * r;
+  }
+  out.residual = std::sqrt(ss / m);
+  out.state = fit_result::status::fitted;
+  return out;
+}
+
+}  // namespace stepbench

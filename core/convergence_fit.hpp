@@ -1,0 +1,52 @@
+#pragma once
+// Observed order of convergence from an error-versus-dt ladder.
+//
+// The error of an order-p method behaves as C dt^p only in the asymptotic range: below
+// it (large dt) higher-order terms or instability dominate; above it (small dt)
+// round-off does. The fit therefore:
+//  1. drops diverged levels and levels whose error is not clearly above round-off
+//     (100 times the bound 8 eps n scale, n = steps) or not clearly below the motion's
+//     size (10 % of its amplitude);
+//  2. starting from the finest remaining pair, extends towards larger dt while each
+//     local slope log(e_k / e_{k+1}) / log(dt_k / dt_{k+1}) stays within 0.2 of the
+//     median slope of the levels already taken;
+//  3. fits log e = p log dt + c by least squares over those levels (at least 3).
+// When every level's error is at round-off, the method is exact for the problem (RK4
+// on constant acceleration): no slope is fitted and the order is NaN.
+#include <string>
+#include <vector>
+
+namespace stepbench {
+
+struct fit_input {
+  std::vector<double> dt;     // decreasing
+  std::vector<double> error;  // the fitted metric at each level
+  std::vector<long> steps;
+  std::vector<bool> diverged;
+  double scale = 1.0;  // size of the motion in the metric's unit
+};
+
+struct fit_result {
+  enum class status { fitted, exact, insufficient };
+  status state = status::insufficient;
+  double order = 0.0;  // NaN unless fitted
+  double intercept = 0.0;
+  double residual = 0.0;     // RMS of the log10 residuals
+  std::vector<int> levels;   // ladder indices used by the fit
+  std::string note;          // why, when not fitted
+};
+
+inline const char* to_string(fit_result::status s) {
+  switch (s) {
+    case fit_result::status::fitted: return "fitted";
+    case fit_result::status::exact: return "exact";
+    default: return "insufficient";
+  }
+}
+
+// Round-off bound for n steps on a motion of size `scale`: 8 eps n scale.
+double roundoff_bound(long steps, double scale);
+
+fit_result fit_order(const fit_input& in);
+
+}  // namespace stepbench

@@ -1,0 +1,164 @@
+#include "core/measure.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+namespace stepbench {
+namespace {
+
+double norm_diff(std::span<const double> a, std::span<const double> b, int offset, int dim) {
+  double s = 0.0;
+  for (int i = 0; i < dim; ++i) {
+    const double d = a[offset + i] - b[offset + i];
+    s += d * d;
+  }
+  return std::sqrt(s);
+}
+
+double norm_part(std::span<const double> y, int offset, int dim) {
+  double s = 0.0;
+  for (int i = 0; i < dim; ++i) s += y[offset + i] * y[offset + i];
+  return std::sqrt(s);
+}
+
+// Kinetic energy of [x; v] is E([0; v]) - E([0; 0]) for every problem here (the
+// potential depends on x only), which needs no kinetic-energy hook in the interface.
+double kinetic(const problem_instance& p, std::span<const double> y) {
+  std::vector<double> moving(y.begin(), y.end()), rest(y.size(), 0.0);
+  for (int i = 0; i < p.dim(); ++i) moving[i] = 0.0;
+  return p.energy(moving) - p.energy(rest);
+}
+
+void set_scales(const problem_instance& p, truth_table& t) {
+  const int dim = p.dim();
+  const auto y0 = p.initial();
+  double xs = norm_part(y0, 0, dim), vs = norm_part(y0, dim, dim);
+  double es = p.has_energy() ? std::max(std::abs(p.energy(y0)), kinetic(p, y0)) : 1.0;
+  for (const auto& y : t.y) {
+    xs = std::max(xs, norm_part(y, 0, dim));
+    vs = std::max(vs, norm_part(y, dim, dim));
+    if (p.has_energy()) es = std::max({es, std::abs(p.energy(y)), kinetic(p, y)});
+  }
+  t.pos_scale = xs > 0.0 ? xs : 1.0;
+  t.vel_scale = vs > 0.0 ? vs : 1.0;
+  t.energy_scale = es > 0.0 ? es : 1.0;
+}
+
+}  // namespace
+
+agreement compare(std::span<const std::vector<double>> a, std::span<const std::vector<double>> b, int dim,
+                  double pos_scale, double vel_scale) {
+  agreement out;
+  for (size_t j = 0; j < a.size(); ++j) {
+    out.pos_rel = std::max(out.pos_rel, norm_diff(a[j], b[j], 0, dim) / pos_scale);
+    out.vel_rel = std::max(out.vel_rel, norm_diff(a[j], b[j], dim, dim) / vel_scale);
+  }
+  return out;
+}
+
+truth_table build_truth(const problem_instance& problem, std::span<const double> times, const truth_options& opts) {
+  truth_table t;
+  t.times.assign(times.begin(), times.end());
+  const bool closed = opts.use_closed_form && problem.has_closed_form();
+  if (!closed && !opts.run_references)
+    throw std::invalid_argument(fmt::format("problem {}: no closed form and references disabled", problem.name()));
+
+  if (opts.run_references) {
+    const ode_system sys = problem.ode();
+    for (const char* source : reference_sources)
+      t.references.push_back({solve_reference(source, sys, times, opts.tol), {}, {}});
+  }
+  if (closed) {
+    t.source = "closed_form";
+    for (double time : times) t.y.push_back(problem.exact(time));
+  }
+  const int dim = problem.dim();
+  if (!closed) {
+    // Scales from the first reference, used only to rank the references.
+    t.y = t.references.front().solution.y;
+    set_scales(problem, t);
+    size_t best = 0;
+    double best_score = std::numeric_limits<double>::infinity();
+    for (size_t i = 0; i < t.references.size(); ++i) {
+      double score = 0.0;
+      for (size_t k = 0; k < t.references.size(); ++k)
+        if (k != i)
+          score = std::max(score, compare(t.references[i].solution.y, t.references[k].solution.y, dim,
+                                          t.pos_scale, t.vel_scale)
+                                      .worst());
+      if (score < best_score) best_score = score, best = i;
+    }
+    t.source = t.references[best].solution.source;
+    t.y = t.references[best].solution.y;
+  }
+  set_scales(problem, t);
+
+  const double limit = opts.agreement_limit_factor * opts.tol.rtol;
+  for (auto& ref : t.references) {
+    if (!closed && ref.solution.source == t.source) {
+      // The chosen truth is reported against the runner-up, so its own row is not a 0.
+      for (const auto& other : t.references)
+        if (other.solution.source != t.source) {
+          const auto a = compare(ref.solution.y, other.solution.y, dim, t.pos_scale, t.vel_scale);
+          if (ref.compared_with.empty() || a.worst() < ref.vs.worst()) ref.vs = a, ref.compared_with = other.solution.source;
+        }
+      continue;
+    }
+    ref.compared_with = t.source;
+    ref.vs = compare(ref.solution.y, t.y, dim, t.pos_scale, t.vel_scale);
+    if (!(ref.vs.worst() <= limit))
+      throw std::runtime_error(fmt::format(
+          "reference {} disagrees with {} on problem {}: relative error {:.3e} (position) {:.3e} (velocity) "
+          "exceeds the agreement limit {:.1e}",
+          ref.solution.source, t.source, problem.name(), ref.vs.pos_rel, ref.vs.vel_rel, limit));
+  }
+  return t;
+}
+
+run_metrics measure(const problem_instance& problem, const run_result& run, const truth_table& truth) {
+  run_metrics m;
+  const int dim = problem.dim();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (run.non_finite) {
+    m.diverged = true;
+    m.diverged_reason = "non-finite state";
+  } else if (run.sample_t.size() != truth.times.size()) {
+    throw std::logic_error("measure: the run's samples do not match the truth's times");
+  }
+  if (m.diverged) {
+    m.err_pos_final = m.err_vel_final = m.err_pos_max = m.err_pos_rms = m.energy_drift = m.energy_err_max = nan;
+    return m;
+  }
+  double sum_sq = 0.0, e_max = 0.0;
+  for (size_t j = 0; j < truth.times.size(); ++j) {
+    if (std::abs(run.sample_t[j] - truth.times[j]) > 1e-12 * std::max(1.0, truth.times[j]))
+      throw std::logic_error("measure: a sample time differs from the truth's");
+    const double e = norm_diff(run.sample_y[j], truth.y[j], 0, dim);
+    m.err_pos_max = std::max(m.err_pos_max, e);
+    sum_sq += e * e;
+    if (problem.has_energy())
+      e_max = std::max(e_max, std::abs(problem.energy(run.sample_y[j]) - problem.energy(truth.y[j])));
+  }
+  m.err_pos_rms = std::sqrt(sum_sq / static_cast<double>(truth.times.size()));
+  std::vector<double> y_final = run.position;
+  y_final.insert(y_final.end(), run.velocity.begin(), run.velocity.end());
+  const auto& y_true = truth.y.back();
+  m.err_pos_final = norm_diff(y_final, y_true, 0, dim);
+  m.err_vel_final = norm_diff(y_final, y_true, dim, dim);
+  if (problem.has_energy()) {
+    m.energy_drift = (problem.energy(y_final) - problem.energy(y_true)) / truth.energy_scale;
+    m.energy_err_max = e_max / truth.energy_scale;
+  } else {
+    m.energy_drift = m.energy_err_max = nan;
+  }
+  if (!(m.err_pos_max <= blowup_factor * truth.pos_scale)) {
+    m.diverged = true;
+    m.diverged_reason = fmt::format("position error {:.3g} exceeds {:.0e} times the amplitude", m.err_pos_max, blowup_factor);
+  }
+  return m;
+}
+
+}  // namespace stepbench

@@ -1,0 +1,28 @@
+#include "core/parse.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+namespace stepbench {
+
+double parse_number(std::string_view text, std::string_view what) {
+  double value = 0.0;
+  const char* end = text.data() + text.size();
+  auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  if (text.empty() || ec != std::errc() || ptr != end || !std::isfinite(value))
+    throw std::invalid_argument(fmt::format("{} must be a finite number, got '{}'", what, text));
+  return value;
+}
+
+std::pair<std::string, double> parse_assignment(std::string_view text) {
+  const auto eq = text.find('=');
+  if (eq == std::string_view::npos || eq == 0 || eq + 1 == text.size())
+    throw std::invalid_argument(fmt::format("malformed --set '{}': expected name=value", text));
+  const std::string name(text.substr(0, eq));
+  return {name, parse_number(text.substr(eq + 1), fmt::format("--set {}", name))};
+}
+
+}  // namespace stepbench

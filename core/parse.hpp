@@ -1,0 +1,16 @@
+#pragma once
+// Strict parsing of command-line values: a number is the whole string or an error.
+#include <string>
+#include <string_view>
+#include <utility>
+
+namespace stepbench {
+
+// Parses a finite double; throws std::invalid_argument("<what> must be a number, got '<text>'").
+double parse_number(std::string_view text, std::string_view what);
+
+// Splits "name=value" (value a finite number); throws std::invalid_argument naming the
+// malformed assignment.
+std::pair<std::string, double> parse_assignment(std::string_view text);
+
+}  // namespace stepbench

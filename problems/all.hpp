@@ -1,0 +1,13 @@
+#pragma once
+// The problem registry: adding a problem is its header plus one entry here.
+#include "core/type_list.hpp"
+#include "problems/constant_acceleration.hpp"
+#include "problems/damped_spring.hpp"
+#include "problems/pendulum.hpp"
+#include "problems/projectile.hpp"
+
+namespace stepbench {
+
+using all_problems = type_list<constant_acceleration, projectile, damped_spring, pendulum>;
+
+}  // namespace stepbench

@@ -1,0 +1,95 @@
+#pragma once
+// The lecture's RK4 example (digest sections 4 and 6): a unit mass on a spring and
+// damper, F = -k_s x - k_d v, i.e. m x'' + k_d x' + k_s x = 0.
+//
+// Closed form for every damping regime in one expression. With gamma = k_d / (2m),
+// w0^2 = k_s / m, D = gamma^2 - w0^2 and s = sqrt|D|:
+//   x(t) = x0 Phi(t) + (v0 + gamma x0) Psi(t),
+//   Phi = e^{-gamma t} C(t), Psi = e^{-gamma t} S(t),
+// with (C, S) = (cos st, sin(st)/s) under-damped (D < 0), (1, t) critical (D = 0),
+// (cosh st, sinh(st)/s) over-damped (D > 0). Since C' = D S and S' = C,
+//   Phi' = -gamma Phi + D Psi, Psi' = -gamma Psi + Phi.
+// sin(st)/s tends to t as s -> 0, so near-critical damping loses no accuracy; the
+// over-damped branch is written with e^{(s - gamma) t} and e^{-(s + gamma) t} so that
+// neither cosh nor e^{-gamma t} overflows, with s - gamma = -w0^2 / (s + gamma) free of
+// cancellation.
+#include <cmath>
+
+#include <Eigen/Core>
+
+#include "core/concepts.hpp"
+
+namespace stepbench {
+
+struct damped_spring {
+  static constexpr std::string_view name = "damped_spring";
+  static constexpr std::string_view description = "mass on a spring and damper (lecture's RK4 example)";
+  static constexpr int dim = 1;
+  static constexpr bool force_depends_on_velocity = true;
+  using vec = Eigen::Matrix<double, 1, 1>;
+
+  double k_s = 10.0;
+  double k_d = 1.0;
+  double mass_kg = 1.0;
+  double x0 = 1.0;
+  double v0 = 0.0;
+  double duration = 10.0;
+
+  static constexpr auto parameters() {
+    using p = param<damped_spring>;
+    return std::array{
+        p{"k_s", &damped_spring::k_s, "N/m", "spring stiffness"},
+        p{"k_d", &damped_spring::k_d, "N s/m", "damping coefficient"},
+        p{"mass_kg", &damped_spring::mass_kg, "kg", "mass"},
+        p{"x0", &damped_spring::x0, "m", "initial displacement"},
+        p{"v0", &damped_spring::v0, "m/s", "initial velocity"},
+        p{"duration", &damped_spring::duration, "s", "default horizon"},
+    };
+  }
+  std::string validate() const {
+    for (auto err : {require_positive("k_s", k_s), require_positive("mass_kg", mass_kg),
+                     require_positive("duration", duration), require_finite("x0", x0), require_finite("v0", v0)})
+      if (!err.empty()) return err;
+    if (!(std::isfinite(k_d) && k_d >= 0.0)) return "k_d must be finite and >= 0";
+    return {};
+  }
+
+  double mass() const { return mass_kg; }
+  vec force(double, const vec& x, const vec& v) const { return -k_s * x - k_d * v; }
+  phase<vec> initial() const { return {vec(x0), vec(v0)}; }
+  double horizon() const { return duration; }
+
+  double gamma() const { return k_d / (2.0 * mass_kg); }
+  double omega0_sq() const { return k_s / mass_kg; }
+  // Damping ratio zeta = k_d / (2 sqrt(k_s m)): < 1 under-, = 1 critically, > 1 over-damped.
+  double damping_ratio() const { return k_d / (2.0 * std::sqrt(k_s * mass_kg)); }
+
+  phase<vec> exact(double t) const {
+    const double g = gamma();
+    const double d = g * g - omega0_sq();
+    double phi, psi;
+    if (d < 0.0) {
+      const double s = std::sqrt(-d), decay = std::exp(-g * t);
+      phi = decay * std::cos(s * t);
+      psi = decay * std::sin(s * t) / s;
+    } else if (d == 0.0) {
+      const double decay = std::exp(-g * t);
+      phi = decay;
+      psi = decay * t;
+    } else {
+      const double s = std::sqrt(d);
+      const double slow = std::exp(-omega0_sq() / (s + g) * t), fast = std::exp(-(s + g) * t);
+      phi = 0.5 * (slow + fast);
+      psi = (slow - fast) / (2.0 * s);
+    }
+    const double b = v0 + g * x0;
+    const double x = x0 * phi + b * psi;
+    const double v = x0 * (-g * phi + d * psi) + b * (-g * psi + phi);
+    return {vec(x), vec(v)};
+  }
+  // Mechanical energy; the damper dissipates it, so it is compared with the exact
+  // solution's energy, not with E(0).
+  double energy(const vec& x, const vec& v) const { return 0.5 * mass_kg * v.squaredNorm() + 0.5 * k_s * x.squaredNorm(); }
+};
+
+}  // namespace stepbench

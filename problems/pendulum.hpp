@@ -1,0 +1,80 @@
+#pragma once
+// Simple pendulum (the lecture's console example, digest section 8):
+// theta'' = -(g/L) sin(theta), released from rest at theta0.
+//
+// State is the angle: x = theta [rad], v = theta' [rad/s]. The integrators see the
+// torque as the force, F = -m g L sin(theta), and the moment of inertia m L^2 as the
+// mass, so F / m is the angular acceleration.
+//
+// Closed form (e.g. Lawden, "Elliptic Functions and Applications", sec. 5.2): with
+// k = sin(theta0 / 2), w0 = sqrt(g / L) and K = K(k) the complete elliptic integral of
+// the first kind,
+//   sin(theta / 2) = k sn(K - w0 t | k^2),   theta' = -2 k w0 cn(K - w0 t | k^2),
+// (differentiate: cos(theta/2) = dn, and d sn/du = cn dn). The exact period is
+// T = 4 K(k) / w0. sn, cn come from gsl_sf_elljac_e, K from gsl_sf_ellint_Kcomp.
+#include <cmath>
+#include <numbers>
+
+#include <Eigen/Core>
+#include <gsl/gsl_mode.h>
+#include <gsl/gsl_sf_ellint.h>
+#include <gsl/gsl_sf_elljac.h>
+
+#include "core/concepts.hpp"
+
+namespace stepbench {
+
+struct pendulum {
+  static constexpr std::string_view name = "pendulum";
+  static constexpr std::string_view description = "simple pendulum, large swing, released from rest";
+  static constexpr int dim = 1;
+  static constexpr bool force_depends_on_velocity = false;
+  using vec = Eigen::Matrix<double, 1, 1>;
+
+  double gravity = 9.8;
+  double length_m = 1.0;
+  double mass_kg = 1.0;
+  double theta0_deg = 120.0;
+  double periods = 2.0;
+
+  static constexpr auto parameters() {
+    using p = param<pendulum>;
+    return std::array{
+        p{"gravity", &pendulum::gravity, "m/s^2", "gravitational acceleration"},
+        p{"length_m", &pendulum::length_m, "m", "rod length"},
+        p{"mass_kg", &pendulum::mass_kg, "kg", "bob mass"},
+        p{"theta0_deg", &pendulum::theta0_deg, "deg", "release angle from the bottom"},
+        p{"periods", &pendulum::periods, "1", "default horizon in exact periods"},
+    };
+  }
+  std::string validate() const {
+    for (auto err : {require_positive("gravity", gravity), require_positive("length_m", length_m),
+                     require_positive("mass_kg", mass_kg), require_positive("periods", periods)})
+      if (!err.empty()) return err;
+    if (!(theta0_deg > 0.0 && theta0_deg < 180.0)) return "theta0_deg must be in (0, 180)";
+    return {};
+  }
+
+  double theta0() const { return theta0_deg * std::numbers::pi / 180.0; }
+  double omega0() const { return std::sqrt(gravity / length_m); }
+  double modulus() const { return std::sin(0.5 * theta0()); }
+  double quarter_period_k() const { return gsl_sf_ellint_Kcomp(modulus(), GSL_PREC_DOUBLE); }
+  double period() const { return 4.0 * quarter_period_k() / omega0(); }
+
+  double mass() const { return mass_kg * length_m * length_m; }
+  vec force(double, const vec& x, const vec&) const { return vec(-mass_kg * gravity * length_m * std::sin(x[0])); }
+  phase<vec> initial() const { return {vec(theta0()), vec(0.0)}; }
+  double horizon() const { return periods * period(); }
+
+  phase<vec> exact(double t) const {
+    const double k = modulus();
+    double sn, cn, dn;
+    gsl_sf_elljac_e(quarter_period_k() - omega0() * t, k * k, &sn, &cn, &dn);
+    return {vec(2.0 * std::asin(k * sn)), vec(-2.0 * k * omega0() * cn)};
+  }
+  double energy(const vec& x, const vec& v) const {
+    return 0.5 * mass() * v.squaredNorm() + mass_kg * gravity * length_m * (1.0 - std::cos(x[0]));
+  }
+};
+
+}  // namespace stepbench

@@ -1,0 +1,79 @@
+#pragma once
+// Projectile motion (digest section 2): up is +z, gravity g = [0, 0, -g]. Launched from
+// the origin along +x at `speed` and `angle_deg` above the horizon. The horizon is the
+// flight time back to launch height, 2 v_z / g. Closed form x(t) = x0 + v0 t + g t^2 / 2.
+#include <cmath>
+#include <numbers>
+
+#include <Eigen/Core>
+
+#include "core/concepts.hpp"
+
+namespace stepbench {
+
+struct projectile {
+  static constexpr std::string_view name = "projectile";
+  static constexpr std::string_view description = "3-D ball under uniform gravity, launched from the ground";
+  static constexpr int dim = 3;
+  static constexpr bool force_depends_on_velocity = false;
+  using vec = Eigen::Vector3d;
+
+  double speed = 50.0;
+  double angle_deg = 70.0;
+  double gravity = 9.8;
+  double mass_kg = 1.0;
+
+  static constexpr auto parameters() {
+    using p = param<projectile>;
+    return std::array{
+        p{"speed", &projectile::speed, "m/s", "launch speed"},
+        p{"angle_deg", &projectile::angle_deg, "deg", "elevation above +x"},
+        p{"gravity", &projectile::gravity, "m/s^2", "magnitude of g, along -z"},
+        p{"mass_kg", &projectile::mass_kg, "kg", "mass"},
+    };
+  }
+  std::string validate() const {
+    for (auto err : {require_positive("speed", speed), require_positive("gravity", gravity),
+                     require_positive("mass_kg", mass_kg)})
+      if (!err.empty()) return err;
+    if (!(angle_deg > 0.0 && angle_deg < 180.0)) return "angle_deg must be in (0, 180) so the ball flies";
+    return {};
+  }
+
+  double angle_rad() const { return angle_deg * std::numbers::pi / 180.0; }
+  vec launch_velocity() const { return {speed * std::cos(angle_rad()), 0.0, speed * std::sin(angle_rad())}; }
+  vec g() const { return {0.0, 0.0, -gravity}; }
+
+  double mass() const { return mass_kg; }
+  vec force(double, const vec&, const vec&) const { return mass_kg * g(); }
+  phase<vec> initial() const { return {vec::Zero(), launch_velocity()}; }
+  double horizon() const { return flight_time(); }
+
+  phase<vec> exact(double t) const {
+    const vec v0 = launch_velocity();
+    return {v0 * t + 0.5 * g() * t * t, v0 + g() * t};
+  }
+  double energy(const vec& x, const vec& v) const { return 0.5 * mass_kg * v.squaredNorm() + mass_kg * gravity * x.z(); }
+
+  // The lecture's formulas (digest section 2), launch and landing at the same height.
+  double flight_time() const { return 2.0 * launch_velocity().z() / gravity; }
+  double apex_time() const { return launch_velocity().z() / gravity; }
+  double apex_height() const {
+    const double vz = launch_velocity().z();
+    return vz * vz / (2.0 * gravity);
+  }
+  double range() const { return speed * speed * std::sin(2.0 * angle_rad()) / gravity; }
+};
+
+// Launch angle (radians) that reaches apex height h above the launch point at speed s:
+// a = asin( sqrt(2 g h) / s ). Returns NaN when h is out of reach.
+inline double launch_angle_for_height(double h, double s, double g) { return std::asin(std::sqrt(2.0 * g * h) / s); }
+
+// The two launch angles (radians) that land at range r: a = asin(r g / s^2) / 2 and
+// pi/2 - a. NaN when r is beyond the maximum range s^2 / g.
+inline std::array<double, 2> launch_angles_for_range(double r, double s, double g) {
+  const double low = 0.5 * std::asin(r * g / (s * s));
+  return {low, std::numbers::pi / 2.0 - low};
+}
+
+}  // namespace stepbench

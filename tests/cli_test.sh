@@ -1,0 +1,82 @@
+#!/usr/bin/env bash
+# The command line as a user meets it: the lecture's example through `run --json`, and
+# every kind of bad input getting one line on stderr, a non-zero exit, and an existing
+# results file left as it was.
+set -u
+bin=${1:?usage: cli_test.sh path/to/stepbench}
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fails=0 passes=0
+ok() { passes=$((passes + 1)); }
+bad() { echo "FAIL: $*"; fails=$((fails + 1)); }
+
+# expect_error "<what the message must contain>" args...
+expect_error() {
+  local want=$1; shift
+  "$bin" "$@" >"$work/out" 2>"$work/err"
+  local rc=$?
+  local lines; lines=$(wc -l <"$work/err")
+  if [ "$rc" -eq 0 ]; then bad "exit 0 for: $*"; return; fi
+  if [ "$lines" -ne 1 ]; then bad "$lines lines on stderr for: $* :: $(cat "$work/err")"; return; fi
+  grep -qi -- "$want" "$work/err" || { bad "message lacks '$want' for: $* :: $(cat "$work/err")"; return; }
+  ok
+}
+
+# The lecture's example: 450 m with explicit Euler, exact 500 m.
+out=$("$bin" run --problem constant_acceleration --integrator euler --dt 1 --json) || bad "run --json failed"
+/usr/bin/python3 - "$out" <<'PY' && ok || bad "run --json content"
+import json, sys
+d = json.loads(sys.argv[1])
+need = {"problem", "integrator", "dt", "horizon", "steps", "force_evals", "position", "velocity",
+        "err_pos_final", "err_vel_final", "energy_drift", "diverged"}
+assert need <= d.keys(), need - d.keys()
+assert d["position"] == [450.0] and d["steps"] == 10 and d["force_evals"] == 10, d
+assert d["err_pos_final"] == 50.0 and d["diverged"] is False, d
+PY
+"$bin" list --json | /usr/bin/python3 -c '
+import json, sys
+d = json.load(sys.stdin)
+names = {p["name"] for p in d["problems"]}
+assert names == {"constant_acceleration", "projectile", "damped_spring", "pendulum"}, names
+orders = {i["name"]: i["expected_order"] for i in d["integrators"]}
+assert orders == {"euler": 1, "semi_implicit_euler": 1, "midpoint": 2, "rk4": 4, "momentum": 1, "velocity_verlet": 2}, orders
+' && ok || bad "list --json"
+
+# A parameter override changes the answer as the closed form says: 20 N gives 1000 m.
+"$bin" run --problem constant_acceleration --integrator rk4 --dt 0.5 --set force_n=20 --json |
+  /usr/bin/python3 -c 'import json,sys; d=json.load(sys.stdin); assert abs(d["position"][0]-1000.0) < 1e-9, d' && ok || bad "--set"
+
+# Bad input.
+expect_error "unknown problem 'nope'" run --problem nope --integrator rk4 --dt 0.1
+expect_error "unknown integrator 'rk5'" run --problem pendulum --integrator rk5 --dt 0.1
+expect_error "--dt must be > 0" run --problem pendulum --integrator rk4 --dt 0
+expect_error "--dt must be > 0" run --problem pendulum --integrator rk4 --dt -1
+expect_error "--dt must be a finite number, got 'abc'" run --problem pendulum --integrator rk4 --dt abc
+expect_error "--dt must be a finite number, got 'nan'" run --problem pendulum --integrator rk4 --dt nan
+expect_error "--dt must be a finite number, got '0.1x'" run --problem pendulum --integrator rk4 --dt 0.1x
+expect_error "--horizon must be > 0" run --problem pendulum --integrator rk4 --dt 0.1 --horizon 0
+expect_error "--horizon must be a finite number" run --problem pendulum --integrator rk4 --dt 0.1 --horizon inf
+expect_error "malformed --set 'theta0_deg'" run --problem pendulum --integrator rk4 --dt 0.1 --set theta0_deg
+expect_error "malformed --set '=3'" run --problem pendulum --integrator rk4 --dt 0.1 --set =3
+expect_error "--set theta0_deg must be a finite number" run --problem pendulum --integrator rk4 --dt 0.1 --set theta0_deg=big
+expect_error "unknown parameter 'k' for problem pendulum" run --problem pendulum --integrator rk4 --dt 0.1 --set k=1
+expect_error "theta0_deg must be in (0, 180)" run --problem pendulum --integrator rk4 --dt 0.1 --set theta0_deg=200
+expect_error "--problem is required" run --integrator rk4 --dt 0.1
+expect_error "unknown problem 'nope'" sweep --problem nope --out "$work/s.h5"
+expect_error "unknown integrator 'rk5'" sweep --integrator rk5 --out "$work/s.h5"
+expect_error "cannot write results file '$work/missing/s.h5'" sweep --levels 3 --out "$work/missing/s.h5"
+expect_error "it is a directory" sweep --levels 3 --out "$work"
+
+# An existing results file survives every failed sweep, byte for byte.
+echo "previous results" >"$work/study.h5"
+expect_error "unknown parameter 'zzz'" sweep --problem pendulum --set zzz=1 --out "$work/study.h5"
+expect_error "levels must be between 2 and 20" sweep --levels 1 --out "$work/study.h5"
+[ "$(cat "$work/study.h5")" = "previous results" ] && ok || bad "existing results file was touched"
+[ -z "$(ls "$work" | grep tmp)" ] && ok || bad "temporary file left behind: $(ls "$work")"
+
+# A good sweep replaces it whole.
+"$bin" sweep --problem damped_spring --integrator rk4 --levels 3 --quiet --out "$work/study.h5" >/dev/null || bad "small sweep failed"
+head -c 4 "$work/study.h5" | grep -q HDF && ok || bad "study file is not HDF5"
+
+echo "cli: $passes passed, $fails failed"
+[ "$fails" -eq 0 ]

@@ -1,0 +1,75 @@
+// The order fit on synthetic ladders with known answers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/convergence_fit.hpp"
+
+using namespace stepbench;
+
+namespace {
+
+fit_input ladder(int levels, auto error_of_dt) {
+  fit_input in;
+  for (int k = 0; k < levels; ++k) {
+    const double dt = 0.5 / std::ldexp(1.0, k);
+    in.dt.push_back(dt);
+    in.error.push_back(error_of_dt(dt));
+    in.steps.push_back(20L << k);
+    in.diverged.push_back(false);
+  }
+  return in;
+}
+
+}  // namespace
+
+TEST(fit, recovers_a_pure_power_law) {
+  const auto r = fit_order(ladder(8, [](double dt) { return 3e-3 * std::pow(dt, 2); }));
+  ASSERT_EQ(r.state, fit_result::status::fitted);
+  EXPECT_NEAR(r.order, 2.0, 1e-12);
+  EXPECT_NEAR(r.intercept, std::log10(3e-3), 1e-10);
+  EXPECT_EQ(r.levels.size(), 8u);
+}
+
+// Pre-asymptotic levels (error saturating at the motion's size) and a round-off floor
+// at the fine end are left out; the levels used are the clean power-law ones.
+TEST(fit, skips_preasymptotic_and_roundoff_levels) {
+  auto in = ladder(12, [](double dt) { return 5e-2 * std::pow(dt, 4) + 1e-15; });
+  in.error[0] = 0.5;  // saturated: above 10 % of the unit scale
+  const auto r = fit_order(in);
+  ASSERT_EQ(r.state, fit_result::status::fitted);
+  EXPECT_NEAR(r.order, 4.0, 0.02);
+  EXPECT_EQ(r.levels.front(), 1);
+  EXPECT_LT(r.levels.back(), 11);  // the finest levels sit at the 1e-15 floor
+}
+
+TEST(fit, diverged_levels_are_excluded) {
+  auto in = ladder(8, [](double dt) { return 1e-2 * dt; });
+  in.diverged[0] = in.diverged[1] = true;
+  in.error[0] = in.error[1] = NAN;
+  const auto r = fit_order(in);
+  ASSERT_EQ(r.state, fit_result::status::fitted);
+  EXPECT_NEAR(r.order, 1.0, 1e-12);
+  EXPECT_EQ(r.levels.front(), 2);
+}
+
+TEST(fit, roundoff_everywhere_is_exact) {
+  const auto r = fit_order(ladder(8, [](double) { return 1e-16; }));
+  EXPECT_EQ(r.state, fit_result::status::exact);
+  EXPECT_TRUE(std::isnan(r.order));
+  EXPECT_TRUE(r.levels.empty());
+}
+
+// A change of slope (order 1 at large dt turning into order 2) is not averaged: the
+// fit keeps the fine end, where the asymptotic behaviour is.
+TEST(fit, keeps_the_fine_end_of_a_slope_change) {
+  const auto r = fit_order(ladder(10, [](double dt) { return dt < 0.03 ? 1e-2 * dt * dt : 3e-4 * dt / 0.03; }));
+  ASSERT_EQ(r.state, fit_result::status::fitted);
+  EXPECT_NEAR(r.order, 2.0, 1e-9);
+}
+
+TEST(fit, too_few_levels_is_insufficient) {
+  const auto r = fit_order(ladder(2, [](double dt) { return dt; }));
+  EXPECT_EQ(r.state, fit_result::status::insufficient);
+  EXPECT_FALSE(r.note.empty());
+}

@@ -1,0 +1,74 @@
+// Per-integrator properties over the list of all integrators: force evaluations per
+// step, exactness where the method's order allows it, and the drive loop's step logic.
+#include <gtest/gtest.h>
+
+#include "core/drive.hpp"
+#include "integrators/all.hpp"
+#include "problems/all.hpp"
+
+using namespace stepbench;
+
+// Force evaluations of n steps: explicit methods pay their stage count every step;
+// velocity Verlet reuses a_{n+1} when the force ignores the velocity (n + 1), and
+// cannot when it does not (2 n).
+TEST(integrators, force_evaluations_per_step) {
+  const damped_spring spring;
+  const pendulum pend;
+  const long n = 100;
+  auto evals = [&](auto method, const auto& problem) {
+    return drive(problem, method, problem.horizon() / n, problem.horizon(), std::span<const long>{}).force_evals;
+  };
+  EXPECT_EQ(evals(euler{}, spring), n);
+  EXPECT_EQ(evals(semi_implicit_euler{}, spring), n);
+  EXPECT_EQ(evals(momentum{}, spring), n);
+  EXPECT_EQ(evals(midpoint{}, spring), 2 * n);
+  EXPECT_EQ(evals(rk4{}, spring), 4 * n);
+  EXPECT_EQ(evals(velocity_verlet{}, spring), 2 * n);
+  EXPECT_EQ(evals(velocity_verlet{}, pend), n + 1);
+  EXPECT_EQ(evals(rk4{}, pend), 4 * n);
+}
+
+// One step of each method on x'' = -x from (1, 0), against its Taylor expansion:
+// the local error of an order-p method is O(dt^{p+1}).
+TEST(integrators, one_step_matches_taylor_series_to_order) {
+  damped_spring p;
+  p.k_s = 1.0;
+  p.k_d = 0.0;
+  const double dt = 1e-2;
+  for_each_type(all_integrators{}, [&]<class I>() {
+    const auto s = drive(p, I{}, dt, dt, std::span<const long>{}).final_state;
+    const double err = std::abs(s.x[0] - std::cos(dt)) + std::abs(s.v[0] + std::sin(dt));
+    EXPECT_LT(err, 2.0 * std::pow(dt, I::order + 1)) << I::name;
+    EXPECT_GT(err, 1e-3 * std::pow(dt, I::order + 2)) << I::name << " is suspiciously better than its order";
+  });
+}
+
+TEST(drive, steps_and_last_step_land_on_the_horizon) {
+  EXPECT_EQ(steps_for(10.0, 1.0), 10);
+  EXPECT_EQ(steps_for(10.0, 3.0), 4);  // 3 + 3 + 3 + 1
+  EXPECT_EQ(steps_for(1.0, 0.1), 10);  // 1.0 / 0.1 = 10.000000000000002 must not add a sliver
+  const constant_acceleration p;
+  const auto r = drive(p, euler{}, 3.0, 10.0, std::span<const long>{});
+  EXPECT_EQ(r.steps, 4);
+  EXPECT_DOUBLE_EQ(r.t_final, 10.0);
+  // Euler with steps 3, 3, 3, 1 under a = 10: x = sum v_i h_i = 0*3 + 30*3 + 60*3 + 90*1.
+  EXPECT_DOUBLE_EQ(r.final_state.x[0], 360.0);
+}
+
+TEST(drive, sample_steps_hit_fixed_fractions) {
+  const auto s = sample_steps(10.0, 10.0 / 64, 32);
+  ASSERT_EQ(s.size(), 32u);
+  EXPECT_EQ(s.front(), 2);
+  EXPECT_EQ(s.back(), 64);
+  const auto few = sample_steps(10.0, 1.0, 32);  // fewer steps than samples: every step once
+  EXPECT_EQ(few.size(), 10u);
+}
+
+TEST(drive, non_finite_state_stops_the_run) {
+  damped_spring p;
+  p.k_s = 1e200;  // explicit Euler overflows within a few steps
+  const std::vector<long> record{1, 2, 3, 4, 5, 6, 7, 8, 9, 10};
+  const auto r = drive(p, euler{}, 1.0, 10.0, record);
+  EXPECT_TRUE(r.non_finite);
+  EXPECT_LT(r.steps, 10);
+}

@@ -1,0 +1,158 @@
+// The lecture's worked examples and the closed forms of the problems.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "core/drive.hpp"
+#include "integrators/all.hpp"
+#include "problems/all.hpp"
+#include "problems/incline.hpp"
+
+using namespace stepbench;
+
+namespace {
+
+template <class I, class P>
+phase<typename P::vec> final_state(const P& p, double dt, double horizon) {
+  return drive(p, I{}, dt, horizon, std::span<const long>{}).final_state;
+}
+
+// Checks x'' = F(t, x, x') / m for a closed form by central differences at t.
+template <class P>
+void expect_satisfies_ode(const P& p, double t, double tol) {
+  const double h = 1e-4;
+  const auto s = p.exact(t);
+  const auto xp = p.exact(t + h).x, xm = p.exact(t - h).x;
+  const auto vp = p.exact(t + h).v, vm = p.exact(t - h).v;
+  for (int i = 0; i < P::dim; ++i) {
+    EXPECT_NEAR((xp[i] - xm[i]) / (2 * h), s.v[i], tol) << P::name << " x' at t=" << t;
+    EXPECT_NEAR((vp[i] - vm[i]) / (2 * h), (p.force(t, s.x, s.v) / p.mass())[i], tol) << P::name << " v' at t=" << t;
+  }
+}
+
+}  // namespace
+
+// Digest section 6: 10 N on 1 kg from rest, 10 s, dt = 1 s. Exact 500 m; explicit
+// Euler 450 m (the lecture's 470 m is wrong); semi-implicit Euler 550 m.
+TEST(lecture, euler_example_distances) {
+  const constant_acceleration p;
+  EXPECT_DOUBLE_EQ(p.exact(10.0).x[0], 500.0);
+  EXPECT_DOUBLE_EQ((final_state<euler>(p, 1.0, 10.0).x[0]), 450.0);
+  EXPECT_DOUBLE_EQ((final_state<semi_implicit_euler>(p, 1.0, 10.0).x[0]), 550.0);
+  EXPECT_DOUBLE_EQ((final_state<momentum>(p, 1.0, 10.0).x[0]), 550.0);
+  // Second order and up are exact for constant acceleration.
+  EXPECT_DOUBLE_EQ((final_state<midpoint>(p, 1.0, 10.0).x[0]), 500.0);
+  EXPECT_DOUBLE_EQ((final_state<rk4>(p, 1.0, 10.0).x[0]), 500.0);
+  EXPECT_DOUBLE_EQ((final_state<velocity_verlet>(p, 1.0, 10.0).x[0]), 500.0);
+}
+
+// The lecture's loop runs `while (t <= 10)`: eleven explicit Euler steps, 550 m; not
+// 470 m either way.
+TEST(lecture, euler_example_eleven_steps) {
+  const constant_acceleration p;
+  EXPECT_DOUBLE_EQ((final_state<euler>(p, 1.0, 11.0).x[0]), 550.0);
+}
+
+// Digest section 2: 50 m/s at 70 degrees, g = 9.8. Range s^2 sin(2a) / g, apex
+// vz^2 / (2 g), flight time 2 vz / g (values computed independently in double
+// precision from those formulas).
+TEST(lecture, projectile_range_apex_flight_time) {
+  const projectile p;
+  EXPECT_NEAR(p.range(), 163.97643104248456, 1e-10);
+  EXPECT_NEAR(p.apex_height(), 112.63038540299603, 1e-10);
+  EXPECT_NEAR(p.flight_time(), 9.588700212101104, 1e-12);
+  EXPECT_DOUBLE_EQ(p.horizon(), p.flight_time());
+  // The closed form lands at the range, at launch height, and peaks at the apex.
+  EXPECT_NEAR(p.exact(p.flight_time()).x.x(), p.range(), 1e-10);
+  EXPECT_NEAR(p.exact(p.flight_time()).x.z(), 0.0, 1e-10);
+  EXPECT_NEAR(p.exact(p.apex_time()).x.z(), p.apex_height(), 1e-10);
+  EXPECT_NEAR(p.exact(p.apex_time()).v.z(), 0.0, 1e-12);
+  // RK4 is exact on uniform gravity: it lands on the range with only 10 steps.
+  const auto s = final_state<rk4>(p, p.horizon() / 10, p.horizon());
+  EXPECT_NEAR(s.x.x(), p.range(), 1e-10);
+  EXPECT_NEAR(s.x.z(), 0.0, 1e-10);
+  // The inverse formulas recover the launch angle.
+  EXPECT_NEAR(launch_angle_for_height(p.apex_height(), p.speed, p.gravity), p.angle_rad(), 1e-12);
+  const auto angles = launch_angles_for_range(p.range(), p.speed, p.gravity);
+  EXPECT_NEAR(angles[1], p.angle_rad(), 1e-12);
+  EXPECT_NEAR(angles[0], std::numbers::pi / 2 - p.angle_rad(), 1e-12);
+}
+
+// Digest section 3: block on a 30 degree incline, mu_k = 0.5: a = g sin - mu_k g cos,
+// about 0.656 m/s^2; static mu_s = 0.5 slides from atan(0.5), about 26.57 degrees.
+TEST(lecture, incline_acceleration_and_sliding_angle) {
+  const double theta = 30.0 * std::numbers::pi / 180.0;
+  EXPECT_NEAR(incline::sliding_acceleration(9.8, theta, 0.5), 0.6564755214562499, 1e-12);
+  EXPECT_NEAR(incline::sliding_angle(0.5) * 180.0 / std::numbers::pi, 26.56505117707799, 1e-10);
+  EXPECT_NEAR(incline::normal_force(10.0, 9.8, theta), 98.0 * std::sqrt(3.0) / 2.0, 1e-12);
+}
+
+TEST(damped_spring, closed_form_all_regimes) {
+  for (double k_d : {0.0, 1.0, 2.0 * std::sqrt(10.0), 2.0 * std::sqrt(10.0) * (1 + 1e-9), 15.0}) {
+    damped_spring p;
+    p.k_d = k_d;
+    p.v0 = -0.7;
+    const auto s0 = p.exact(0.0);
+    EXPECT_NEAR(s0.x[0], p.x0, 1e-15) << "k_d " << k_d;
+    EXPECT_NEAR(s0.v[0], p.v0, 1e-14) << "k_d " << k_d;
+    for (double t : {0.3, 1.7, 4.0, 9.5}) expect_satisfies_ode(p, t, 1e-6);
+  }
+}
+
+// Near-critical damping must not lose accuracy: the closed form is continuous in k_d.
+TEST(damped_spring, closed_form_continuous_through_critical) {
+  damped_spring crit, under, over;
+  crit.k_d = 2.0 * std::sqrt(10.0);
+  under.k_d = crit.k_d * (1 - 1e-10);
+  over.k_d = crit.k_d * (1 + 1e-10);
+  for (double t : {0.5, 2.0, 8.0}) {
+    EXPECT_NEAR(under.exact(t).x[0], crit.exact(t).x[0], 1e-8);
+    EXPECT_NEAR(over.exact(t).x[0], crit.exact(t).x[0], 1e-8);
+  }
+  damped_spring very_over;  // large gamma t must not overflow cosh or underflow to NaN
+  very_over.k_d = 2000.0;
+  EXPECT_TRUE(std::isfinite(very_over.exact(1000.0).x[0]));
+}
+
+// K(k) for k = sin 60 deg, i.e. m = k^2 = 3/4: 2.156515647499643 (Abramowitz & Stegun
+// table 17.1; scipy.special.ellipk(0.75) gives the same to 16 digits).
+TEST(pendulum, exact_period_from_elliptic_integral) {
+  const pendulum p;  // 120 degrees
+  EXPECT_NEAR(p.quarter_period_k(), 2.156515647499643, 1e-14);
+  EXPECT_NEAR(p.period(), 4.0 * 2.156515647499643 / std::sqrt(9.8), 1e-13);
+  // The large swing is 37 % slower than the small-angle period 2 pi sqrt(L/g).
+  EXPECT_NEAR(p.period() / (2 * std::numbers::pi / std::sqrt(9.8)), 1.3728, 1e-4);
+  // After one exact period the closed form is back at rest at theta0.
+  EXPECT_NEAR(p.exact(p.period()).x[0], p.theta0(), 1e-12);
+  EXPECT_NEAR(p.exact(p.period()).v[0], 0.0, 1e-12);
+  // At a quarter period it passes the bottom at the speed energy conservation gives.
+  EXPECT_NEAR(p.exact(p.period() / 4).x[0], 0.0, 1e-12);
+  EXPECT_NEAR(std::abs(p.exact(p.period() / 4).v[0]), std::sqrt(2 * 9.8 * (1 - std::cos(p.theta0()))), 1e-12);
+}
+
+TEST(pendulum, closed_form_satisfies_ode_and_conserves_energy) {
+  const pendulum p;
+  const auto s0 = p.initial();
+  for (double t : {0.1, 0.9, 2.2, 4.4}) {
+    expect_satisfies_ode(p, t, 1e-6);
+    const auto s = p.exact(t);
+    EXPECT_NEAR(p.energy(s.x, s.v), p.energy(s0.x, s0.v), 1e-12);
+  }
+}
+
+TEST(problems, validate_rejects_bad_parameters) {
+  pendulum p;
+  p.theta0_deg = 180.0;
+  EXPECT_NE(p.validate(), "");
+  damped_spring d;
+  d.mass_kg = 0.0;
+  EXPECT_NE(d.validate(), "");
+  d = {};
+  d.k_d = -1.0;
+  EXPECT_NE(d.validate(), "");
+  projectile pr;
+  pr.speed = std::nan("");
+  EXPECT_NE(pr.validate(), "");
+  EXPECT_EQ(constant_acceleration{}.validate(), "");
+}

@@ -10,6 +10,10 @@ double roundoff_bound(long steps, double scale) {
   return 8.0 * std::numeric_limits<double>::epsilon() * static_cast<double>(std::max(1L, steps)) * scale;
 }
 
+double roundoff_noise(long steps, double scale) {
+  return std::numeric_limits<double>::epsilon() * std::sqrt(static_cast<double>(std::max(1L, steps))) * scale;
+}
+
 namespace {
 
 double median(std::vector<double> v) {
@@ -35,7 +39,7 @@ fit_result fit_order(const fit_input& in) {
   }
 
   auto usable = [&](int k) {
-    return !in.diverged[k] && std::isfinite(in.error[k]) && in.error[k] > 100.0 * roundoff_bound(in.steps[k], in.scale) &&
+    return !in.diverged[k] && std::isfinite(in.error[k]) && in.error[k] > 100.0 * roundoff_noise(in.steps[k], in.scale) &&
            in.error[k] < 0.1 * in.scale;
   };
   int last = n - 1;
@@ -47,7 +51,7 @@ fit_result fit_order(const fit_input& in) {
   auto slope = [&](int k) { return std::log(in.error[k] / in.error[k + 1]) / std::log(in.dt[k] / in.dt[k + 1]); };
   std::vector<double> slopes{slope(last - 1)};
   int first = last - 1;
-  while (first > 0 && usable(first - 1) && std::abs(slope(first - 1) - median(slopes)) <= 0.2) {
+  while (first > 0 && usable(first - 1) && std::abs(slope(first - 1) - median(slopes)) <= 0.1) {
     --first;
     slopes.push_back(slope(first));
   }

@@ -5,14 +5,16 @@
 // it (large dt) higher-order terms or instability dominate; above it (small dt)
 // round-off does. The fit therefore:
 //  1. drops diverged levels and levels whose error is not clearly above round-off
-//     (100 times the bound 8 eps n scale, n = steps) or not clearly below the motion's
-//     size (10 % of its amplitude);
+//     noise (100 times its typical size eps scale sqrt(n), n = steps: rounding errors
+//     of a stable method accumulate like a random walk) or not clearly below the
+//     motion's size (10 % of its amplitude);
 //  2. starting from the finest remaining pair, extends towards larger dt while each
-//     local slope log(e_k / e_{k+1}) / log(dt_k / dt_{k+1}) stays within 0.2 of the
+//     local slope log(e_k / e_{k+1}) / log(dt_k / dt_{k+1}) stays within 0.1 of the
 //     median slope of the levels already taken;
 //  3. fits log e = p log dt + c by least squares over those levels (at least 3).
-// When every level's error is at round-off, the method is exact for the problem (RK4
-// on constant acceleration): no slope is fitted and the order is NaN.
+// When every level's error is within the worst-case round-off bound 8 eps n scale, the
+// method is exact for the problem (RK4 on constant acceleration): no slope is fitted
+// and the order is NaN.
 #include <string>
 #include <vector>
 
@@ -44,8 +46,10 @@ inline const char* to_string(fit_result::status s) {
   }
 }
 
-// Round-off bound for n steps on a motion of size `scale`: 8 eps n scale.
+// Worst-case round-off bound for n steps on a motion of size `scale`: 8 eps n scale.
 double roundoff_bound(long steps, double scale);
+// Typical accumulated round-off for n steps: eps scale sqrt(n).
+double roundoff_noise(long steps, double scale);
 
 fit_result fit_order(const fit_input& in);
 

@@ -17,7 +17,7 @@ struct sweep_options {
   std::vector<std::string> integrators;  // empty: all
   // Parameter overrides per problem: overrides["pendulum"]["theta0_deg"] = 30.
   std::map<std::string, std::map<std::string, double>> overrides;
-  int levels = 10;       // ladder length (at least 8 for the default study)
+  int levels = 12;       // ladder length (at least 8 for the default study)
   int base_steps = 32;   // steps at the coarsest level; dt_k = T / (base_steps 2^k)
   int sample_count = 32; // fixed sample times j T / sample_count; must divide base_steps
   reference_tolerances tol{};

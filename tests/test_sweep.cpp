@@ -117,7 +117,10 @@ TEST(sweep, overrides_reach_the_problem) {
   const auto params = s.problems.front().problem->params();
   bool found = false;
   for (const auto& q : params)
-    if (q.name == "theta0_deg") found = true, EXPECT_DOUBLE_EQ(q.value, 10.0);
+    if (q.name == "theta0_deg") {
+      found = true;
+      EXPECT_DOUBLE_EQ(q.value, 10.0);
+    }
   EXPECT_TRUE(found);
 }
 

@@ -1,0 +1,123 @@
+// Reference solutions from GSL's gsl_odeiv2 driver with the rk8pd stepper
+// (Prince-Dormand 8(9), 13 stages) and the y_new error control.
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_odeiv2.h>
+
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "references/reference.hpp"
+
+namespace stepbench {
+namespace detail {
+void validate_reference_input(std::string_view source, const ode_system& sys, std::span<const double> times,
+                              reference_tolerances tol);
+}
+
+namespace {
+
+constexpr const char* source_name = "gsl_rk8pd";
+
+// What the C callback needs, and what it hands back: GSL's callback is C, so a C++
+// exception must not cross it (it is stashed and rethrown once the driver returns).
+struct gsl_callback_state {
+  const ode_system* sys = nullptr;
+  long calls = 0;
+  std::exception_ptr error;
+  bool non_finite = false;
+  double non_finite_t = 0.0;
+};
+
+// Every call of f goes through here; GSL itself counts none.
+int gsl_rhs(double t, const double y[], double dydt[], void* params) noexcept {
+  auto& st = *static_cast<gsl_callback_state*>(params);
+  ++st.calls;
+  const auto n = static_cast<std::size_t>(st.sys->n);
+  try {
+    st.sys->rhs(t, std::span<const double>(y, n), std::span<double>(dydt, n));
+  } catch (...) {
+    st.error = std::current_exception();
+    return GSL_EBADFUNC;  // evolve_apply returns GSL_EBADFUNC at once, without retrying
+  }
+  // The y_new control (GSL 2.7.1 ode-initval2/cstd.c) takes rmax = GSL_MAX_DBL(r, rmax),
+  // which drops a NaN error ratio, so a NaN step would be accepted and even enlarged.
+  // A reference must never silently return NaN: refuse non-finite derivatives here.
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(dydt[i])) {
+      st.non_finite = true;
+      st.non_finite_t = t;
+      return GSL_EBADFUNC;
+    }
+  }
+  return GSL_SUCCESS;
+}
+
+struct driver_deleter {
+  void operator()(gsl_odeiv2_driver* d) const noexcept { gsl_odeiv2_driver_free(d); }
+};
+
+}  // namespace
+
+reference_solution solve_gsl_rk8pd(const ode_system& sys, std::span<const double> times,
+                                   reference_tolerances tol) {
+  detail::validate_reference_input(source_name, sys, times, tol);
+  const auto start = std::chrono::steady_clock::now();
+
+  gsl_callback_state st;
+  st.sys = &sys;
+  gsl_odeiv2_system gsys{&gsl_rhs, nullptr, static_cast<std::size_t>(sys.n), &st};
+
+  // A small first step; the control grows it at most 5x per step (cstd.c), so the cost of
+  // starting small is a handful of steps, while starting too large costs rejections.
+  const double hstart = 1e-6 * times.front();
+  std::unique_ptr<gsl_odeiv2_driver, driver_deleter> driver(
+      gsl_odeiv2_driver_alloc_y_new(&gsys, gsl_odeiv2_step_rk8pd, hstart, tol.atol, tol.rtol));
+  if (!driver) throw std::runtime_error("gsl_rk8pd: gsl_odeiv2_driver_alloc_y_new returned null");
+  // nmax bounds the steps of one driver_apply call (0 would mean unbounded).
+  if (int s = gsl_odeiv2_driver_set_nmax(driver.get(), 100'000'000UL); s != GSL_SUCCESS)
+    throw std::runtime_error("gsl_rk8pd: gsl_odeiv2_driver_set_nmax failed, status " + std::to_string(s));
+
+  reference_solution out;
+  out.source = source_name;
+  out.times.assign(times.begin(), times.end());
+  out.y.reserve(times.size());
+
+  std::vector<double> y = sys.y0;
+  double t = 0.0;
+  for (double tout : times) {
+    const int status = gsl_odeiv2_driver_apply(driver.get(), &t, tout, y.data());
+    if (st.error) std::rethrow_exception(st.error);
+    if (st.non_finite)
+      throw std::runtime_error("gsl_rk8pd: right-hand side returned a non-finite value at t=" +
+                               std::to_string(st.non_finite_t) + " (integrating towards t=" + std::to_string(tout) +
+                               ")");
+    if (status != GSL_SUCCESS)
+      throw std::runtime_error("gsl_rk8pd: gsl_odeiv2_driver_apply failed at t=" + std::to_string(t) +
+                               " towards t=" + std::to_string(tout) + ", status " + std::to_string(status) + " (" +
+                               gsl_strerror(status) + ")");
+    for (double v : y)
+      if (!std::isfinite(v))
+        throw std::runtime_error("gsl_rk8pd: non-finite state at t=" + std::to_string(tout));
+    out.y.push_back(y);
+  }
+
+  // Counters of the evolve object (gsl_odeiv2.h), accumulated over all driver_apply calls
+  // (driver_apply resets only driver->n). gsl_odeiv2_evolve_apply increments count before
+  // the error test, so count is every attempt and a rejected one is in both count and
+  // failed_steps (GSL 2.7.1 ode-initval2/evolve.c; checked: driver->n, the accepted steps of
+  // one driver_apply, equals the increase of count - failed_steps).
+  out.stats.failed_steps = static_cast<long>(driver->e->failed_steps);
+  out.stats.steps = static_cast<long>(driver->e->count) - out.stats.failed_steps;
+  out.stats.rhs_evals_counted = st.calls;
+  out.stats.rhs_evals = st.calls;
+  out.stats.rtol = tol.rtol;
+  out.stats.atol = tol.atol;
+  out.stats.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+}  // namespace stepbench

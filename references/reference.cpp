@@ -1,0 +1,52 @@
+// Input validation shared by the reference solvers, and dispatch by source name.
+#include "references/reference.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace stepbench {
+namespace detail {
+
+// Declared (without a header, to keep the interface in reference.hpp unchanged) in
+// gsl_reference.cpp and cvode_reference.cpp: both solvers are public, so both check
+// their input, not only solve_reference.
+void validate_reference_input(std::string_view source, const ode_system& sys, std::span<const double> times,
+                              reference_tolerances tol) {
+  const auto fail = [&](const std::string& what) {
+    throw std::invalid_argument(std::string(source) + ": " + what);
+  };
+  if (sys.n <= 0) fail("system dimension n must be positive, got " + std::to_string(sys.n));
+  if (sys.y0.size() != static_cast<std::size_t>(sys.n))
+    fail("y0 has " + std::to_string(sys.y0.size()) + " entries, expected n = " + std::to_string(sys.n));
+  for (double v : sys.y0)
+    if (!std::isfinite(v)) fail("y0 has a non-finite entry");
+  if (!sys.rhs) fail("rhs is not set");
+  if (times.empty()) fail("no output times");
+  for (std::size_t i = 0; i < times.size(); ++i) {
+    if (!std::isfinite(times[i]) || times[i] <= 0.0)
+      fail("output time " + std::to_string(i) + " is not finite and > 0");
+    if (i > 0 && !(times[i] > times[i - 1]))
+      fail("output times are not strictly increasing at index " + std::to_string(i));
+  }
+  // Both solvers need non-negative tolerances (GSL manual, gsl_odeiv2_control_standard_new;
+  // CVODE user guide, CVodeSStolerances); all-zero makes a pure relative test that fails at y = 0.
+  if (!std::isfinite(tol.rtol) || !std::isfinite(tol.atol) || tol.rtol < 0.0 || tol.atol < 0.0 ||
+      (tol.rtol == 0.0 && tol.atol == 0.0))
+    fail("tolerances must be finite, >= 0 and not both zero");
+}
+
+}  // namespace detail
+
+reference_solution solve_reference(std::string_view source, const ode_system& sys, std::span<const double> times,
+                                   reference_tolerances tol) {
+  // Each solver validates its input, times itself (steady_clock) and fills source, times,
+  // rtol and atol, so that calling it directly gives the same record as calling it here.
+  if (source == "gsl_rk8pd") return solve_gsl_rk8pd(sys, times, tol);
+  if (source == "cvode_bdf") return solve_cvode(sys, times, cvode_method::bdf, tol);
+  if (source == "cvode_adams") return solve_cvode(sys, times, cvode_method::adams, tol);
+  throw std::invalid_argument("unknown reference source '" + std::string(source) +
+                              "' (expected gsl_rk8pd, cvode_bdf or cvode_adams)");
+}
+
+}  // namespace stepbench

@@ -9,8 +9,8 @@
 // with (C, S) = (cos st, sin(st)/s) under-damped (D < 0), (1, t) critical (D = 0),
 // (cosh st, sinh(st)/s) over-damped (D > 0). Since C' = D S and S' = C,
 //   Phi' = -gamma Phi + D Psi, Psi' = -gamma Psi + Phi.
-// sin(st)/s tends to t as s -> 0, so near-critical damping loses no accuracy; the
-// over-damped branch is written with e^{(s - gamma) t} and e^{-(s + gamma) t} so that
+// sin(st)/s tends to t as s -> 0, so near-critical damping loses no accuracy (on the
+// over-damped side through expm1); the over-damped branch is written with e^{(s - gamma) t} and e^{-(s + gamma) t} so that
 // neither cosh nor e^{-gamma t} overflows, with s - gamma = -w0^2 / (s + gamma) free of
 // cancellation.
 #include <cmath>
@@ -80,7 +80,9 @@ struct damped_spring {
       const double s = std::sqrt(d);
       const double slow = std::exp(-omega0_sq() / (s + g) * t), fast = std::exp(-(s + g) * t);
       phi = 0.5 * (slow + fast);
-      psi = (slow - fast) / (2.0 * s);
+      // slow - fast = fast (e^{2st} - 1): expm1 keeps the digits that the difference
+      // would cancel near critical damping (s t small).
+      psi = 2.0 * s * t < 1.0 ? fast * std::expm1(2.0 * s * t) / (2.0 * s) : (slow - fast) / (2.0 * s);
     }
     const double b = v0 + g * x0;
     const double x = x0 * phi + b * psi;

@@ -19,17 +19,17 @@ struct param {
   std::string_view description;
 };
 
-// The state an integrator advances. `a` caches the acceleration at (t, x, v) when
-// `a_current` is true, so a method whose last stage lands on the new state (velocity
-// Verlet with a velocity-independent force) pays one force evaluation per step, not two.
-// Anything that changes x or v from outside the integrator (an event, a reset) must
-// clear `a_current`.
+// The state an integrator advances. `f` caches the force at (t, x, v) when `f_current`
+// is true, so a method whose last stage lands on the new state (velocity Verlet with a
+// velocity-independent force) pays one force evaluation per step, not two. Anything
+// that changes x or v from outside the integrator (an event, a reset) must clear
+// `f_current`.
 template <class Vec>
 struct step_state {
   Vec x;
   Vec v;
-  Vec a;
-  bool a_current = false;
+  Vec f;
+  bool f_current = false;
 };
 
 // Position and velocity at one time: what closed forms and references return.
@@ -73,19 +73,27 @@ concept integrator = requires {
   { I::description } -> std::convertible_to<std::string_view>;
 };
 
-// a = F / m at the state's (x, v), computed once and cached in the state.
-template <class Sys, class Vec>
-inline const Vec& current_acceleration(const Sys& sys, double t, step_state<Vec>& s) {
-  if (!s.a_current) {
-    s.a = sys.force(t, s.x, s.v) / sys.mass();
-    s.a_current = true;
-  }
-  return s.a;
+// 1 / m. The integrators work with the force and fold 1 / m into their step
+// coefficients (v += (h / m) F, the momentum form's own idea): one multiplication less
+// on each stage's dependency chain (v -> F -> v), which is what bounds a step's latency,
+// and no division at all. The drive loop's system computes 1 / m once per run
+// (counted_system::inverse_mass); a bare problem falls back to dividing here.
+template <class Sys>
+inline double inverse_mass(const Sys& sys) {
+  if constexpr (requires { sys.inverse_mass(); })
+    return sys.inverse_mass();
+  else
+    return 1.0 / sys.mass();
 }
 
+// F at the state's (x, v), computed once and cached in the state.
 template <class Sys, class Vec>
-inline Vec acceleration(const Sys& sys, double t, const Vec& x, const Vec& v) {
-  return sys.force(t, x, v) / sys.mass();
+inline const Vec& current_force(const Sys& sys, double t, step_state<Vec>& s) {
+  if (!s.f_current) {
+    s.f = sys.force(t, s.x, s.v);
+    s.f_current = true;
+  }
+  return s.f;
 }
 
 // Parameter checks shared by the problems; each returns "" or a one-line reason.

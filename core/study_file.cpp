@@ -31,9 +31,28 @@ struct convergence_record {
   double energy_drift;
   double energy_err_max;
   std::int8_t diverged;
+  double time_ns;
+  std::int64_t repetitions;
+  std::int8_t cut;
 };
 
-H5::CompType convergence_type() {
+// One row of /<problem>/<peer>/work_precision.
+struct peer_record {
+  double param;
+  std::int64_t steps;
+  std::int64_t force_evals;
+  double err_pos_final;
+  double err_pos_max;
+  std::int8_t diverged;
+  double time_ns;
+  std::int64_t repetitions;
+  std::int8_t cut;
+};
+
+// The timing fields are written only for a timed study, so an untimed file does not
+// carry columns of NaN that a reader could mistake for measurements. This is the memory
+// type (the struct's full size, whatever members are chosen); the file gets it packed.
+H5::CompType convergence_type(bool timed) {
   H5::CompType t(sizeof(convergence_record));
 #define STEPBENCH_FIELD(name, type) t.insertMember(#name, HOFFSET(convergence_record, name), type)
   STEPBENCH_FIELD(dt, H5::PredType::NATIVE_DOUBLE);
@@ -46,6 +65,27 @@ H5::CompType convergence_type() {
   STEPBENCH_FIELD(energy_drift, H5::PredType::NATIVE_DOUBLE);
   STEPBENCH_FIELD(energy_err_max, H5::PredType::NATIVE_DOUBLE);
   STEPBENCH_FIELD(diverged, H5::PredType::NATIVE_INT8);
+  if (timed) {
+    STEPBENCH_FIELD(time_ns, H5::PredType::NATIVE_DOUBLE);
+    STEPBENCH_FIELD(repetitions, H5::PredType::NATIVE_INT64);
+    STEPBENCH_FIELD(cut, H5::PredType::NATIVE_INT8);
+  }
+#undef STEPBENCH_FIELD
+  return t;
+}
+
+H5::CompType peer_type() {
+  H5::CompType t(sizeof(peer_record));
+#define STEPBENCH_FIELD(name, type) t.insertMember(#name, HOFFSET(peer_record, name), type)
+  STEPBENCH_FIELD(param, H5::PredType::NATIVE_DOUBLE);
+  STEPBENCH_FIELD(steps, H5::PredType::NATIVE_INT64);
+  STEPBENCH_FIELD(force_evals, H5::PredType::NATIVE_INT64);
+  STEPBENCH_FIELD(err_pos_final, H5::PredType::NATIVE_DOUBLE);
+  STEPBENCH_FIELD(err_pos_max, H5::PredType::NATIVE_DOUBLE);
+  STEPBENCH_FIELD(diverged, H5::PredType::NATIVE_INT8);
+  STEPBENCH_FIELD(time_ns, H5::PredType::NATIVE_DOUBLE);
+  STEPBENCH_FIELD(repetitions, H5::PredType::NATIVE_INT64);
+  STEPBENCH_FIELD(cut, H5::PredType::NATIVE_INT8);
 #undef STEPBENCH_FIELD
   return t;
 }
@@ -104,29 +144,55 @@ void write_reference(H5::Group& parent, const reference_check& ref, const std::s
   attr(g, "is_truth", static_cast<int>(sol.source == truth_source));
 }
 
-void write_integrator(H5::Group& parent, const integrator_study& is) {
+void write_fit(H5::Group& g, const fit_result& fit) {
+  attr(g, "observed_order", fit.order);
+  attr(g, "fit_status", to_string(fit.state));
+  attr(g, "fit_metric", "err_pos_max");
+  attr(g, "fit_levels", fit.levels);
+  attr(g, "fit_residual_log10", fit.residual);
+  attr(g, "fit_note", fit.note);
+}
+
+void write_integrator(H5::Group& parent, const integrator_study& is, bool timed) {
   H5::Group g = parent.createGroup(is.info.name);
   attr(g, "expected_order", is.info.order);
-  attr(g, "observed_order", is.fit.order);
   attr(g, "exact_for_problem", static_cast<int>(is.fit.state == fit_result::status::exact));
-  attr(g, "fit_status", to_string(is.fit.state));
-  attr(g, "fit_metric", "err_pos_max");
-  attr(g, "fit_levels", is.fit.levels);
-  attr(g, "fit_residual_log10", is.fit.residual);
-  attr(g, "fit_note", is.fit.note);
+  write_fit(g, is.fit);
   attr(g, "description", is.info.description);
   std::vector<convergence_record> rows;
   for (const auto& r : is.rows) {
     const auto& m = r.metrics;
     rows.push_back({r.dt, r.steps, r.force_evals, m.err_pos_final, m.err_vel_final, m.err_pos_max, m.err_pos_rms,
-                    m.energy_drift, m.energy_err_max, static_cast<std::int8_t>(m.diverged)});
+                    m.energy_drift, m.energy_err_max, static_cast<std::int8_t>(m.diverged), r.time.time_ns,
+                    r.time.repetitions, static_cast<std::int8_t>(r.time.cut)});
   }
   const hsize_t n = rows.size();
-  const auto type = convergence_type();
-  g.createDataSet("convergence", type, H5::DataSpace(1, &n)).write(rows.data(), type);
+  const auto memory_type = convergence_type(timed);
+  H5::CompType file_type;  // a copy (H5Tcopy): CompType's copy constructor shares the id
+  file_type.copy(memory_type);
+  file_type.pack();
+  g.createDataSet("convergence", file_type, H5::DataSpace(1, &n)).write(rows.data(), memory_type);
 }
 
-void write_problem(H5::H5File& file, const problem_study& ps) {
+void write_peer(H5::Group& parent, const peer_study& ps) {
+  H5::Group g = parent.createGroup(ps.name);
+  attr(g, "kind", ps.kind);
+  attr(g, "description", ps.description);
+  attr(g, "declared_order", ps.declared_order);
+  write_fit(g, ps.fit);
+  std::vector<peer_record> rows;
+  for (const auto& r : ps.rows)
+    rows.push_back({r.param, r.steps, r.force_evals, r.err_pos_final, r.err_pos_max, static_cast<std::int8_t>(r.diverged),
+                    r.time.time_ns, r.time.repetitions, static_cast<std::int8_t>(r.time.cut)});
+  const hsize_t n = rows.size();
+  const auto memory_type = peer_type();
+  H5::CompType file_type;  // a copy (H5Tcopy): CompType's copy constructor shares the id
+  file_type.copy(memory_type);
+  file_type.pack();
+  g.createDataSet("work_precision", file_type, H5::DataSpace(1, &n)).write(rows.data(), memory_type);
+}
+
+void write_problem(H5::H5File& file, const problem_study& ps, bool timed) {
   const auto& p = *ps.problem;
   H5::Group g = file.createGroup(std::string(p.name()));
   for (const auto& param : p.params()) attr(g, param.name, param.value);
@@ -143,7 +209,8 @@ void write_problem(H5::H5File& file, const problem_study& ps) {
   dataset(g, "truth_state", ps.truth.y);
   H5::Group refs = g.createGroup("reference");
   for (const auto& ref : ps.truth.references) write_reference(refs, ref, ps.truth.source, p.dim());
-  for (const auto& is : ps.integrators) write_integrator(g, is);
+  for (const auto& is : ps.integrators) write_integrator(g, is, timed);
+  for (const auto& peer : ps.peers) write_peer(g, peer);
 }
 
 std::string temp_path_for(const std::string& path) { return fmt::format("{}.tmp.{}", path, ::getpid()); }
@@ -201,7 +268,19 @@ void write_study(const study& s, const std::string& path) {
     attr(file, "reference_atol", s.options.tol.atol);
     attr(file, "fit_metric", "err_pos_max");
     attr(file, "wall_seconds", s.wall_seconds);
-    for (const auto& ps : s.problems) write_problem(file, ps);
+    attr(file, "timing", static_cast<int>(s.timed.has_value()));
+    if (s.timed) {
+      const auto& t = *s.timed;
+      attr(file, "benchmark_mode", t.mode);
+      attr(file, "benchmark_min_time_s", t.min_time_s);
+      attr(file, "benchmark_repetitions", t.repetitions);
+      attr(file, "benchmark_case_budget_s", t.case_budget_s);
+      attr(file, "benchmark_wall_seconds", t.wall_seconds);
+      attr(file, "cpu_scaling_enabled", t.cpu_scaling_enabled);
+      attr(file, "num_cpus", t.num_cpus);
+      attr(file, "mhz_per_cpu", t.mhz_per_cpu);
+    }
+    for (const auto& ps : s.problems) write_problem(file, ps, s.timed.has_value());
     file.close();
   } catch (const H5::Exception& e) {
     std::remove(tmp.c_str());

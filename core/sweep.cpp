@@ -73,7 +73,7 @@ study run_sweep(const sweep_options& opts) {
       for (double dt : ladder) {
         const auto steps = sample_steps(ps.horizon, dt, opts.sample_count);
         const run_result run = ps.problem->run(iname, dt, ps.horizon, steps);
-        convergence_row row{dt, run.steps, run.force_evals, measure(*ps.problem, run, ps.truth)};
+        convergence_row row{dt, run.steps, run.force_evals, measure(*ps.problem, run, ps.truth), {}};
         fit.dt.push_back(dt);
         fit.error.push_back(row.metrics.err_pos_max);
         fit.steps.push_back(run.steps_planned);

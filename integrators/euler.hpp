@@ -1,7 +1,7 @@
 #pragma once
 // Explicit (forward) Euler, as in the lecture (digest section 6): the position moves
 // with the OLD velocity, then the velocity with the old acceleration.
-//   x_{n+1} = x_n + dt v_n,   v_{n+1} = v_n + dt a(t_n, x_n, v_n).
+//   x_{n+1} = x_n + dt v_n,   v_{n+1} = v_n + dt F(t_n, x_n, v_n) / m.
 // First order; exact only when the rate of change is constant.
 #include "core/concepts.hpp"
 
@@ -14,10 +14,10 @@ struct euler {
 
   template <class Sys, class Vec>
   void step(const Sys& sys, double t, step_state<Vec>& s, double dt) const {
-    const Vec a = current_acceleration(sys, t, s);
+    const Vec& f = current_force(sys, t, s);
     s.x += dt * s.v;
-    s.v += dt * a;
-    s.a_current = false;
+    s.v += (dt * inverse_mass(sys)) * f;
+    s.f_current = false;
   }
 };
 

@@ -20,7 +20,7 @@ struct momentum {
     const Vec p = m * s.v + dt * sys.force(t, s.x, s.v);
     s.v = p / m;
     s.x += dt * s.v;
-    s.a_current = false;
+    s.f_current = false;
   }
 };
 

@@ -1,6 +1,6 @@
 #pragma once
 // Semi-implicit (symplectic) Euler: velocity first, then position with the NEW velocity.
-//   v_{n+1} = v_n + dt a(t_n, x_n, v_n),   x_{n+1} = x_n + dt v_{n+1}.
+//   v_{n+1} = v_n + dt F(t_n, x_n, v_n) / m,   x_{n+1} = x_n + dt v_{n+1}.
 // First order, but symplectic for separable forces (Hairer, Lubich, Wanner, "Geometric
 // Numerical Integration", Thm. VI.3.3): its energy error stays bounded on oscillators.
 #include "core/concepts.hpp"
@@ -14,9 +14,9 @@ struct semi_implicit_euler {
 
   template <class Sys, class Vec>
   void step(const Sys& sys, double t, step_state<Vec>& s, double dt) const {
-    s.v += dt * current_acceleration(sys, t, s);
+    s.v += (dt * inverse_mass(sys)) * current_force(sys, t, s);
     s.x += dt * s.v;
-    s.a_current = false;
+    s.f_current = false;
   }
 };
 

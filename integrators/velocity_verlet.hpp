@@ -1,15 +1,15 @@
 #pragma once
 // Velocity Verlet (Swope et al., J. Chem. Phys. 76, 637 (1982)):
 //   v_h = v_n + dt/2 a_n,  x_{n+1} = x_n + dt v_h,  v_{n+1} = v_h + dt/2 a_{n+1}.
-// Second order and symplectic for forces that depend on position only; then a_{n+1}
-// is exactly the next step's a_n, so it is cached and the method costs one force
+// Second order and symplectic for forces that depend on position only; then F_{n+1}
+// is exactly the next step's F_n, so it is cached and the method costs one force
 // evaluation per step.
 //
 // A velocity-dependent force (a damper) needs v_{n+1} to compute a_{n+1}. We evaluate
 // it at the predicted velocity v_n + dt a_n (an Euler predictor), which makes the
 // velocity update Heun's trapezoidal rule and keeps the method second order; the
-// cached acceleration is then not the one at the true v_{n+1}, so it is recomputed
-// (two evaluations per step).
+// cached force is then not the one at the true v_{n+1}, so it is recomputed (two
+// evaluations per step).
 #include "core/concepts.hpp"
 
 namespace stepbench {
@@ -21,18 +21,18 @@ struct velocity_verlet {
 
   template <class Sys, class Vec>
   void step(const Sys& sys, double t, step_state<Vec>& s, double dt) const {
-    const double h = 0.5 * dt;
-    const Vec a_n = current_acceleration(sys, t, s);
-    const Vec v_half = s.v + h * a_n;
+    const double h_im = 0.5 * dt * inverse_mass(sys);
+    const Vec f_n = current_force(sys, t, s);
+    const Vec v_half = s.v + h_im * f_n;
     s.x += dt * v_half;
     if constexpr (Sys::force_depends_on_velocity) {
-      const Vec v_pred = v_half + h * a_n;
-      s.v = v_half + h * acceleration(sys, t + dt, s.x, v_pred);
-      s.a_current = false;
+      const Vec v_pred = v_half + h_im * f_n;
+      s.v = v_half + h_im * sys.force(t + dt, s.x, v_pred);
+      s.f_current = false;
     } else {
-      s.a = acceleration(sys, t + dt, s.x, v_half);
-      s.v = v_half + h * s.a;
-      s.a_current = true;
+      s.f = sys.force(t + dt, s.x, v_half);
+      s.v = v_half + h_im * s.f;
+      s.f_current = true;
     }
   }
 };

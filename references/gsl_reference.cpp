@@ -1,5 +1,6 @@
-// Reference solutions from GSL's gsl_odeiv2 driver with the rk8pd stepper
-// (Prince-Dormand 8(9), 13 stages) and the y_new error control.
+// Solutions from GSL's gsl_odeiv2 driver with the y_new error control: the rk8pd
+// stepper (Prince-Dormand 8(9), 13 stages) is the reference; rkf45 (Fehlberg 4(5)) is
+// a peer that the benchmark times over a ladder of tolerances.
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_odeiv2.h>
 
@@ -19,8 +20,6 @@ void validate_reference_input(std::string_view source, const ode_system& sys, st
 }
 
 namespace {
-
-constexpr const char* source_name = "gsl_rk8pd";
 
 // What the C callback needs, and what it hands back: GSL's callback is C, so a C++
 // exception must not cross it (it is stashed and rethrown once the driver returns).
@@ -62,8 +61,11 @@ struct driver_deleter {
 
 }  // namespace
 
-reference_solution solve_gsl_rk8pd(const ode_system& sys, std::span<const double> times,
-                                   reference_tolerances tol) {
+reference_solution solve_gsl(const ode_system& sys, std::span<const double> times, gsl_method method,
+                             reference_tolerances tol) {
+  const std::string source = method == gsl_method::rk8pd ? "gsl_rk8pd" : "gsl_rkf45";
+  const gsl_odeiv2_step_type* stepper = method == gsl_method::rk8pd ? gsl_odeiv2_step_rk8pd : gsl_odeiv2_step_rkf45;
+  const char* source_name = source.c_str();
   detail::validate_reference_input(source_name, sys, times, tol);
   const auto start = std::chrono::steady_clock::now();
 
@@ -75,14 +77,14 @@ reference_solution solve_gsl_rk8pd(const ode_system& sys, std::span<const double
   // starting small is a handful of steps, while starting too large costs rejections.
   const double hstart = 1e-6 * times.front();
   std::unique_ptr<gsl_odeiv2_driver, driver_deleter> driver(
-      gsl_odeiv2_driver_alloc_y_new(&gsys, gsl_odeiv2_step_rk8pd, hstart, tol.atol, tol.rtol));
-  if (!driver) throw std::runtime_error("gsl_rk8pd: gsl_odeiv2_driver_alloc_y_new returned null");
+      gsl_odeiv2_driver_alloc_y_new(&gsys, stepper, hstart, tol.atol, tol.rtol));
+  if (!driver) throw std::runtime_error(source + ": gsl_odeiv2_driver_alloc_y_new returned null");
   // nmax bounds the steps of one driver_apply call (0 would mean unbounded).
   if (int s = gsl_odeiv2_driver_set_nmax(driver.get(), 100'000'000UL); s != GSL_SUCCESS)
-    throw std::runtime_error("gsl_rk8pd: gsl_odeiv2_driver_set_nmax failed, status " + std::to_string(s));
+    throw std::runtime_error(source + ": gsl_odeiv2_driver_set_nmax failed, status " + std::to_string(s));
 
   reference_solution out;
-  out.source = source_name;
+  out.source = source;
   out.times.assign(times.begin(), times.end());
   out.y.reserve(times.size());
 
@@ -92,16 +94,16 @@ reference_solution solve_gsl_rk8pd(const ode_system& sys, std::span<const double
     const int status = gsl_odeiv2_driver_apply(driver.get(), &t, tout, y.data());
     if (st.error) std::rethrow_exception(st.error);
     if (st.non_finite)
-      throw std::runtime_error("gsl_rk8pd: right-hand side returned a non-finite value at t=" +
+      throw std::runtime_error(source + ": right-hand side returned a non-finite value at t=" +
                                std::to_string(st.non_finite_t) + " (integrating towards t=" + std::to_string(tout) +
                                ")");
     if (status != GSL_SUCCESS)
-      throw std::runtime_error("gsl_rk8pd: gsl_odeiv2_driver_apply failed at t=" + std::to_string(t) +
+      throw std::runtime_error(source + ": gsl_odeiv2_driver_apply failed at t=" + std::to_string(t) +
                                " towards t=" + std::to_string(tout) + ", status " + std::to_string(status) + " (" +
                                gsl_strerror(status) + ")");
     for (double v : y)
       if (!std::isfinite(v))
-        throw std::runtime_error("gsl_rk8pd: non-finite state at t=" + std::to_string(tout));
+        throw std::runtime_error(source + ": non-finite state at t=" + std::to_string(tout));
     out.y.push_back(y);
   }
 
@@ -118,6 +120,10 @@ reference_solution solve_gsl_rk8pd(const ode_system& sys, std::span<const double
   out.stats.atol = tol.atol;
   out.stats.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
+}
+
+reference_solution solve_gsl_rk8pd(const ode_system& sys, std::span<const double> times, reference_tolerances tol) {
+  return solve_gsl(sys, times, gsl_method::rk8pd, tol);
 }
 
 }  // namespace stepbench

@@ -55,6 +55,11 @@ struct reference_tolerances {
 reference_solution solve_gsl_rk8pd(const ode_system& sys, std::span<const double> times,
                                    reference_tolerances tol = {});
 
+// The same driver with another embedded stepper (rkf45 is a peer, not a reference).
+enum class gsl_method { rk8pd, rkf45 };
+reference_solution solve_gsl(const ode_system& sys, std::span<const double> times, gsl_method method,
+                             reference_tolerances tol = {});
+
 enum class cvode_method { bdf, adams };
 reference_solution solve_cvode(const ode_system& sys, std::span<const double> times, cvode_method method,
                                reference_tolerances tol = {});

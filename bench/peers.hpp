@@ -1,0 +1,253 @@
+#pragma once
+// The peers: what a user might run instead of our integrators, driven over the same
+// horizon with the same dt (fixed-step) and recorded at the same sample steps, so
+// their errors and times sit beside ours. Each is templated on the problem, like our
+// drive loop, so every force model inlines into the peer's callback as it would in a
+// user's code.
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_odeiv2.h>
+
+#include <array>
+#include <cmath>
+#include <memory>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "core/concepts.hpp"
+#include "core/drive.hpp"
+#include "problems/all.hpp"
+
+#if STEPBENCH_HAVE_ODEINT
+#include <boost/numeric/odeint/stepper/runge_kutta4.hpp>
+#include <boost/numeric/odeint/stepper/velocity_verlet.hpp>
+#endif
+
+namespace stepbench::peers {
+
+// A peer's run in plain vectors: [x; v] after each recorded step and at the end.
+struct peer_run {
+  long steps = 0;
+  long force_evals = 0;
+  bool non_finite = false;
+  std::vector<std::vector<double>> samples;
+  std::vector<double> final_y;
+};
+
+// y' = [v; F / m] for the first-order peers, with the same arithmetic as our loop (the
+// force model, times 1 / m computed once per run).
+template <problem P>
+inline void first_order_rhs(const P& p, double inv_mass, double t, const double* y, double* dydt) {
+  using vec = typename P::vec;
+  vec x(P::dim), v(P::dim);
+  for (int i = 0; i < P::dim; ++i) x[i] = y[i], v[i] = y[P::dim + i];
+  const vec a = p.force(t, x, v) * inv_mass;
+  for (int i = 0; i < P::dim; ++i) dydt[i] = v[i], dydt[P::dim + i] = a[i];
+}
+
+inline bool finite(std::span<const double> y) {
+  for (double v : y)
+    if (!std::isfinite(v)) return false;
+  return true;
+}
+
+// ---- GSL fixed-step: gsl_odeiv2_step_apply at our dt -------------------------------
+// As the GSL manual recommends for a fixed-step loop: dydt_out of one step is passed as
+// dydt_in of the next, so no stage is computed twice. GSL's rk4 still estimates its
+// error by step doubling (a full step and two half steps), and rkf45 by its embedded
+// pair: work a user pays for whether or not they use the estimate.
+
+template <problem P>
+struct gsl_context {
+  const P* problem;
+  double inv_mass;
+  long calls = 0;
+};
+
+template <problem P>
+int gsl_rhs(double t, const double y[], double dydt[], void* params) {
+  auto& c = *static_cast<gsl_context<P>*>(params);
+  ++c.calls;
+  first_order_rhs(*c.problem, c.inv_mass, t, y, dydt);
+  return GSL_SUCCESS;
+}
+
+struct gsl_step_deleter {
+  void operator()(gsl_odeiv2_step* s) const { gsl_odeiv2_step_free(s); }
+};
+
+template <problem P>
+peer_run gsl_fixed(const P& p, const gsl_odeiv2_step_type* type, double dt, double horizon,
+                   std::span<const long> record) {
+  constexpr int n = 2 * P::dim;
+  gsl_context<P> ctx{&p, 1.0 / p.mass()};
+  gsl_odeiv2_system sys{&gsl_rhs<P>, nullptr, n, &ctx};
+  std::unique_ptr<gsl_odeiv2_step, gsl_step_deleter> step(gsl_odeiv2_step_alloc(type, n));
+  if (!step) throw std::runtime_error("gsl_odeiv2_step_alloc failed");
+  std::array<double, n> y, yerr, dydt_in, dydt_out;
+  const auto s0 = p.initial();
+  for (int i = 0; i < P::dim; ++i) y[i] = s0.x[i], y[P::dim + i] = s0.v[i];
+  gsl_rhs<P>(0.0, y.data(), dydt_in.data(), &ctx);
+
+  peer_run out;
+  const long steps = steps_for(horizon, dt);
+  auto next = record.begin();
+  double t = 0.0;
+  for (long i = 0; i < steps; ++i) {
+    const double h = i + 1 == steps ? horizon - t : dt;
+    const int status = gsl_odeiv2_step_apply(step.get(), t, h, y.data(), yerr.data(), dydt_in.data(),
+                                             dydt_out.data(), &sys);
+    if (status != GSL_SUCCESS) throw std::runtime_error(std::string("gsl_odeiv2_step_apply: ") + gsl_strerror(status));
+    dydt_in = dydt_out;
+    t = time_after_step(i + 1, steps, dt, horizon);
+    out.steps = i + 1;
+    if (next != record.end() && *next == i + 1) {
+      ++next;
+      if (!finite(y)) {
+        out.non_finite = true;
+        break;
+      }
+      out.samples.emplace_back(y.begin(), y.end());
+    }
+  }
+  out.non_finite = out.non_finite || !finite(y);
+  out.force_evals = ctx.calls;
+  out.final_y.assign(y.begin(), y.end());
+  return out;
+}
+
+// ---- Hand-written RK4 on plain doubles: the speed-of-light baseline ---------------
+// What a programmer writes for one scalar degree of freedom with the acceleration
+// spelled out: no abstraction, no Eigen, no counting wrapper. Same recording of samples
+// as our loop, so the comparison is of the step alone.
+
+// The acceleration spelled out with the problem's constants folded and copied into
+// locals first, as a programmer writing one scalar loop by hand would: a = -(k/m) x -
+// (c/m) v, no division, no separate multiplication by 1/m. (Constants read from the
+// problem inside the loop would be reloaded every stage: the loop stores samples, which
+// the compiler must assume could alias the problem.)
+inline auto baseline_acceleration(const damped_spring& p) {
+  return [km = p.k_s / p.mass_kg, cm = p.k_d / p.mass_kg](double x, double v) { return -cm * v - km * x; };
+}
+inline auto baseline_acceleration(const pendulum& p) {
+  return [g_over_l = p.gravity / p.length_m](double x, double) { return -g_over_l * std::sin(x); };
+}
+
+template <class P>
+concept has_baseline = requires(const P& p) { baseline_acceleration(p)(0.0, 0.0); };
+
+template <has_baseline P>
+peer_run baseline_rk4(const P& p, double dt, double horizon, std::span<const long> record) {
+  const auto accel = baseline_acceleration(p);
+  const auto s0 = p.initial();
+  double x = s0.x[0], v = s0.v[0];
+  const long steps = steps_for(horizon, dt);
+  peer_run out;
+  out.samples.reserve(record.size());
+  auto next = record.begin();
+  for (long i = 0; i < steps; ++i) {
+    const double h = i + 1 == steps ? horizon - static_cast<double>(i) * dt : dt, h2 = 0.5 * h;
+    const double a1 = accel(x, v);
+    const double x2 = x + h2 * v, v2 = v + h2 * a1, a2 = accel(x2, v2);
+    const double x3 = x + h2 * v2, v3 = v + h2 * a2, a3 = accel(x3, v3);
+    const double x4 = x + h * v3, v4 = v + h * a3, a4 = accel(x4, v4);
+    x += (h / 6.0) * (v + 2.0 * (v2 + v3) + v4);
+    v += (h / 6.0) * (a1 + 2.0 * (a2 + a3) + a4);
+    if (next != record.end() && *next == i + 1) {
+      ++next;
+      out.samples.push_back({x, v});
+    }
+  }
+  out.steps = steps;
+  out.force_evals = 4 * steps;
+  out.non_finite = !std::isfinite(x) || !std::isfinite(v);
+  out.final_y = {x, v};
+  return out;
+}
+
+#if STEPBENCH_HAVE_ODEINT
+// ---- Boost.Odeint: runge_kutta4 and velocity_verlet on std::array -------------------
+
+template <problem P>
+peer_run odeint_rk4(const P& p, double dt, double horizon, std::span<const long> record) {
+  using state = std::array<double, 2 * P::dim>;
+  long calls = 0;
+  const double inv_mass = 1.0 / p.mass();
+  auto system = [&](const state& y, state& dydt, double t) {
+    ++calls;
+    first_order_rhs(p, inv_mass, t, y.data(), dydt.data());
+  };
+  boost::numeric::odeint::runge_kutta4<state> stepper;
+  state y;
+  const auto s0 = p.initial();
+  for (int i = 0; i < P::dim; ++i) y[i] = s0.x[i], y[P::dim + i] = s0.v[i];
+  peer_run out;
+  const long steps = steps_for(horizon, dt);
+  auto next = record.begin();
+  double t = 0.0;
+  for (long i = 0; i < steps; ++i) {
+    stepper.do_step(system, y, t, i + 1 == steps ? horizon - t : dt);
+    t = time_after_step(i + 1, steps, dt, horizon);
+    if (next != record.end() && *next == i + 1) {
+      ++next;
+      out.samples.emplace_back(y.begin(), y.end());
+    }
+  }
+  out.steps = steps;
+  out.force_evals = calls;
+  out.non_finite = !finite(y);
+  out.final_y.assign(y.begin(), y.end());
+  return out;
+}
+
+// Odeint's velocity_verlet is a second-order-system stepper: the system returns the
+// acceleration a(x, v, t). It declares order() == 1 (Boost 1.74) although the scheme is
+// second order; the study fits what it achieves and reports both.
+template <problem P>
+peer_run odeint_velocity_verlet(const P& p, double dt, double horizon, std::span<const long> record) {
+  using coord = std::array<double, P::dim>;
+  long calls = 0;
+  const double inv_mass = 1.0 / p.mass();
+  auto accel = [&](const coord& x, const coord& v, coord& a, double t) {
+    ++calls;
+    typename P::vec xe(P::dim), ve(P::dim);
+    for (int i = 0; i < P::dim; ++i) xe[i] = x[i], ve[i] = v[i];
+    const typename P::vec ae = p.force(t, xe, ve) * inv_mass;
+    for (int i = 0; i < P::dim; ++i) a[i] = ae[i];
+  };
+  boost::numeric::odeint::velocity_verlet<coord> stepper;
+  coord x, v;
+  const auto s0 = p.initial();
+  for (int i = 0; i < P::dim; ++i) x[i] = s0.x[i], v[i] = s0.v[i];
+  peer_run out;
+  const long steps = steps_for(horizon, dt);
+  auto next = record.begin();
+  double t = 0.0;
+  auto flat = [&] {
+    std::vector<double> y(x.begin(), x.end());
+    y.insert(y.end(), v.begin(), v.end());
+    return y;
+  };
+  for (long i = 0; i < steps; ++i) {
+    stepper.do_step(accel, std::make_pair(std::ref(x), std::ref(v)), t, i + 1 == steps ? horizon - t : dt);
+    t = time_after_step(i + 1, steps, dt, horizon);
+    if (next != record.end() && *next == i + 1) {
+      ++next;
+      out.samples.push_back(flat());
+    }
+  }
+  out.steps = steps;
+  out.force_evals = calls;
+  out.final_y = flat();
+  out.non_finite = !finite(out.final_y);
+  return out;
+}
+
+inline int odeint_declared_order_rk4() { return boost::numeric::odeint::runge_kutta4<std::array<double, 2>>::order_value; }
+inline int odeint_declared_order_velocity_verlet() {
+  return boost::numeric::odeint::velocity_verlet<std::array<double, 1>>::order_value;
+}
+#endif
+
+}  // namespace stepbench::peers

@@ -16,6 +16,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <unistd.h>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -142,17 +143,17 @@ peer_row peer_errors(const peers::peer_run& r, const truth_table& truth, int dim
   row.steps = r.steps;
   row.force_evals = r.force_evals;
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  if (r.non_finite || r.samples.size() != truth.y.size()) {
+  if (r.non_finite || r.sample_count() != truth.y.size()) {
     row.diverged = true;
     row.err_pos_final = row.err_pos_max = nan;
     return row;
   }
-  auto pos_err = [&](const std::vector<double>& a, const std::vector<double>& b) {
+  auto pos_err = [&](std::span<const double> a, std::span<const double> b) {
     double s = 0;
     for (int i = 0; i < dim; ++i) s += (a[i] - b[i]) * (a[i] - b[i]);
     return std::sqrt(s);
   };
-  for (size_t j = 0; j < truth.y.size(); ++j) row.err_pos_max = std::max(row.err_pos_max, pos_err(r.samples[j], truth.y[j]));
+  for (size_t j = 0; j < truth.y.size(); ++j) row.err_pos_max = std::max(row.err_pos_max, pos_err(r.sample(j), truth.y[j]));
   row.err_pos_final = pos_err(r.final_y, truth.y.back());
   row.diverged = !(row.err_pos_max <= blowup_factor * truth.pos_scale);
   return row;
@@ -162,7 +163,8 @@ peers::peer_run from_solution(const reference_solution& s) {
   peers::peer_run r;
   r.steps = s.stats.steps;
   r.force_evals = s.stats.rhs_evals_counted;
-  r.samples = s.y;
+  r.start(static_cast<int>(s.y.front().size()), s.y.size());
+  for (const auto& y : s.y) r.record(y.begin(), y.end());
   r.final_y = s.y.back();
   return r;
 }
@@ -465,11 +467,18 @@ bench_options take_own_flags(int& argc, char** argv, std::vector<std::string>& e
   return o;
 }
 
+// The display reporter Google Benchmark would have made from the flags: JSON or console,
+// coloured only on a terminal unless --benchmark_color says otherwise.
 std::unique_ptr<benchmark::BenchmarkReporter> display_reporter_for(int argc, char** argv) {
+  bool color = ::isatty(STDOUT_FILENO);
   for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--benchmark_format=json") == 0) return std::make_unique<benchmark::JSONReporter>();
+    const std::string a = argv[i];
+    if (a == "--benchmark_format=json") return std::make_unique<benchmark::JSONReporter>();
+    if (a == "--benchmark_color=false" || a == "--benchmark_color=no" || a == "--benchmark_color=0") color = false;
+    if (a == "--benchmark_color=true" || a == "--benchmark_color=yes" || a == "--benchmark_color=1") color = true;
   }
-  return std::make_unique<benchmark::ConsoleReporter>();
+  return std::make_unique<benchmark::ConsoleReporter>(color ? benchmark::ConsoleReporter::OO_ColorTabular
+                                                            : benchmark::ConsoleReporter::OO_Tabular);
 }
 
 }  // namespace

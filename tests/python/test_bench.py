@@ -123,3 +123,20 @@ def test_bad_flags(bench, args, message):
     assert done.returncode != 0
     assert message in done.stderr
     assert done.stdout == ""
+
+
+def test_time_budget_cuts_and_marks_the_fine_end(bench, tmp_path):
+    """A budget far below one iteration's time: each family's first (coarsest) case runs,
+    every finer one is cut, and the study file says so instead of holding a number."""
+    path = tmp_path / "cut.h5"
+    subprocess.run([bench, "--quick", "--case_budget=1e-9", "--benchmark_filter=^pendulum/(rk4|cvode_bdf)/",
+                    f"--study_out={path}"], check=True, capture_output=True, text=True)
+    with h5py.File(path, "r") as f:
+        assert f.attrs["benchmark_case_budget_s"] == 1e-9
+        for table in [f["pendulum/rk4/convergence"][()], f["pendulum/cvode_bdf/work_precision"][()]]:
+            assert table["time_ns"][0] > 0 and not table["cut"][0]
+            assert table["cut"][1:].all()
+            assert all(math.isnan(t) for t in table["time_ns"][1:])
+        # Cases the filter left out are neither timed nor cut.
+        other = f["pendulum/euler/convergence"][()]
+        assert not other["cut"].any() and all(math.isnan(t) for t in other["time_ns"])

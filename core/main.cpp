@@ -9,6 +9,7 @@
 #include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
+#include "core/advise.hpp"
 #include "core/drive.hpp"
 #include "core/measure.hpp"
 #include "core/parse.hpp"
@@ -178,6 +179,46 @@ int cmd_sweep(sweep_args a) {
   return 0;
 }
 
+struct advise_args {
+  std::string problem, tol_text, metric = "err_pos_max", study = "results/study.h5";
+  bool json = false;
+};
+
+// Exit 0 with an answer, 3 when no method in the file meets the tolerance (the answer
+// then names the best error achieved and by whom); bad input and unreadable files throw.
+int cmd_advise(const advise_args& a) {
+  const double tol = parse_number(a.tol_text, "--tol");
+  if (!(tol > 0.0)) throw usage_error(fmt::format("--tol must be > 0, got {}", a.tol_text));
+  const advise_result r = advise(read_advise_input(a.study, a.problem, a.metric), tol);
+  if (!a.json) {
+    fmt::print("{}", format_advice(r));
+    return r.ranked.empty() ? advise_exit_no_method : 0;
+  }
+  auto pick = [](const advise_pick& p) {
+    return json{{"method", p.method},
+                {"kind", p.peer ? "peer" : "integrator"},
+                {"param_name", p.adaptive ? "rtol" : "dt"},
+                {"param", p.row.param},
+                {"force_evals", p.row.force_evals},
+                {"time_ns", p.row.time_ns},  // NaN (not timed) is written as null by nlohmann::json
+                {"error", p.row.error},
+                {"cost", p.cost},
+                {"diverged_rows", p.diverged_rows},
+                {"smallest_diverged", p.smallest_diverged ? json(*p.smallest_diverged) : json(nullptr)},
+                {"largest_diverged", p.largest_diverged ? json(*p.largest_diverged) : json(nullptr)}};
+  };
+  json out = {{"problem", r.problem}, {"metric", r.metric}, {"tol", r.tol},     {"unit", r.unit},
+              {"cost", r.cost},       {"timings", r.timings}, {"met", !r.ranked.empty()}};
+  out["choice"] = r.ranked.empty() ? json(nullptr) : pick(r.ranked.front());
+  out["runners_up"] = json::array();
+  for (std::size_t i = 1; i < r.ranked.size(); ++i) out["runners_up"].push_back(pick(r.ranked[i]));
+  out["excluded"] = json::array();
+  for (const auto& e : r.excluded) out["excluded"].push_back({{"method", e.method}, {"reason", e.reason}});
+  out["best_achieved"] = r.best_achieved ? pick(*r.best_achieved) : json(nullptr);
+  std::cout << out.dump(2) << "\n";
+  return r.ranked.empty() ? advise_exit_no_method : 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -207,6 +248,17 @@ int main(int argc, char** argv) {
   sweep->add_option("--out", sa.out, "study file to write")->capture_default_str();
   sweep->add_flag("--quiet", sa.quiet, "print only the summary line");
 
+  advise_args aa;
+  auto* advise_cmd = app.add_subcommand(
+      "advise", "the cheapest stable method and its dt (or tolerance) for an error, from a study file");
+  advise_cmd->add_option("--problem", aa.problem, "problem name (one in the study file)")->required();
+  advise_cmd->add_option("--tol", aa.tol_text, "largest acceptable error, in the problem's units (> 0)")->required();
+  advise_cmd->add_option("--metric", aa.metric, "err_pos_max, err_pos_final, err_pos_rms or err_vel_final")
+      ->capture_default_str();
+  advise_cmd->add_option("--study", aa.study, "study file to read")->capture_default_str();
+  advise_cmd->add_flag("--json", aa.json, "print JSON");
+  advise_cmd->footer("exit codes: 0 answer, 1 study file unreadable, 2 bad usage, 3 no method meets the tolerance\n");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -221,6 +273,7 @@ int main(int argc, char** argv) {
     if (*list) return cmd_list(list_json);
     if (*run) return cmd_run(ra);
     if (*sweep) return cmd_sweep(sa);
+    if (*advise_cmd) return cmd_advise(aa);
   } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "stepbench: error: %s\n", e.what());
     return 2;

@@ -1,0 +1,372 @@
+"""The report's figures (matplotlib, Agg backend, PNG)."""
+import math
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
+from matplotlib.transforms import blended_transform_factory  # noqa: E402
+
+from . import tables, theory  # noqa: E402
+
+DPI = 100
+plt.rcParams.update({
+    "font.size": 10, "axes.titlesize": 11, "axes.labelsize": 10, "legend.fontsize": 8.5,
+    "axes.grid": True, "grid.alpha": 0.3, "grid.linewidth": 0.6, "savefig.dpi": DPI,
+})
+
+OUR_MARKERS = ["o", "s", "^", "D", "v", "P", "X", "*"]
+PEER_MARKERS = ["o", "s", "^", "D", "v", "P", "X", "*", "h", "<", ">", "p"]
+
+
+class Styles:
+    """One colour and marker per method, the same in every figure."""
+
+    def __init__(self, study):
+        # First appearance over the problems keeps the study's order (by order, then name).
+        ours = list(dict.fromkeys(m.name for p in study.problems for m in p.integrators))
+        peers = list(dict.fromkeys(m.name for p in study.problems for m in p.peers))
+        tab10 = plt.get_cmap("tab10").colors
+        # Peers: dashed lines and hollow markers, colours from a second palette so that
+        # none repeats one of ours (Dark2, then the darker half of tab20b).
+        peer_colors = list(plt.get_cmap("Dark2").colors) + list(plt.get_cmap("tab20b").colors)[::4]
+        self.style = {}
+        for i, n in enumerate(ours):
+            self.style[n] = dict(color=tab10[i % 10], marker=OUR_MARKERS[i % len(OUR_MARKERS)], linestyle="-")
+        for i, n in enumerate(peers):
+            self.style[n] = dict(color=peer_colors[i % len(peer_colors)], marker=PEER_MARKERS[(i + 3) % len(PEER_MARKERS)],
+                                 linestyle="--", markerfacecolor="white")
+
+    def __call__(self, name):
+        return self.style[name]
+
+
+def error_label(metric, unit):
+    what = {"err_pos_max": "max position error over the run", "err_pos_final": "final position error",
+            "energy_drift": "|energy drift| at the horizon (relative)"}[metric]
+    return f"{what} [{unit}]" if unit else what
+
+
+def _save(fig, path):
+    fig.savefig(path, dpi=DPI, bbox_inches="tight", pad_inches=0.12)
+    plt.close(fig)
+
+
+def coincident(curves):
+    """{name: earlier name} for curves (name, x, y) identical to one drawn before (the
+    momentum form is semi-implicit Euler up to rounding, and would hide under it)."""
+    out, seen = {}, []
+    for name, x, y in curves:
+        for n0, x0, y0 in seen:
+            if len(x0) == len(x) and np.allclose(x0, x) and np.allclose(np.nan_to_num(y0), np.nan_to_num(y),
+                                                                         rtol=1e-3, atol=0):
+                out[name] = out.get(n0, n0)
+                break
+        seen.append((name, x, y))
+    return out
+
+
+def _log_limits(values, pad=3.0):
+    v = np.asarray([x for x in values if np.isfinite(x) and x > 0])
+    if len(v) == 0:
+        return 1e-16, 1.0
+    return v.min() / pad, v.max() * pad
+
+
+def _edge_markers(ax, xs, where, style, size=8):
+    """Markers pinned to the top (where=1) or bottom (where=0) edge of the axes, for
+    values a log axis cannot show (diverged runs, errors exactly zero)."""
+    if len(xs) == 0:
+        return
+    tr = blended_transform_factory(ax.transData, ax.transAxes)
+    ax.plot(xs, [where] * len(xs), transform=tr, clip_on=False, linestyle="none", zorder=5,
+            markersize=size, **style)
+
+
+def convergence(problem, styles, path):
+    """Log-log max position error against dt, every integrator, fitted slope in the
+    legend, guide lines of orders 1, 2, 4. Fit levels filled, others hollow."""
+    fig, ax = plt.subplots(figsize=(10, 5.4))
+    all_err, all_dt = [], []
+    diverging = [m.name for m in problem.integrators if m.diverged.any()]
+    for m in problem.integrators:
+        dt, err = m.param, m.col("err_pos_max")
+        all_dt += list(dt)
+        # Diverged rows may carry huge finite errors (over 1e6 x the motion's scale): they
+        # are drawn as x marks, so they must not stretch the axis.
+        all_err += list(err[~m.diverged & np.isfinite(err) & (err > 0)])
+    lo, hi = _log_limits(all_err)
+    # Room at the top for one row of x marks per diverging method.
+    band = 0.05 * len(diverging)
+    if band:
+        hi = hi * (hi / lo) ** (band / (1 - band))
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_ylim(lo, hi)
+    dmin, dmax = min(all_dt) / 1.5, max(all_dt) * 1.5
+    ax.set_xlim(dmin, dmax)
+    any_div = any_zero = False
+    handles, labels = [], []
+    same_as = coincident([(m.name, m.param, m.col("err_pos_max")) for m in problem.integrators])
+    for k, m in enumerate(problem.integrators):
+        st = styles(m.name)
+        dt, err, div = m.param, m.col("err_pos_max"), m.diverged
+        a = m.attrs
+        levels = set(int(v) for v in np.atleast_1d(a.get("fit_levels", [])))
+        ok = ~div & np.isfinite(err) & (err > 0)
+        zero = ~div & (err == 0)
+        if int(a.get("exact_for_problem", 0) or 0) == 1 or a.get("fit_status") == "exact":
+            label = f"{m.name}: exact for this problem"
+        elif a.get("fit_status") == "fitted":
+            label = f"{m.name}: slope {a['observed_order']:.2f} (order {m.expected_order:g})"
+        else:
+            label = f"{m.name}: not fitted (order {m.expected_order:g})"
+        # Identical curves would hide each other: say so, and draw later ones with smaller
+        # markers so the earlier ones show around them.
+        if m.name in same_as:
+            label += f" (= {same_as[m.name]})"
+        group = [n for n in same_as if same_as[n] == same_as.get(m.name)]  # later copies of the same curve
+        size = 8.5 - 2.0 * (group.index(m.name) + 1) if m.name in same_as else 8.5
+        ax.plot(dt[ok], err[ok], color=st["color"], linestyle="-", linewidth=1.4, zorder=3 + k * 0.01)
+        fit = np.array([i in levels for i in range(len(dt))])
+        ax.plot(dt[ok & fit], err[ok & fit], linestyle="none", marker=st["marker"], color=st["color"],
+                markersize=size, zorder=4 + k * 0.01)
+        ax.plot(dt[ok & ~fit], err[ok & ~fit], linestyle="none", marker=st["marker"], markerfacecolor="white",
+                color=st["color"], markersize=size, zorder=4 + k * 0.01)
+        if zero.any():
+            any_zero = True
+            _edge_markers(ax, dt[zero], 0, dict(marker=st["marker"], color=st["color"], markerfacecolor="white"),
+                          size=size + 1)
+        if div.any():
+            any_div = True
+            row = 0.985 - 0.05 * diverging.index(m.name)  # axes fraction: its own row in the top band
+            _edge_markers(ax, dt[div], row, dict(marker="x", color=st["color"], markeredgewidth=2), size=7)
+        handles.append(Line2D([], [], color=st["color"], marker=st["marker"], markersize=6, linewidth=1.4))
+        labels.append(label)
+    _guides(ax, (1, 2, 4), top=1 - band)
+    if band:
+        edge = lo * (hi / lo) ** (1 - band)
+        ax.axhline(edge, color="0.6", linewidth=0.8)
+        ax.text(0.01, 1 - band / 2, "diverged", transform=ax.transAxes, rotation=90, va="center", ha="left",
+                fontsize=8, color="0.35")
+    ax.set_xlabel("timestep dt [s]")
+    ax.set_ylabel(error_label("err_pos_max", problem.unit))
+    ax.set_title(f"{problem.name}: convergence (horizon {problem.attrs.get('horizon', float('nan')):.4g} s)")
+    handles.append(Line2D([], [], color="grey", marker="o", linestyle="none"))
+    labels.append("filled: levels used by the fit")
+    handles.append(Line2D([], [], color="grey", marker="o", markerfacecolor="white", linestyle="none"))
+    labels.append("hollow: not used (round-off, pre-asymptotic)")
+    if any_zero:
+        handles.append(Line2D([], [], color="grey", marker="o", markerfacecolor="white", linestyle="none"))
+        labels.append("on the bottom edge: error exactly 0")
+    if any_div:
+        handles.append(Line2D([], [], color="grey", marker="x", linestyle="none", markeredgewidth=2))
+        labels.append("x in the top band: diverged (a row per method)")
+    ax.legend(handles, labels, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0, frameon=False)
+    fig.subplots_adjust(left=0.09, right=0.62, top=0.92, bottom=0.11)
+    _save(fig, path)
+
+
+def _guides(ax, orders, top=1.0):
+    """Dashed grey lines err ~ dt^p from the upper right corner of the data area (below
+    `top`, an axes fraction), labelled where they are still inside the axes."""
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    lx = math.log10(x1 / x0)
+    ly = math.log10(y1 / y0) * top
+    ya = y0 * 10 ** (0.92 * ly)  # anchor just below the top right corner
+    xs = np.logspace(math.log10(x0), math.log10(x1), 50)
+    for p in orders:
+        ax.plot(xs, ya * (xs / x1) ** p, color="0.55", linestyle="--", linewidth=0.9, zorder=1)
+        # Label at the left end of the visible part, but not beyond 60 % of the width.
+        dec = min(0.6 * lx, 0.85 * ly / p)
+        xl = x1 / 10 ** dec
+        yl = ya * (xl / x1) ** p
+        ax.text(xl, yl, f"order {p}", color="0.35", fontsize=8, ha="right", va="bottom", zorder=2,
+                bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.8))
+
+
+def _grid(n):
+    cols = 2 if n > 1 else 1
+    rows = math.ceil(n / cols)
+    return rows, cols
+
+
+def _panels(n, legend_entries, title_lines):
+    """A grid of n panels with room above for a title and below for a shared legend,
+    sized in inches so that nothing overlaps whatever n is."""
+    rows, cols = _grid(n)
+    ncol = 4 if legend_entries > 6 else 3
+    legend_h = 0.24 * math.ceil(legend_entries / ncol) + 0.15
+    panel_h, gap, top, bottom = 3.3, 0.95, 0.35 + 0.25 * title_lines, legend_h + 0.6
+    height = panel_h * rows + gap * (rows - 1) + top + bottom
+    fig, axes = plt.subplots(rows, cols, figsize=(12, height), squeeze=False)
+    fig.subplots_adjust(left=0.07, right=0.98, top=1 - top / height, bottom=bottom / height,
+                        hspace=gap / panel_h, wspace=0.22)
+    for ax in list(axes.flat)[n:]:
+        ax.set_visible(False)
+    return fig, axes, ncol
+
+
+def _finish(fig, handles, labels, ncol, title):
+    fig.suptitle(title, fontsize=12, y=1 - 0.1 / fig.get_figheight(), va="top")
+    fig.legend(handles, labels, loc="lower center", ncol=ncol, frameon=False, bbox_to_anchor=(0.5, 0.0))
+
+
+def work_precision(study, styles, path, x_field):
+    """Error against cost, one panel per problem, every method (peers dashed); the
+    Pareto front (points no other beats in both cost and error) drawn as a thick band."""
+    timings = study.timings
+    probs = study.problems
+    names = list(dict.fromkeys(m.name for p in probs for m in p.methods))
+    fig, axes, ncol = _panels(len(probs), len(names) + 2, 1 if timings else 2)
+    seen, any_zero = {}, False
+    for ax, p in zip(axes.flat, probs):
+        pts = tables.work_points(p, x_field, timings)
+        same_as = coincident([(n, x, e) for n, (x, e, _, _) in pts.items()])
+        front = tables.pareto_front(pts)
+        all_e = [e for (_, es, _, _) in pts.values() for e in es]
+        lo, hi = _log_limits(all_e)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_ylim(lo, hi)
+        if front:
+            fx = [f[1] for f in front]
+            fy = [max(f[2], lo) for f in front]
+            ax.step(fx, fy, where="post", color="gold", linewidth=7, alpha=0.45, zorder=1, solid_capstyle="round")
+        for name, (xs, es, _, m) in pts.items():
+            st = styles(name)
+            pos = es > 0
+            size = 4.0 if name in same_as else 6.0
+            ax.plot(xs[pos], es[pos], markersize=size, linewidth=1.1, zorder=3, **st)
+            h = Line2D([], [], markersize=6, **st)
+            if (~pos).any():
+                any_zero = True
+                _edge_markers(ax, xs[~pos], 0, dict(marker=st["marker"], color=st["color"], markerfacecolor="white"),
+                              size=6)
+            seen.setdefault(name, (h, m))
+        ax.set_title(p.name)
+        ax.set_xlabel("median wall time per run [s]" if x_field == "time_s" else "force evaluations per run")
+        ax.set_ylabel(error_label("err_pos_max", p.unit))
+    names = list(seen)
+    handles = [seen[n][0] for n in names]
+    labels = [n + (" (peer)" if seen[n][1].peer else "") for n in names]
+    handles.append(Line2D([], [], color="gold", linewidth=7, alpha=0.45))
+    labels.append("Pareto front (nothing beats it in both cost and error)")
+    if any_zero:
+        handles.append(Line2D([], [], color="grey", marker="o", markerfacecolor="white", linestyle="none"))
+        labels.append("on the bottom edge: error exactly 0")
+    what = "time" if x_field == "time_s" else "force evaluations"
+    title = f"Work-precision: error against {what}"
+    if not timings:
+        title += "\n(the study has no timings: run the benchmark study for error against time)"
+    _finish(fig, handles, labels, ncol, title)
+    _save(fig, path)
+
+
+def energy(study, styles, path):
+    """|energy drift| at the horizon against dt, per problem with an energy."""
+    probs = [p for p in study.problems if int(p.attrs.get("has_energy", 0) or 0) == 1]
+    if not probs:
+        return False
+    names = list(dict.fromkeys(m.name for p in probs for m in p.integrators))
+    fig, axes, ncol = _panels(len(probs), len(names) + 2, 1)
+    seen = {}
+    for ax, p in zip(axes.flat, probs):
+        vals = []
+        for m in p.integrators:
+            d = m.col("energy_drift")
+            ok = ~m.diverged & np.isfinite(d) & (np.abs(d) > 0)
+            vals += list(np.abs(d[ok]))
+        lo, hi = _log_limits(vals)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_ylim(lo, hi)
+        same_as = coincident([(m.name, m.param, np.abs(m.col("energy_drift"))) for m in p.integrators])
+        for m in p.integrators:
+            st = styles(m.name)
+            dt, d = m.param, m.col("energy_drift")
+            ok = ~m.diverged & np.isfinite(d) & (np.abs(d) > 0)
+            size = 3.5 if m.name in same_as else 5.5  # coinciding curves nest instead of hiding
+            ax.plot(dt[ok], np.abs(d[ok]), color=st["color"], linewidth=1.1, zorder=2)
+            gain, loss = ok & (d > 0), ok & (d < 0)
+            ax.plot(dt[gain], d[gain], linestyle="none", marker=st["marker"], color=st["color"], markersize=size,
+                    zorder=3)
+            ax.plot(dt[loss], -d[loss], linestyle="none", marker=st["marker"], color=st["color"],
+                    markerfacecolor="white", markersize=size, zorder=3)
+            seen.setdefault(m.name, Line2D([], [], color=st["color"], marker=st["marker"]))
+        ax.set_title(p.name)
+        ax.set_xlabel("timestep dt [s]")
+        ax.set_ylabel("|energy drift| / energy scale [-]")
+    handles = list(seen.values()) + [Line2D([], [], color="grey", marker="o", linestyle="none"),
+                                     Line2D([], [], color="grey", marker="o", markerfacecolor="white",
+                                            linestyle="none")]
+    labels = list(seen) + ["filled: gained energy", "hollow: lost energy"]
+    _finish(fig, handles, labels, ncol, "Energy error at the horizon (relative to the energy scale)")
+    _save(fig, path)
+    return True
+
+
+def stability(osc_rows, path):
+    """Left: absolute-stability regions |R(z)| <= 1 of the Runge-Kutta methods in the
+    plane of z = h lambda, with their intervals on the axes. Right: the undamped
+    oscillator's limit w dt for every method."""
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 6.2), gridspec_kw={"width_ratios": [1, 1]})
+    re = np.linspace(-3.5, 1.0, 451)
+    im = np.linspace(-3.3, 3.3, 661)
+    zr, zi = np.meshgrid(re, im)
+    z = zr + 1j * zi
+    colors = {"euler": "tab:blue", "midpoint": "tab:green", "rk4": "tab:red"}
+    box = dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.85)
+    handles = []
+    for name in ("rk4", "midpoint", "euler"):
+        r = np.polynomial.Polynomial(theory.stability_function(name))
+        mag = np.abs(r(z))
+        ax.contourf(zr, zi, mag, levels=[0, 1], colors=[colors[name]], alpha=0.18)
+        ax.contour(zr, zi, mag, levels=[1], colors=[colors[name]], linewidths=1.6)
+        xr = theory.real_axis_limit(name)
+        yi, _ = theory.imaginary_axis_limit(name)
+        ax.plot([xr], [0], marker="o", color=colors[name], markersize=7, zorder=5, markeredgecolor="black")
+        text = f"{name}: real axis to {xr:.3f}"
+        text += f", imag. axis |y| <= {yi:.3f}" if yi > 0 else ", imag. axis: only 0"
+        handles.append((Line2D([], [], color=colors[name], linewidth=6, alpha=0.5), text))
+        if yi > 0:
+            ax.plot([0, 0], [-yi, yi], color=colors[name], linewidth=4, solid_capstyle="butt", zorder=4)
+            for s in (-1, 1):
+                ax.annotate(f"{s * yi:+.3f}i", (0, s * yi), xytext=(6, 0), textcoords="offset points",
+                            va="center", fontsize=8.5, color=colors[name], bbox=box)
+    box = dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.85)
+    xr1 = theory.real_axis_limit("euler")
+    ax.annotate(f"{xr1:.3f}\n(euler, midpoint)", (xr1, 0), xytext=(xr1, -0.75), fontsize=8.5, ha="center",
+                va="top", bbox=box, arrowprops=dict(arrowstyle="-", color="0.4", linewidth=0.8))
+    xr4 = theory.real_axis_limit("rk4")
+    ax.annotate(f"{xr4:.3f} (rk4)", (xr4, 0), xytext=(xr4 + 0.1, 0.6), fontsize=8.5, ha="center", bbox=box,
+                arrowprops=dict(arrowstyle="-", color="0.4", linewidth=0.8))
+    ax.axhline(0, color="black", linewidth=0.7)
+    ax.axvline(0, color="black", linewidth=0.7)
+    ax.set_aspect("equal", adjustable="datalim")  # fill the panel: show more of the plane, not blank space
+    ax.set_xlim(re[0], re[-1])
+    ax.set_ylim(im[0], im[-1])
+    ax.set_xlabel("Re(z),  z = dt * lambda  [-]")
+    ax.set_ylabel("Im(z)  [-]")
+    ax.set_title("Absolute stability regions |R(z)| <= 1")
+    ax.legend([h for h, _ in handles], [t for _, t in handles], loc="upper center", bbox_to_anchor=(0.5, -0.11),
+              fontsize=8.5, frameon=False)
+
+    names = [r["method"] for r in osc_rows]
+    ys = [r["y_limit"] for r in osc_rows]
+    bars = bx.barh(range(len(names)), ys, color=["tab:gray" if y == 0 else "tab:blue" for y in ys])
+    for i, y in enumerate(ys):
+        bx.text(max(y, 0) + 0.05, i, "unstable for every dt" if y == 0 else f"w dt < {y:.4f}", va="center",
+                fontsize=9)
+    del bars
+    bx.set_yticks(range(len(names)))
+    bx.set_yticklabels(names)
+    bx.invert_yaxis()
+    bx.set_xlim(0, max(ys + [1]) * 1.45)
+    bx.set_xlabel("stability limit w * dt on x'' = -w^2 x  [-]")
+    bx.set_title("Undamped oscillator: largest stable w * dt")
+    bx.grid(axis="y", visible=False)
+    fig.subplots_adjust(left=0.07, right=0.98, top=0.93, bottom=0.24, wspace=0.45)
+    _save(fig, path)

@@ -427,7 +427,7 @@ void print_ratios(const study& s) {
         ratio("rk4", "baseline_rk4", "<= 1.15", ns.at("rk4") / ns.at("baseline_rk4") <= 1.15);
       if (ns.count("gsl_rk4")) {
         ratio("gsl_rk4", "rk4", ">= 6", ns.at("gsl_rk4") / ns.at("rk4") >= 6.0);
-        fmt::print("    (GSL's rk4 step also estimates its error by step doubling: {} force evaluations a step against our 4)\n",
+        fmt::print("    (GSL's rk4 step also estimates its error by step doubling: {:.2f} force evaluations a step against our 4)\n",
                    [&] {
                      for (const auto& p : spring->peers)
                        if (p.name == "gsl_rk4") return static_cast<double>(p.rows.back().force_evals) / p.rows.back().steps;

@@ -7,4 +7,4 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 build=${STEPBENCH_BUILD_DIR:-$root/build}
 [ -x "$build/stepbench_bench" ] || "$root/scripts/build.sh" >/dev/null
 "$build/stepbench_bench" --benchmark_filter='^(damped_spring/(rk4|baseline_rk4|gsl_rk4|odeint_rk4)/|pendulum/)' \
-  --benchmark_min_time=0.1 --benchmark_repetitions=3 "$@" | sed -n '/^Performance ratios/,$p'
+  --benchmark_min_time=0.03 --benchmark_repetitions=3 "$@" 2>/dev/null | sed -n '/^Performance ratios/,$p'

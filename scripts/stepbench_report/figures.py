@@ -145,7 +145,8 @@ def convergence(problem, styles, path):
             _edge_markers(ax, dt[div], row, dict(marker="x", color=st["color"], markeredgewidth=2), size=7)
         handles.append(Line2D([], [], color=st["color"], marker=st["marker"], markersize=6, linewidth=1.4))
         labels.append(label)
-    _guides(ax, (1, 2, 4), top=1 - band)
+    _guides(ax, (1, 2, 4), [(m.param[~m.diverged], m.col("err_pos_max")[~m.diverged]) for m in problem.integrators],
+            top=1 - band)
     if band:
         edge = lo * (hi / lo) ** (1 - band)
         ax.axhline(edge, color="0.6", linewidth=0.8)
@@ -169,22 +170,51 @@ def convergence(problem, styles, path):
     _save(fig, path)
 
 
-def _guides(ax, orders, top=1.0):
+def _guides(ax, orders, data, top=1.0):
     """Dashed grey lines err ~ dt^p from the upper right corner of the data area (below
-    `top`, an axes fraction), labelled where they are still inside the axes."""
+    `top`, an axes fraction). Each label goes where the line is farthest from the data
+    (`data`: list of (x, y) arrays of the plotted curves) and from the other labels, so
+    no text sits on a curve."""
     (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
-    lx = math.log10(x1 / x0)
-    ly = math.log10(y1 / y0) * top
+    lx, ly_full = math.log10(x1 / x0), math.log10(y1 / y0)
+    ly = ly_full * top
     ya = y0 * 10 ** (0.92 * ly)  # anchor just below the top right corner
     xs = np.logspace(math.log10(x0), math.log10(x1), 50)
+
+    def frac(x, y):  # data -> axes fraction on the log axes
+        return np.log10(np.asarray(x) / x0) / lx, np.log10(np.asarray(y) / y0) / ly_full
+
+    # The curves, densified along their segments, in axes fractions.
+    pts = []
+    for x, y in data:
+        ok = np.isfinite(x) & np.isfinite(y) & (np.asarray(x) > 0) & (np.asarray(y) > 0)
+        fx, fy = frac(np.asarray(x)[ok], np.asarray(y)[ok])
+        for i in range(len(fx)):
+            pts.append((fx[i], fy[i]))
+            if i + 1 < len(fx):
+                for t in np.linspace(0.1, 0.9, 9):
+                    pts.append((fx[i] + t * (fx[i + 1] - fx[i]), fy[i] + t * (fy[i + 1] - fy[i])))
+    pts = np.array(pts) if pts else np.zeros((0, 2))
+    placed = []
     for p in orders:
         ax.plot(xs, ya * (xs / x1) ** p, color="0.55", linestyle="--", linewidth=0.9, zorder=1)
-        # Label at the left end of the visible part, but not beyond 60 % of the width.
-        dec = min(0.6 * lx, 0.85 * ly / p)
-        xl = x1 / 10 ** dec
-        yl = ya * (xl / x1) ** p
-        ax.text(xl, yl, f"order {p}", color="0.35", fontsize=8, ha="right", va="bottom", zorder=2,
-                bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.8))
+        best, best_score = None, -1.0
+        for xc in np.logspace(math.log10(x0), math.log10(x1), 80)[3:-3]:
+            yc = ya * (xc / x1) ** p
+            fx, fy = frac(xc, yc)
+            if not (0.06 < fy < top - 0.06):
+                continue
+            # Label box ~ 0.1 wide, 0.05 high (axes fractions): distance in box units.
+            near = [np.min(np.hypot((pts[:, 0] - fx) / 0.1, (pts[:, 1] - fy) / 0.05))] if len(pts) else [9.0]
+            near += [np.hypot((q[0] - fx) / 0.1, (q[1] - fy) / 0.05) for q in placed]
+            score = min(near)
+            if score > best_score:
+                best, best_score = (xc, yc, fx, fy), score
+        if best is None:
+            continue
+        placed.append(best[2:])
+        ax.text(best[0], best[1], f"order {p}", color="0.3", fontsize=8, ha="center", va="center", zorder=6,
+                bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="0.8", linewidth=0.5))
 
 
 def _grid(n):

@@ -15,24 +15,14 @@
 #include <stdexcept>
 #include <string>
 
+#include "references/detail.hpp"
 #include "references/reference.hpp"
 
 namespace stepbench {
-namespace detail {
-void validate_reference_input(std::string_view source, const ode_system& sys, std::span<const double> times,
-                              reference_tolerances tol);
-}
 
 namespace {
 
-// What the C callbacks need, and what they hand back: a C++ exception must not cross
-// CVODE's C frames, so it is stashed and rethrown once CVODE has returned.
-struct cvode_callback_state {
-  const ode_system* sys = nullptr;
-  long calls = 0;
-  std::exception_ptr error;
-  bool non_finite = false;
-  double non_finite_t = 0.0;
+struct cvode_callback_state : detail::callback_state {
   std::string last_message;  // from the error handler, instead of CVODE printing to stderr
 };
 

@@ -11,25 +11,14 @@
 #include <stdexcept>
 #include <string>
 
+#include "references/detail.hpp"
 #include "references/reference.hpp"
 
 namespace stepbench {
-namespace detail {
-void validate_reference_input(std::string_view source, const ode_system& sys, std::span<const double> times,
-                              reference_tolerances tol);
-}
 
 namespace {
 
-// What the C callback needs, and what it hands back: GSL's callback is C, so a C++
-// exception must not cross it (it is stashed and rethrown once the driver returns).
-struct gsl_callback_state {
-  const ode_system* sys = nullptr;
-  long calls = 0;
-  std::exception_ptr error;
-  bool non_finite = false;
-  double non_finite_t = 0.0;
-};
+using gsl_callback_state = detail::callback_state;
 
 // Every call of f goes through here; GSL itself counts none.
 int gsl_rhs(double t, const double y[], double dydt[], void* params) noexcept {

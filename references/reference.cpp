@@ -1,6 +1,8 @@
 // Input validation shared by the reference solvers, and dispatch by source name.
 #include "references/reference.hpp"
 
+#include "references/detail.hpp"
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -8,9 +10,6 @@
 namespace stepbench {
 namespace detail {
 
-// Declared (without a header, to keep the interface in reference.hpp unchanged) in
-// gsl_reference.cpp and cvode_reference.cpp: both solvers are public, so both check
-// their input, not only solve_reference.
 void validate_reference_input(std::string_view source, const ode_system& sys, std::span<const double> times,
                               reference_tolerances tol) {
   const auto fail = [&](const std::string& what) {

@@ -9,8 +9,8 @@ import time
 from . import report, study
 
 
-def main(argv=None):
-    start = time.perf_counter()
+def main(argv=None, start=None):
+    start = time.perf_counter() if start is None else start
     ap = argparse.ArgumentParser(
         prog="report",
         description="Turn a stepbench study file into a report folder: index.html (opens offline), REPORT.md and "

@@ -11,7 +11,7 @@ from .tables import fmt_num, fmt_param, fmt_time_ns
 META_KEYS = ["version", "git_commit", "compiler", "build_type", "created_utc", "cpu", "cores", "format_version",
              "levels", "base_steps", "sample_count", "reference_rtol", "reference_atol", "fit_metric", "wall_seconds"]
 BENCH_KEYS = ["timing", "benchmark_mode", "benchmark_min_time_s", "benchmark_repetitions", "benchmark_case_budget_s",
-              "cpu_scaling_enabled", "num_cpus", "mhz_per_cpu"]
+              "benchmark_wall_seconds", "cpu_scaling_enabled", "num_cpus", "mhz_per_cpu"]
 PROBLEM_KEYS = {"horizon", "dim", "description", "has_closed_form", "has_energy", "truth_source", "pos_scale",
                 "vel_scale", "energy_scale", "position_unit"}
 

@@ -57,7 +57,8 @@ def add_fake_timings(src, dst):
                 g[name].create_dataset("convergence", data=new)
             rk4 = g["rk4"]["convergence"][()]
             wp_type = [("param", "<f8"), ("steps", "<i8"), ("force_evals", "<i8"), ("err_pos_final", "<f8"),
-                       ("err_pos_max", "<f8"), ("time_ns", "<f8"), ("repetitions", "<i8"), ("cut", "i1")]
+                       ("err_pos_max", "<f8"), ("diverged", "i1"), ("time_ns", "<f8"), ("repetitions", "<i8"),
+                       ("cut", "i1")]
             # A fixed-step peer: GSL's RK4 at our dt, same errors as ours, slower.
             fixed = np.zeros(len(rk4), dtype=wp_type)
             for field in ("steps", "force_evals", "err_pos_final", "err_pos_max"):
@@ -83,6 +84,7 @@ def add_fake_timings(src, dst):
             ad["time_ns"] = 40.0 * ad["force_evals"]
             ad["repetitions"] = 3
             ad["err_pos_final"][0] = ad["err_pos_max"][0] = np.nan
+            ad["diverged"][0] = 1
             pg = g.create_group("cvode_bdf")
             pg.attrs.update({"kind": "adaptive", "declared_order": np.nan, "observed_order": np.nan,
                              "fit_status": "insufficient", "description": "CVODE BDF (test fixture)"})

@@ -46,6 +46,7 @@ concept problem = requires(const P& p, double t, const typename P::vec& x) {
   { P::name } -> std::convertible_to<std::string_view>;
   { P::description } -> std::convertible_to<std::string_view>;
   { P::dim } -> std::convertible_to<int>;
+  { P::position_unit } -> std::convertible_to<std::string_view>;  // "m", or "rad" for an angle
   { P::force_depends_on_velocity } -> std::convertible_to<bool>;
   { P::parameters() };
   { p.mass() } -> std::convertible_to<double>;

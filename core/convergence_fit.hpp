@@ -15,6 +15,7 @@
 // When every level's error is within the worst-case round-off bound 8 eps n scale, the
 // method is exact for the problem (RK4 on constant acceleration): no slope is fitted
 // and the order is NaN.
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -31,7 +32,7 @@ struct fit_input {
 struct fit_result {
   enum class status { fitted, exact, insufficient };
   status state = status::insufficient;
-  double order = 0.0;  // NaN unless fitted
+  double order = std::numeric_limits<double>::quiet_NaN();  // NaN unless fitted
   double intercept = 0.0;
   double residual = 0.0;     // RMS of the log10 residuals
   std::vector<int> levels;   // ladder indices used by the fit

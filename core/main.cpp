@@ -36,6 +36,7 @@ int cmd_list(bool as_json) {
     out["problems"].push_back({{"name", name},
                                {"description", p->description()},
                                {"dim", p->dim()},
+                               {"position_unit", p->position_unit()},
                                {"horizon", p->horizon()},
                                {"closed_form", p->has_closed_form()},
                                {"energy", p->has_energy()},

@@ -156,7 +156,7 @@ run_metrics measure(const problem_instance& problem, const run_result& run, cons
   }
   if (!(m.err_pos_max <= blowup_factor * truth.pos_scale)) {
     m.diverged = true;
-    m.diverged_reason = fmt::format("position error {:.3g} exceeds {:.0e} times the amplitude", m.err_pos_max, blowup_factor);
+    m.diverged_reason = fmt::format("position error {:.3g} exceeds {:g} times the amplitude", m.err_pos_max, blowup_factor);
   }
   return m;
 }

@@ -34,6 +34,7 @@ class problem_model final : public problem_instance {
   std::string_view name() const override { return P::name; }
   std::string_view description() const override { return P::description; }
   int dim() const override { return P::dim; }
+  std::string_view position_unit() const override { return P::position_unit; }
 
   std::vector<param_value> params() const override {
     std::vector<param_value> out;

@@ -47,6 +47,7 @@ class problem_instance {
   virtual std::string_view name() const = 0;
   virtual std::string_view description() const = 0;
   virtual int dim() const = 0;
+  virtual std::string_view position_unit() const = 0;
   virtual std::vector<param_value> params() const = 0;
   // Sets a parameter; throws std::invalid_argument naming an unknown parameter.
   virtual void set(std::string_view param, double value) = 0;

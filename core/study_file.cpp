@@ -198,6 +198,7 @@ void write_problem(H5::H5File& file, const problem_study& ps, bool timed) {
   for (const auto& param : p.params()) attr(g, param.name, param.value);
   attr(g, "horizon", ps.horizon);
   attr(g, "dim", p.dim());
+  attr(g, "position_unit", std::string(p.position_unit()));
   attr(g, "description", std::string(p.description()));
   attr(g, "has_closed_form", static_cast<int>(p.has_closed_form()));
   attr(g, "has_energy", static_cast<int>(p.has_energy()));
@@ -267,6 +268,7 @@ void write_study(const study& s, const std::string& path) {
     attr(file, "reference_rtol", s.options.tol.rtol);
     attr(file, "reference_atol", s.options.tol.atol);
     attr(file, "fit_metric", "err_pos_max");
+    attr(file, "divergence_factor", blowup_factor);
     attr(file, "wall_seconds", s.wall_seconds);
     attr(file, "timing", static_cast<int>(s.timed.has_value()));
     if (s.timed) {

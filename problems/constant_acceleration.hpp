@@ -13,6 +13,7 @@ struct constant_acceleration {
   static constexpr std::string_view name = "constant_acceleration";
   static constexpr std::string_view description = "1-D body under a constant force (lecture's Euler example)";
   static constexpr int dim = 1;
+  static constexpr std::string_view position_unit = "m";
   static constexpr bool force_depends_on_velocity = false;
   using vec = Eigen::Matrix<double, 1, 1>;
 

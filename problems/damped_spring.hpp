@@ -25,6 +25,7 @@ struct damped_spring {
   static constexpr std::string_view name = "damped_spring";
   static constexpr std::string_view description = "mass on a spring and damper (lecture's RK4 example)";
   static constexpr int dim = 1;
+  static constexpr std::string_view position_unit = "m";
   static constexpr bool force_depends_on_velocity = true;
   using vec = Eigen::Matrix<double, 1, 1>;
 

@@ -28,6 +28,7 @@ struct pendulum {
   static constexpr std::string_view name = "pendulum";
   static constexpr std::string_view description = "simple pendulum, large swing, released from rest";
   static constexpr int dim = 1;
+  static constexpr std::string_view position_unit = "rad";
   static constexpr bool force_depends_on_velocity = false;
   using vec = Eigen::Matrix<double, 1, 1>;
 

@@ -15,6 +15,7 @@ struct projectile {
   static constexpr std::string_view name = "projectile";
   static constexpr std::string_view description = "3-D ball under uniform gravity, launched from the ground";
   static constexpr int dim = 3;
+  static constexpr std::string_view position_unit = "m";
   static constexpr bool force_depends_on_velocity = false;
   using vec = Eigen::Vector3d;
 

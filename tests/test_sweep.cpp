@@ -135,3 +135,27 @@ TEST(sweep, invalid_options_are_rejected) {
   opts.overrides["pendulum"]["length_m"] = -1.0;
   EXPECT_THROW(validate(opts), std::invalid_argument);
 }
+
+// Explicit Euler on m x'' + c x' + k x = 0 multiplies each mode by 1 + h lambda, lambda =
+// -gamma +- i w_d, so it is stable iff h < 2 gamma / w0^2 = c / k = 0.1 s for the default
+// spring. Below the limit no row may be flagged diverged; the coarsest row (dt = 0.3125 s,
+// |1 + h lambda| = 1.29, grown 1.29^32 ~ 3e3 times) must be.
+TEST(sweep, divergence_follows_the_stability_limit) {
+  const auto& ps = find(default_study(), "damped_spring");
+  for (const auto& is : ps.integrators) {
+    if (is.info.name != "euler") continue;
+    EXPECT_TRUE(is.rows.front().metrics.diverged);
+    for (const auto& row : is.rows) {
+      if (row.dt < 0.1) {
+        EXPECT_FALSE(row.metrics.diverged) << "dt " << row.dt;
+      }
+    }
+  }
+  // No stable method diverges anywhere on the default problems.
+  for (const auto& p : default_study().problems) {
+    for (const auto& is : p.integrators) {
+      if (is.info.name == "euler") continue;
+      for (const auto& row : is.rows) EXPECT_FALSE(row.metrics.diverged) << p.problem->name() << "/" << is.info.name;
+    }
+  }
+}

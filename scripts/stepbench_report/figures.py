@@ -94,7 +94,7 @@ def convergence(problem, styles, path):
     for m in problem.integrators:
         dt, err = m.param, m.col("err_pos_max")
         all_dt += list(dt)
-        # Diverged rows may carry huge finite errors (over 1e6 x the motion's scale): they
+        # Diverged rows may carry huge finite errors (over divergence_factor x the scale): they
         # are drawn as x marks, so they must not stretch the axis.
         all_err += list(err[~m.diverged & np.isfinite(err) & (err > 0)])
     lo, hi = _log_limits(all_err)

@@ -237,7 +237,8 @@ def document(study, figs):
                          fmt_num(big.max()) + f" {p.unit}" if len(big) else "", str(int((~above & div).sum()))])
         doc.h(3, f"{p.name}: ladder against the limits", anchor=f"ladder-{p.name}")
         doc.p(f"Each ladder row against the theoretical limit (with the damping) on {p.name}. A run counts as "
-              "diverged when its error exceeds 1e6 x the motion's scale, so a row just above the limit may grow "
+              f"diverged when its error exceeds {study.attrs.get('divergence_factor', 1e6):g} x the motion's scale, "
+              "so a row just above the limit may grow "
               "without being flagged within the horizon; a diverged row below the limit would contradict the theory.")
         doc.table(["integrator", "theoretical dt limit [s]", "coarsest dt in the study [s]", "rows at or above the limit",
                    "of those, diverged", "largest error of the others", "diverged rows below the limit"], rows)

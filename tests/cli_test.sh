@@ -77,6 +77,9 @@ expect_error "levels must be between 2 and 20" sweep --levels 1 --out "$work/stu
 # A good sweep replaces it whole.
 "$bin" sweep --problem damped_spring --integrator rk4 --levels 3 --quiet --out "$work/study.h5" >/dev/null || bad "small sweep failed"
 head -c 4 "$work/study.h5" | grep -q HDF && ok || bad "study file is not HDF5"
+# h5dump (hdf5-tools) reads it: the compound convergence table with its documented fields.
+h5dump -d /damped_spring/rk4/convergence "$work/study.h5" >"$work/dump" 2>&1 &&
+  grep -q '"err_pos_max"' "$work/dump" && grep -q '"diverged"' "$work/dump" && ok || bad "h5dump cannot read the study file"
 
 echo "cli: $passes passed, $fails failed"
 [ "$fails" -eq 0 ]

@@ -140,3 +140,20 @@ def test_time_budget_cuts_and_marks_the_fine_end(bench, tmp_path):
         # Cases the filter left out are neither timed nor cut.
         other = f["pendulum/euler/convergence"][()]
         assert not other["cut"].any() and all(math.isnan(t) for t in other["time_ns"])
+
+
+def test_two_json_outputs_compare_with_google_benchmarks_compare_py(bench, tmp_path):
+    compare = "/usr/share/benchmark/compare.py"
+    if not os.path.exists(compare):
+        pytest.skip("libbenchmark-tools is not installed")
+    outs = []
+    for name in ["a.json", "b.json"]:
+        out = tmp_path / name
+        subprocess.run([bench, "--quick", "--benchmark_filter=^damped_spring/(rk4|gsl_rk4)/",
+                        f"--benchmark_out={out}", "--benchmark_out_format=json"], check=True, capture_output=True)
+        outs.append(str(out))
+    done = subprocess.run(["/usr/bin/python3", compare, "benchmarks", *outs], capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 0, done.stderr
+    rows = [line for line in done.stdout.splitlines() if "damped_spring/" in line]
+    assert len(rows) == 16  # 8 quick levels x 2 methods, each compared old against new

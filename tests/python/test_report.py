@@ -340,6 +340,25 @@ def test_bad_study_file_leaves_the_old_report(tmp_path):
     assert sorted(os.listdir(tmp_path)) == ["garbage.h5", "report"]  # no temporary folder left
 
 
+def test_never_replaces_a_folder_it_did_not_write(studies, tmp_path):
+    """--out naming a folder with other files in it (results/, the working directory)
+    is refused, and nothing in it is touched; a report folder it wrote is replaced."""
+    study, _ = studies["plain"]
+    precious = tmp_path / "results"
+    precious.mkdir()
+    (precious / "notes.txt").write_text("keep me\n")
+    for out, cwd in [(str(precious), None), ("", str(precious)), (".", str(precious))]:
+        p = subprocess.run([PYTHON, REPORT, str(study), "--out", out], capture_output=True, text=True, cwd=cwd)
+        assert p.returncode == 1, p.stdout
+        assert len(p.stderr.strip().splitlines()) == 1 and p.stderr.startswith("report: error:"), p.stderr
+        assert sorted(os.listdir(precious)) == ["notes.txt"]
+    report = tmp_path / "report"
+    for _ in range(2):  # the second run replaces the first's folder
+        p = subprocess.run([PYTHON, REPORT, str(study), "--out", str(report)], capture_output=True, text=True)
+        assert p.returncode == 0, p.stderr
+        assert (report / ".stepbench-report").exists() and (report / "index.html").exists()
+
+
 # --- stepbench advise -------------------------------------------------------------------------
 
 def advise(stepbench, study, *args):

@@ -4,15 +4,15 @@
 //
 // Closed form for every damping regime in one expression. With gamma = k_d / (2m),
 // w0^2 = k_s / m, D = gamma^2 - w0^2 and s = sqrt|D|:
-//   x(t) = x0 Phi(t) + (v0 + gamma x0) Psi(t),
+//   x(t) = x0 Phi(t) + (v0 + gamma x0) Psi(t),   v(t) = v0 (Phi - gamma Psi) - w0^2 x0 Psi,
 //   Phi = e^{-gamma t} C(t), Psi = e^{-gamma t} S(t),
 // with (C, S) = (cos st, sin(st)/s) under-damped (D < 0), (1, t) critical (D = 0),
 // (cosh st, sinh(st)/s) over-damped (D > 0). Since C' = D S and S' = C,
 //   Phi' = -gamma Phi + D Psi, Psi' = -gamma Psi + Phi.
 // sin(st)/s tends to t as s -> 0, so near-critical damping loses no accuracy (on the
-// over-damped side through expm1); the over-damped branch is written with e^{(s - gamma) t} and e^{-(s + gamma) t} so that
-// neither cosh nor e^{-gamma t} overflows, with s - gamma = -w0^2 / (s + gamma) free of
-// cancellation.
+// over-damped side through expm1). Away from critical damping the over-damped motion is
+// evaluated as c1 e^{r1 t} + c2 e^{r2 t} with the roots written without cancellation, so
+// heavy damping (gamma >> w0) keeps its digits in v too.
 #include <cmath>
 
 #include <Eigen/Core>
@@ -66,8 +66,9 @@ struct damped_spring {
   double damping_ratio() const { return k_d / (2.0 * std::sqrt(k_s * mass_kg)); }
 
   phase<vec> exact(double t) const {
-    const double g = gamma();
-    const double d = g * g - omega0_sq();
+    const double g = gamma(), w0 = std::sqrt(omega0_sq());
+    const double d = (g - w0) * (g + w0);  // gamma^2 - w0^2 without overflow or cancellation
+    const double b = v0 + g * x0;
     double phi, psi;
     if (d < 0.0) {
       const double s = std::sqrt(-d), decay = std::exp(-g * t);
@@ -78,16 +79,27 @@ struct damped_spring {
       phi = decay;
       psi = decay * t;
     } else {
-      const double s = std::sqrt(d);
-      const double slow = std::exp(-omega0_sq() / (s + g) * t), fast = std::exp(-(s + g) * t);
+      // Roots r1 = -w0^2 / (s + gamma) (slow, written without cancellation) and
+      // r2 = -(s + gamma) (fast).
+      const double s = std::sqrt(d), r1 = -omega0_sq() / (s + g), r2 = -(s + g);
+      const double slow = std::exp(r1 * t), fast = std::exp(r2 * t);
+      if (2.0 * s * t >= 1.0) {
+        // Away from critical damping: x = c1 e^{r1 t} + c2 e^{r2 t}. The Phi/Psi form
+        // below would take v as a difference of terms of size gamma that nearly cancel
+        // when gamma >> w0 (heavy damping).
+        const double c1 = (v0 - r2 * x0) / (2.0 * s), c2 = (r1 * x0 - v0) / (2.0 * s);
+        return {vec(c1 * slow + c2 * fast), vec(r1 * c1 * slow + r2 * c2 * fast)};
+      }
       phi = 0.5 * (slow + fast);
       // slow - fast = fast (e^{2st} - 1): expm1 keeps the digits that the difference
       // would cancel near critical damping (s t small).
-      psi = 2.0 * s * t < 1.0 ? fast * std::expm1(2.0 * s * t) / (2.0 * s) : (slow - fast) / (2.0 * s);
+      psi = fast * std::expm1(2.0 * s * t) / (2.0 * s);
     }
-    const double b = v0 + g * x0;
+    // v = x0 Phi' + b Psi' = x0 (d - gamma^2) Psi + v0 (Phi - gamma Psi), and d - gamma^2
+    // = -w0^2: written so, no terms of size gamma cancel (they would when gamma t is small
+    // and gamma large).
     const double x = x0 * phi + b * psi;
-    const double v = x0 * (-g * phi + d * psi) + b * (-g * psi + phi);
+    const double v = v0 * (phi - g * psi) - omega0_sq() * x0 * psi;
     return {vec(x), vec(v)};
   }
   // Mechanical energy; the damper dissipates it, so it is compared with the exact

@@ -115,6 +115,25 @@ TEST(damped_spring, closed_form_continuous_through_critical) {
   EXPECT_TRUE(std::isfinite(very_over.exact(1000.0).x[0]));
 }
 
+// Heavy damping (gamma = 5e4 >> w0 = 3.16) at small and large t: x and v against the
+// two-exponential form c1 e^{r1 t} + c2 e^{r2 t} evaluated in long double. The velocity is
+// a small difference of terms of size gamma in the textbook form; it must keep its digits.
+TEST(damped_spring, closed_form_keeps_digits_under_heavy_damping) {
+  damped_spring p;
+  p.k_d = 1e5;
+  p.v0 = -0.7;
+  using ld = long double;
+  const ld g = 5e4L, w2 = 10.0L, s = std::sqrt(g * g - w2), r1 = -g + s, r2 = -g - s;
+  const ld c1 = (ld(p.v0) - r2 * p.x0) / (2 * s), c2 = (r1 * p.x0 - ld(p.v0)) / (2 * s);
+  for (double t : {1e-7, 1e-5, 1e-3, 0.3, 5.0}) {
+    const ld x = c1 * std::exp(r1 * t) + c2 * std::exp(r2 * t);
+    const ld v = r1 * c1 * std::exp(r1 * t) + r2 * c2 * std::exp(r2 * t);
+    const auto e = p.exact(t);
+    EXPECT_NEAR(e.x[0], static_cast<double>(x), 1e-13 * std::abs(static_cast<double>(x))) << "t " << t;
+    EXPECT_NEAR(e.v[0], static_cast<double>(v), 1e-11 * std::abs(static_cast<double>(v))) << "t " << t;
+  }
+}
+
 // K(k) for k = sin 60 deg, i.e. m = k^2 = 3/4: 2.156515647499643 (Abramowitz & Stegun
 // table 17.1; scipy.special.ellipk(0.75) gives the same to 16 digits).
 TEST(pendulum, exact_period_from_elliptic_integral) {

@@ -32,7 +32,15 @@ fit_result fit_order(const fit_input& in) {
   bool all_roundoff = n > 0;
   for (int k = 0; k < n; ++k)
     if (in.diverged[k] || !(in.error[k] <= roundoff_bound(in.steps[k], in.scale))) all_roundoff = false;
-  if (all_roundoff) {
+  // The bound grows with n, so on a ladder of huge step counts a converging method can sit
+  // under it too; exact also means the error does not fall as dt does (round-off grows
+  // with the step count, truncation error shrinks).
+  std::vector<double> local;
+  for (int k = 0; k + 1 < n; ++k)
+    if (in.error[k] > 0.0 && in.error[k + 1] > 0.0)
+      local.push_back(std::log(in.error[k] / in.error[k + 1]) / std::log(in.dt[k] / in.dt[k + 1]));
+  const bool converging = !local.empty() && median(local) > 0.5;
+  if (all_roundoff && !converging) {
     out.state = fit_result::status::exact;
     out.note = "error at round-off at every level: the method is exact for this problem";
     return out;

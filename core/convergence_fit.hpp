@@ -12,9 +12,9 @@
 //     local slope log(e_k / e_{k+1}) / log(dt_k / dt_{k+1}) stays within 0.1 of the
 //     median slope of the levels already taken;
 //  3. fits log e = p log dt + c by least squares over those levels (at least 3).
-// When every level's error is within the worst-case round-off bound 8 eps n scale, the
-// method is exact for the problem (RK4 on constant acceleration): no slope is fitted
-// and the order is NaN.
+// When every level's error is within the worst-case round-off bound 8 eps n scale and
+// does not fall with dt, the method is exact for the problem (RK4 on constant
+// acceleration): no slope is fitted and the order is NaN.
 #include <limits>
 #include <string>
 #include <vector>

@@ -73,3 +73,20 @@ TEST(fit, too_few_levels_is_insufficient) {
   EXPECT_EQ(r.state, fit_result::status::insufficient);
   EXPECT_FALSE(r.note.empty());
 }
+
+// On a ladder of a billion steps the round-off bound 8 eps n scale is ~2e-6, above a
+// first-order method's truncation error there; halving errors are convergence, not
+// exactness.
+TEST(fit, converging_errors_under_a_large_bound_are_not_exact) {
+  fit_input in;
+  for (int k = 0; k < 3; ++k) {
+    in.dt.push_back(1e-9 / std::ldexp(1.0, k));
+    in.error.push_back(9e-7 / std::ldexp(1.0, k));
+    in.steps.push_back(1000000000L << k);
+    in.diverged.push_back(false);
+  }
+  ASSERT_LT(in.error[0], roundoff_bound(in.steps[0], 1.0));
+  const auto r = fit_order(in);
+  EXPECT_NE(r.state, fit_result::status::exact);
+  EXPECT_NEAR(r.order, 1.0, 1e-9);
+}

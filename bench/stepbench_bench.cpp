@@ -352,23 +352,24 @@ std::map<std::string, double> ns_per_step_at_common_dt(const problem_study& ps, 
   return {};
 }
 
-// Time to reach `target` final position error, interpolated log-log between the two
-// rows that bracket it (rows as (error, time)); NaN when no row reaches it.
-double time_at_error(std::vector<std::pair<double, double>> rows, double target) {
-  std::erase_if(rows, [](auto& r) { return !std::isfinite(r.first) || !std::isfinite(r.second) || r.first <= 0; });
+// Time to reach `target` error: the cheapest measured row at or below it, or the
+// log-log interpolation between two consecutive rows of the ladder that bracket it,
+// whichever is less; NaN when no row reaches it. Rows are (error, time) in ladder order.
+double time_at_error(const std::vector<std::pair<double, double>>& rows, double target) {
+  auto usable = [](const std::pair<double, double>& r) {
+    return std::isfinite(r.first) && std::isfinite(r.second) && r.first > 0 && r.second > 0;
+  };
   double best = std::numeric_limits<double>::quiet_NaN();
-  for (const auto& [e, t] : rows)
-    if (e <= target && !(t >= best)) best = t;
-  for (size_t i = 0; i < rows.size(); ++i)
-    for (size_t j = 0; j < rows.size(); ++j) {
-      const auto [e1, t1] = rows[i];
-      const auto [e2, t2] = rows[j];
-      if (e1 > target && e2 < target) {
-        const double w = std::log(target / e1) / std::log(e2 / e1);
-        const double t = std::exp(std::log(t1) + w * (std::log(t2) - std::log(t1)));
-        if (!(t >= best)) best = t;
-      }
-    }
+  for (const auto& r : rows)
+    if (usable(r) && r.first <= target && !(r.second >= best)) best = r.second;
+  for (size_t i = 0; i + 1 < rows.size(); ++i) {
+    const auto [e1, t1] = rows[i];
+    const auto [e2, t2] = rows[i + 1];
+    if (!usable(rows[i]) || !usable(rows[i + 1]) || !(e1 > target && e2 < target)) continue;
+    const double w = std::log(target / e1) / std::log(e2 / e1);
+    const double t = std::exp(std::log(t1) + w * (std::log(t2) - std::log(t1)));
+    if (!(t >= best)) best = t;
+  }
   return best;
 }
 
@@ -459,6 +460,8 @@ bench_options take_own_flags(int& argc, char** argv, std::vector<std::string>& e
     const std::string a = argv[i];
     if (a == "--quick") {
       o.quick = true;
+    } else if (a == "--study_out" || a == "--case_budget") {
+      throw std::invalid_argument(a + " takes its value after '=': " + a + "=VALUE");
     } else if (a.rfind("--study_out=", 0) == 0) {
       o.study_out = a.substr(12);
       if (o.study_out.empty()) throw std::invalid_argument("--study_out needs a path");
@@ -473,7 +476,10 @@ bench_options take_own_flags(int& argc, char** argv, std::vector<std::string>& e
       }
       if (a.rfind("--benchmark_repetitions=", 0) == 0) {
         reps_given = true;
-        o.repetitions = static_cast<int>(parse_number(a.substr(24), "--benchmark_repetitions"));
+        const double reps = parse_number(a.substr(24), "--benchmark_repetitions");
+        if (!(reps >= 1 && reps <= 1000 && reps == std::floor(reps)))
+          throw std::invalid_argument("--benchmark_repetitions must be a whole number from 1 to 1000");
+        o.repetitions = static_cast<int>(reps);
       }
       if (a == "--benchmark_list_tests" || a == "--benchmark_list_tests=true") o.list_only = true;
       argv[out++] = argv[i];
@@ -510,6 +516,8 @@ int main(int argc, char** argv) {
   try {
     std::vector<std::string> extra;
     bench_options opts = take_own_flags(argc, argv, extra);
+    // Chosen before Initialize, which removes the --benchmark_* flags from argv.
+    collecting_reporter reporter(display_reporter_for(argc, argv));
     std::vector<char*> args(argv, argv + argc);
     for (auto& e : extra) args.push_back(e.data());
     int n = static_cast<int>(args.size());
@@ -529,11 +537,13 @@ int main(int argc, char** argv) {
         if (P::name == ps.problem->name()) register_problem<P>(ps, opts);
       });
 
-    collecting_reporter reporter(display_reporter_for(n, args.data()));
     benchmark::RunSpecifiedBenchmarks(&reporter);
     benchmark::Shutdown();
     if (opts.list_only) return 0;
 
+    if (!opts.study_out.empty() && book.ns_per_iteration.empty())
+      throw std::runtime_error("no case was timed (does --benchmark_filter match any?); " + opts.study_out +
+                               " was not written");
     merge_timings(s);
     fit_peers(s);
     timing_settings ts;

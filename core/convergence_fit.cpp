@@ -33,13 +33,15 @@ fit_result fit_order(const fit_input& in) {
   for (int k = 0; k < n; ++k)
     if (in.diverged[k] || !(in.error[k] <= roundoff_bound(in.steps[k], in.scale))) all_roundoff = false;
   // The bound grows with n, so on a ladder of huge step counts a converging method can sit
-  // under it too; exact also means the error does not fall as dt does (round-off grows
-  // with the step count, truncation error shrinks).
+  // under it too. Such errors fall as dt does and stand clearly above typical round-off
+  // noise; an exact method's errors are noise (they may fall too, from 1e-17 relative
+  // upwards, as the rounding of O(dt) terms shrinks).
   std::vector<double> local;
   for (int k = 0; k + 1 < n; ++k)
     if (in.error[k] > 0.0 && in.error[k + 1] > 0.0)
       local.push_back(std::log(in.error[k] / in.error[k + 1]) / std::log(in.dt[k] / in.dt[k + 1]));
-  const bool converging = !local.empty() && median(local) > 0.5;
+  const bool converging = !local.empty() && median(local) > 0.5 &&
+                          in.error[0] > 100.0 * roundoff_noise(in.steps[0], in.scale);
   if (all_roundoff && !converging) {
     out.state = fit_result::status::exact;
     out.note = "error at round-off at every level: the method is exact for this problem";

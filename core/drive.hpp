@@ -44,12 +44,12 @@ template <class P>
 struct counted_system {
   const P& problem;
   double inv_mass = 1.0 / problem.mass();
-  long evals = 0;
+  mutable long evals = 0;
   static constexpr bool force_depends_on_velocity = P::force_depends_on_velocity;
   double mass() const { return problem.mass(); }
   double inverse_mass() const { return inv_mass; }
   typename P::vec force(double t, const typename P::vec& x, const typename P::vec& v) const {
-    ++const_cast<long&>(evals);
+    ++evals;
     return problem.force(t, x, v);
   }
 };

@@ -95,6 +95,14 @@ truth_table build_truth(const problem_instance& problem, std::span<const double>
     t.y = t.references[best].solution.y;
   }
   set_scales(problem, t);
+  for (size_t j = 0; j < t.y.size(); ++j)
+    for (double value : t.y[j])
+      if (!std::isfinite(value))
+        throw std::runtime_error(fmt::format("the true solution of problem {} ({}) is not finite at t = {:g}: "
+                                             "are the parameters in range?",
+                                             problem.name(), t.source, t.times[j]));
+  if (!std::isfinite(t.pos_scale) || !std::isfinite(t.vel_scale))
+    throw std::runtime_error(fmt::format("the motion of problem {} overflows: are the parameters in range?", problem.name()));
 
   const double limit = opts.agreement_limit_factor * opts.tol.rtol;
   for (auto& ref : t.references) {

@@ -32,6 +32,15 @@ void validate(const sweep_options& opts) {
     throw std::invalid_argument("base_steps must be a positive multiple of sample_count");
   if (!(opts.tol.rtol > 0.0 && opts.tol.atol > 0.0)) throw std::invalid_argument("reference tolerances must be > 0");
   for (const auto& name : selected(opts.integrators, {})) find_integrator(name);
+  for (const auto* names : {&opts.problems, &opts.integrators})
+    for (size_t i = 0; i < names->size(); ++i)
+      for (size_t j = 0; j < i; ++j)
+        if ((*names)[i] == (*names)[j]) throw std::invalid_argument(fmt::format("'{}' is named twice", (*names)[i]));
+  // A bound on the work: the finest level's steps (run has the same kind of bound).
+  const double finest = static_cast<double>(opts.base_steps) * std::ldexp(1.0, opts.levels - 1);
+  if (finest > 1e8)
+    throw std::invalid_argument(fmt::format(
+        "the ladder's finest level would take {:.3g} steps (base_steps 2^(levels-1)); the limit is 1e8", finest));
   for (const auto& [name, _] : opts.overrides) {
     bool chosen = opts.problems.empty();
     for (const auto& p : opts.problems) chosen = chosen || p == name;

@@ -114,7 +114,7 @@ reference_solution solve_cvode(const ode_system& sys, std::span<const double> ti
   const auto fail = [&](const std::string& call, int flag, flag_kind kind = flag_kind::cv) {
     std::string what = std::string(source) + ": " + call + " failed, flag " + std::to_string(flag) + " (" +
                        flag_name(flag, kind) + ")";
-    if (st.non_finite) what += "; right-hand side returned a non-finite value at t=" + std::to_string(st.non_finite_t);
+    if (st.non_finite) what += "; right-hand side returned a non-finite value at t=" + detail::num(st.non_finite_t);
     if (!st.last_message.empty()) what += "; " + st.last_message;
     throw std::runtime_error(what);
   };
@@ -136,7 +136,7 @@ reference_solution solve_cvode(const ode_system& sys, std::span<const double> ti
   check("CVodeInit", CVodeInit(h.mem, &cvode_rhs, 0.0, h.y));
   check("CVodeSStolerances", CVodeSStolerances(h.mem, tol.rtol, tol.atol));
   check("CVodeSetUserData", CVodeSetUserData(h.mem, &st));
-  check("CVodeSetMaxNumSteps", CVodeSetMaxNumSteps(h.mem, 10'000'000L));
+  check("CVodeSetMaxNumSteps", CVodeSetMaxNumSteps(h.mem, detail::max_steps_per_output));
 
   if (method == cvode_method::bdf) {
     // No Jacobian function is set, so CVLS uses its dense difference-quotient Jacobian,
@@ -166,11 +166,11 @@ reference_solution solve_cvode(const ode_system& sys, std::span<const double> ti
     sunrealtype t = 0.0;
     const int flag = CVode(h.mem, tout, h.y, &t, CV_NORMAL);
     if (st.error) std::rethrow_exception(st.error);
-    if (flag < 0) fail("CVode at t=" + std::to_string(t) + " towards t=" + std::to_string(tout), flag);
+    if (flag < 0) fail("CVode at t=" + detail::num(t) + " towards t=" + detail::num(tout), flag);
     const double* y = N_VGetArrayPointer(h.y);
     for (std::size_t i = 0; i < n; ++i)
       if (!std::isfinite(y[i])) throw std::runtime_error(std::string(source) + ": non-finite state at t=" +
-                                                         std::to_string(tout));
+                                                         detail::num(tout));
     out.y.emplace_back(y, y + n);
   }
 

@@ -1,12 +1,26 @@
 #pragma once
 // Shared by the GSL and CVODE wrappers; not part of the interface (reference.hpp).
+#include <cstdio>
 #include <exception>
+#include <string>
 #include <span>
 #include <string_view>
 
 #include "references/reference.hpp"
 
 namespace stepbench::detail {
+
+// Step budget between two output times, for both solvers: far above what the references
+// need on the scenes here (hundreds of steps in all), low enough that a problem too stiff
+// for the solver fails in seconds with its message instead of running for minutes.
+inline constexpr long max_steps_per_output = 200'000;
+
+// A time or value for an error message: %g, not std::to_string's fixed notation.
+inline std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
 
 // Both solvers are public, so both check their input, not only solve_reference.
 void validate_reference_input(std::string_view source, const ode_system& sys, std::span<const double> times,

@@ -52,21 +52,25 @@ fit_result fit_order(const fit_input& in) {
     return !in.diverged[k] && std::isfinite(in.error[k]) && in.error[k] > 100.0 * roundoff_noise(in.steps[k], in.scale) &&
            in.error[k] < 0.1 * in.scale;
   };
-  int last = n - 1;
-  while (last >= 0 && !usable(last)) --last;
-  if (last < 2 || !usable(last - 1)) {
-    out.note = "fewer than two usable levels (diverged, at round-off or pre-asymptotic)";
-    return out;
-  }
   auto slope = [&](int k) { return std::log(in.error[k] / in.error[k + 1]) / std::log(in.dt[k] / in.dt[k + 1]); };
-  std::vector<double> slopes{slope(last - 1)};
-  int first = last - 1;
-  while (first > 0 && usable(first - 1) && std::abs(slope(first - 1) - median(slopes)) <= 0.1) {
-    --first;
-    slopes.push_back(slope(first));
+  // The window grown coarser from the pair (end - 1, end) while each local slope stays
+  // within 0.1 of the median so far. It starts at the finest usable pair; when that pair
+  // is the odd one out (the first touch of round-off) and leaves fewer than three levels,
+  // the next coarser end is tried.
+  int first = -1, last = -1;
+  for (int end = n - 1; end >= 2 && first < 0; --end) {
+    if (!usable(end) || !usable(end - 1)) continue;
+    std::vector<double> slopes{slope(end - 1)};
+    int start = end - 1;
+    while (start > 0 && usable(start - 1) && std::abs(slope(start - 1) - median(slopes)) <= 0.1) {
+      --start;
+      slopes.push_back(slope(start));
+    }
+    if (end - start + 1 >= 3) first = start, last = end;
   }
-  if (last - first + 1 < 3) {
-    out.note = "fewer than three levels in the asymptotic range";
+  if (first < 0) {
+    out.note = "fewer than three consecutive levels in the asymptotic range (the rest diverged, are at round-off "
+               "or pre-asymptotic)";
     return out;
   }
   // Least squares for log10 e = p log10 dt + c.

@@ -10,7 +10,8 @@
 //     motion's size (10 % of its amplitude);
 //  2. starting from the finest remaining pair, extends towards larger dt while each
 //     local slope log(e_k / e_{k+1}) / log(dt_k / dt_{k+1}) stays within 0.1 of the
-//     median slope of the levels already taken;
+//     median slope of the levels already taken (if that leaves fewer than three levels,
+//     the window ending one level coarser is tried, and so on);
 //  3. fits log e = p log dt + c by least squares over those levels (at least 3).
 // When every level's error is within the worst-case round-off bound 8 eps n scale and
 // does not fall with dt, the method is exact for the problem (RK4 on constant

@@ -90,3 +90,15 @@ TEST(fit, converging_errors_under_a_large_bound_are_not_exact) {
   EXPECT_NE(r.state, fit_result::status::exact);
   EXPECT_NEAR(r.order, 1.0, 1e-9);
 }
+
+// The finest usable pair is the first touch of round-off (its slope is off by 0.5): the
+// window that starts there has only two levels, so the fit moves one level coarser and
+// still finds the clean order-4 range.
+TEST(fit, an_odd_finest_pair_does_not_hide_the_asymptotic_range) {
+  auto in = ladder(8, [](double dt) { return 1e-1 * std::pow(dt, 4); });
+  in.error[7] = in.error[6] / std::pow(2.0, 3.5);  // slope 3.5 at the fine end
+  const auto r = fit_order(in);
+  ASSERT_EQ(r.state, fit_result::status::fitted) << r.note;
+  EXPECT_NEAR(r.order, 4.0, 1e-9);
+  EXPECT_EQ(r.levels.back(), 6);
+}

@@ -65,6 +65,35 @@ inline bool finite(std::span<const double> y) {
   return true;
 }
 
+// The fixed-step loop every stepping peer shares with ours: steps of exactly dt but a
+// shortened last one, t = i dt, and the state recorded after each step in `record`.
+// `step(t, h)` advances the peer's state; `state()` returns it as [x; v] (an iterable of
+// 2 dim values). A non-finite recorded state stops the run.
+template <class Step, class State>
+void drive_fixed(peer_run& out, double dt, double horizon, std::span<const long> record, Step&& step, State&& state) {
+  const long steps = steps_for(horizon, dt);
+  auto next = record.begin();
+  double t = 0.0;
+  long i = 0;
+  while (i < steps) {
+    step(t, i + 1 == steps ? horizon - t : dt);
+    t = time_after_step(++i, steps, dt, horizon);
+    if (next != record.end() && *next == i) {
+      ++next;
+      const auto y = state();
+      if (!finite(y)) {
+        out.non_finite = true;
+        break;
+      }
+      out.record(y.begin(), y.end());
+    }
+  }
+  out.steps = i;
+  const auto y = state();
+  out.final_y.assign(y.begin(), y.end());
+  out.non_finite = out.non_finite || !finite(y);
+}
+
 // ---- GSL fixed-step: gsl_odeiv2_step_apply at our dt -------------------------------
 // As the GSL manual recommends for a fixed-step loop: dydt_out of one step is passed as
 // dydt_in of the next, so no stage is computed twice. GSL's rk4 still estimates its
@@ -105,29 +134,16 @@ peer_run gsl_fixed(const P& p, const gsl_odeiv2_step_type* type, double dt, doub
 
   peer_run out;
   out.start(n, record.size());
-  const long steps = steps_for(horizon, dt);
-  auto next = record.begin();
-  double t = 0.0;
-  for (long i = 0; i < steps; ++i) {
-    const double h = i + 1 == steps ? horizon - t : dt;
-    const int status = gsl_odeiv2_step_apply(step.get(), t, h, y.data(), yerr.data(), dydt_in.data(),
-                                             dydt_out.data(), &sys);
-    if (status != GSL_SUCCESS) throw std::runtime_error(std::string("gsl_odeiv2_step_apply: ") + gsl_strerror(status));
-    dydt_in = dydt_out;
-    t = time_after_step(i + 1, steps, dt, horizon);
-    out.steps = i + 1;
-    if (next != record.end() && *next == i + 1) {
-      ++next;
-      if (!finite(y)) {
-        out.non_finite = true;
-        break;
-      }
-      out.record(y.begin(), y.end());
-    }
-  }
-  out.non_finite = out.non_finite || !finite(y);
+  drive_fixed(
+      out, dt, horizon, record,
+      [&](double t, double h) {
+        const int status = gsl_odeiv2_step_apply(step.get(), t, h, y.data(), yerr.data(), dydt_in.data(),
+                                                 dydt_out.data(), &sys);
+        if (status != GSL_SUCCESS) throw std::runtime_error(std::string("gsl_odeiv2_step_apply: ") + gsl_strerror(status));
+        dydt_in = dydt_out;
+      },
+      [&] { return y; });
   out.force_evals = ctx.calls;
-  out.final_y.assign(y.begin(), y.end());
   return out;
 }
 
@@ -203,21 +219,9 @@ peer_run odeint_rk4(const P& p, double dt, double horizon, std::span<const long>
   for (int i = 0; i < P::dim; ++i) y[i] = s0.x[i], y[P::dim + i] = s0.v[i];
   peer_run out;
   out.start(2 * P::dim, record.size());
-  const long steps = steps_for(horizon, dt);
-  auto next = record.begin();
-  double t = 0.0;
-  for (long i = 0; i < steps; ++i) {
-    stepper.do_step(system, y, t, i + 1 == steps ? horizon - t : dt);
-    t = time_after_step(i + 1, steps, dt, horizon);
-    if (next != record.end() && *next == i + 1) {
-      ++next;
-      out.record(y.begin(), y.end());
-    }
-  }
-  out.steps = steps;
+  drive_fixed(
+      out, dt, horizon, record, [&](double t, double h) { stepper.do_step(system, y, t, h); }, [&] { return y; });
   out.force_evals = calls;
-  out.non_finite = !finite(y);
-  out.final_y.assign(y.begin(), y.end());
   return out;
 }
 
@@ -242,23 +246,16 @@ peer_run odeint_velocity_verlet(const P& p, double dt, double horizon, std::span
   for (int i = 0; i < P::dim; ++i) x[i] = s0.x[i], v[i] = s0.v[i];
   peer_run out;
   out.start(2 * P::dim, record.size());
-  const long steps = steps_for(horizon, dt);
-  auto next = record.begin();
-  double t = 0.0;
-  for (long i = 0; i < steps; ++i) {
-    stepper.do_step(accel, std::make_pair(std::ref(x), std::ref(v)), t, i + 1 == steps ? horizon - t : dt);
-    t = time_after_step(i + 1, steps, dt, horizon);
-    if (next != record.end() && *next == i + 1) {
-      ++next;
-      out.record(x.begin(), x.end());
-      out.record(v.begin(), v.end());
-    }
-  }
-  out.steps = steps;
+  drive_fixed(
+      out, dt, horizon, record,
+      [&](double t, double h) { stepper.do_step(accel, std::make_pair(std::ref(x), std::ref(v)), t, h); },
+      [&] {
+        std::array<double, 2 * P::dim> y;
+        std::copy(x.begin(), x.end(), y.begin());
+        std::copy(v.begin(), v.end(), y.begin() + P::dim);
+        return y;
+      });
   out.force_evals = calls;
-  out.final_y.assign(x.begin(), x.end());
-  out.final_y.insert(out.final_y.end(), v.begin(), v.end());
-  out.non_finite = !finite(out.final_y);
   return out;
 }
 

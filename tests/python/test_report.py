@@ -340,6 +340,24 @@ def test_bad_study_file_leaves_the_old_report(tmp_path):
     assert sorted(os.listdir(tmp_path)) == ["garbage.h5", "report"]  # no temporary folder left
 
 
+def test_a_peer_that_misdeclares_its_order_is_flagged(studies, tmp_path):
+    """The fixture's gsl_rk4 declares 4 and achieves 3.99: "yes". Made to declare 1 (as
+    Boost's velocity_verlet does for a second-order method), the report says so."""
+    study, folder = studies["timed"]
+    md = (folder / "REPORT.md").read_text()
+    assert re.search(r"\| gsl_rk4 \| 4 \| 3\.988 \|.*\| yes \|", md), md
+    wrong = tmp_path / "wrong.h5"
+    shutil.copy(study, wrong)
+    with h5py.File(wrong, "r+") as f:
+        for p in f:
+            if isinstance(f[p], h5py.Group) and "gsl_rk4" in f[p]:
+                f[p]["gsl_rk4"].attrs["declared_order"] = 1.0
+    out = tmp_path / "report"
+    p = subprocess.run([PYTHON, REPORT, str(wrong), "--out", str(out)], capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    assert "NO: declares 1, achieves 3.99" in (out / "REPORT.md").read_text()
+
+
 def test_never_replaces_a_folder_it_did_not_write(studies, tmp_path):
     """--out naming a folder with other files in it (results/, the working directory)
     is refused, and nothing in it is touched; a report folder it wrote is replaced."""

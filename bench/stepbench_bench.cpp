@@ -8,6 +8,7 @@
 //   --study_out=PATH     run the accuracy sweep too and write the study file with each
 //                        timing next to its accuracy row
 //   --case_budget=S      cut a family's finer cases once one iteration would exceed S s
+//   --set=P.NAME=VALUE   a problem parameter, as `stepbench sweep --set` (repeatable)
 // After the run it prints the performance ratios (docs in README).
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
@@ -43,6 +44,7 @@ struct bench_options {
   double min_time_s = 0.025;
   int repetitions = 3;
   bool list_only = false;
+  std::map<std::string, std::map<std::string, double>> overrides;  // problem -> parameter -> value
 };
 
 std::string dt_label(double dt) { return fmt::format("dt:{:.6g}", dt); }
@@ -182,7 +184,15 @@ peers::peer_run from_solution(const reference_solution& s) {
 // is captured by value.
 template <problem P>
 void register_problem(problem_study& ps, const bench_options& opts) {
-  const P p{};  // default parameters, as the sweep used
+  // The parameters the sweep used (checked there): defaults plus --set.
+  const P p = [&] {
+    P q{};
+    if (auto it = opts.overrides.find(std::string(P::name)); it != opts.overrides.end())
+      for (const auto& [name, value] : it->second)
+        for (const auto& param : P::parameters())
+          if (param.name == name) q.*param.member = value;
+    return q;
+  }();
   const double horizon = ps.horizon;
   const int samples = static_cast<int>(ps.truth.times.size());
   const std::string pname(P::name);
@@ -460,7 +470,13 @@ bench_options take_own_flags(int& argc, char** argv, std::vector<std::string>& e
     const std::string a = argv[i];
     if (a == "--quick") {
       o.quick = true;
-    } else if (a == "--study_out" || a == "--case_budget") {
+    } else if (a.rfind("--set=", 0) == 0) {
+      const auto [name, value] = parse_assignment(a.substr(6));
+      const auto dot = name.find('.');
+      if (dot == std::string::npos || dot == 0 || dot + 1 == name.size())
+        throw std::invalid_argument("--set=" + a.substr(6) + ": name the problem, --set=problem.name=value");
+      o.overrides[name.substr(0, dot)][name.substr(dot + 1)] = value;
+    } else if (a == "--study_out" || a == "--case_budget" || a == "--set") {
       throw std::invalid_argument(a + " takes its value after '=': " + a + "=VALUE");
     } else if (a.rfind("--study_out=", 0) == 0) {
       o.study_out = a.substr(12);
@@ -530,6 +546,13 @@ int main(int argc, char** argv) {
     // The accuracy sweep first: it gives each case its counters and the study its rows.
     sweep_options sopts;
     if (opts.quick) sopts.levels = 8;
+    sopts.overrides = opts.overrides;
+    for (const auto& [problem, params] : opts.overrides) {
+      const auto known = problem_names();
+      if (std::find(known.begin(), known.end(), problem) == known.end()) make_problem(problem);  // throws, naming it
+      auto instance = make_problem(problem);
+      for (const auto& [name, value] : params) instance->set(name, value);  // throws for an unknown parameter
+    }
     const auto start = std::chrono::steady_clock::now();
     study s = run_sweep(sopts);
     for (auto& ps : s.problems)

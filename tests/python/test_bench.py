@@ -157,3 +157,23 @@ def test_two_json_outputs_compare_with_google_benchmarks_compare_py(bench, tmp_p
     assert done.returncode == 0, done.stderr
     rows = [line for line in done.stdout.splitlines() if "damped_spring/" in line]
     assert len(rows) == 16  # 8 quick levels x 2 methods, each compared old against new
+
+
+def test_set_reaches_the_timed_cases_and_the_study(bench, stepbench, tmp_path):
+    """--set changes the scene for the sweep and for the timed loop alike: the study
+    records the parameter, and a timed case's counters equal `stepbench run --set`."""
+    path, out = tmp_path / "set.h5", tmp_path / "set.json"
+    subprocess.run([bench, "--quick", "--set=damped_spring.k_d=3", "--benchmark_filter=^damped_spring/rk4/dt:0.0390625$",
+                    f"--benchmark_out={out}", "--benchmark_out_format=json", f"--study_out={path}"],
+                   check=True, capture_output=True)
+    with h5py.File(path, "r") as f:
+        assert f["damped_spring"].attrs["k_d"] == 3.0
+    case = [b for b in json.loads(out.read_text())["benchmarks"] if b["run_type"] == "iteration"][0]
+    run = json.loads(subprocess.run([stepbench, "run", "--problem", "damped_spring", "--integrator", "rk4",
+                                     "--dt", "0.0390625", "--set", "k_d=3", "--json"], check=True,
+                                    capture_output=True, text=True).stdout)
+    assert case["err_pos_max"] == pytest.approx(run["err_pos_max"], rel=1e-12)
+    default = json.loads(subprocess.run([stepbench, "run", "--problem", "damped_spring", "--integrator", "rk4",
+                                         "--dt", "0.0390625", "--json"], check=True, capture_output=True,
+                                        text=True).stdout)
+    assert case["err_pos_max"] != pytest.approx(default["err_pos_max"], rel=1e-3)

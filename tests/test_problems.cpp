@@ -150,6 +150,19 @@ TEST(pendulum, exact_period_from_elliptic_integral) {
   EXPECT_NEAR(std::abs(p.exact(p.period() / 4).v[0]), std::sqrt(2 * 9.8 * (1 - std::cos(p.theta0()))), 1e-12);
 }
 
+// Near the top, K grows like ln(4 / k') and k = sin(theta0/2) -> 1 loses the digits that
+// matter; the AGM on k' = cos(theta0/2) keeps them. Values from mpmath.ellipk at 40 digits
+// for the binary doubles 179.0 and 179.9999 (not the decimal 179.9999, which differs by
+// 1e-10 relative in k' this close to the top), g = 9.8.
+TEST(pendulum, period_near_the_top) {
+  pendulum p;
+  p.theta0_deg = 179.0;
+  EXPECT_NEAR(p.quarter_period_k(), 6.127778824526720, 1e-13);
+  p.theta0_deg = 179.9999;
+  EXPECT_NEAR(p.quarter_period_k(), 15.33800887866649, 1e-12);
+  EXPECT_NEAR(p.period(), 19.59818885268205, 1e-12);
+}
+
 TEST(pendulum, closed_form_satisfies_ode_and_conserves_energy) {
   const pendulum p;
   const auto s0 = p.initial();

@@ -32,6 +32,8 @@ def main(argv=None, start=None):
     if not args.out.strip():
         print("report: error: --out must name a folder", file=sys.stderr)
         return 1
+    for gap in s.gaps:
+        print(f"report: warning: incomplete study file: {gap}", file=sys.stderr)
     out = os.path.abspath(args.out)
     parent = os.path.dirname(out)
     # Only a folder this script wrote (it carries MARKER) or an empty one is ever replaced:

@@ -112,6 +112,8 @@ def document(study, figs):
     doc.h(2, "Study")
     rows = [["study file", study.path]] + [[k, _value(a[k])] for k in META_KEYS if k in a]
     doc.table(["field", "value"], rows)
+    for gap in study.gaps:
+        doc.note(f"Incomplete study file: {gap}. The tables below rank only what the file holds.")
     bench = [[k, _value(a[k])] for k in BENCH_KEYS if k in a]
     if study.timings and bench:
         doc.table(["benchmark setting", "value"], bench, caption="Timing run (Google Benchmark):")

@@ -113,6 +113,7 @@ class Study:
     attrs: dict
     problems: list
     optional: dict  # hook name -> {"title", "attrs", "datasets"}; see OPTIONAL_SECTIONS
+    gaps: list = field(default_factory=list)  # what a complete study would have and this one lacks
 
     @property
     def timings(self):
@@ -173,4 +174,19 @@ def load(path):
             problems.append(p)
         if not problems:
             raise StudyError(f"cannot read study file '{path}': it holds no problem with integrators")
-        return Study(path=str(path), attrs=_attrs(f), problems=problems, optional=optional)
+        return Study(path=str(path), attrs=_attrs(f), problems=problems, optional=optional, gaps=_gaps(problems))
+
+
+def _gaps(problems):
+    """A study written by stepbench has every integrator (and, when timed, every peer) on
+    every problem and the references of each; a file with less was cut down or damaged,
+    and the report says so rather than ranking what is left as if it were everything."""
+    gaps = []
+    integrators = set().union(*({m.name for m in p.integrators} for p in problems))
+    for p in problems:
+        missing = sorted(integrators - {m.name for m in p.integrators})
+        if missing:
+            gaps.append(f"{p.name}: no convergence data for {', '.join(missing)}")
+        if not p.references:
+            gaps.append(f"{p.name}: no reference solutions")
+    return gaps

@@ -358,6 +358,25 @@ def test_a_peer_that_misdeclares_its_order_is_flagged(studies, tmp_path):
     assert "NO: declares 1, achieves 3.99" in (out / "REPORT.md").read_text()
 
 
+def test_an_incomplete_study_is_reported_as_such(studies, tmp_path):
+    study, _ = studies["plain"]
+    cut = tmp_path / "cut.h5"
+    shutil.copy(study, cut)
+    with h5py.File(cut, "r+") as f:
+        del f["pendulum/rk4"]
+        del f["damped_spring/reference"]
+    out = tmp_path / "report"
+    p = subprocess.run([PYTHON, REPORT, str(cut), "--out", str(out)], capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    assert "warning: incomplete study file: pendulum: no convergence data for rk4" in p.stderr
+    assert "warning: incomplete study file: damped_spring: no reference solutions" in p.stderr
+    md = (out / "REPORT.md").read_text()
+    assert "Incomplete study file: pendulum: no convergence data for rk4" in md
+    clean = subprocess.run([PYTHON, REPORT, str(study), "--out", str(tmp_path / "clean")], capture_output=True,
+                           text=True)
+    assert "warning" not in clean.stderr
+
+
 def test_never_replaces_a_folder_it_did_not_write(studies, tmp_path):
     """--out naming a folder with other files in it (results/, the working directory)
     is refused, and nothing in it is touched; a report folder it wrote is replaced."""

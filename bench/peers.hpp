@@ -48,16 +48,6 @@ struct peer_run {
   }
 };
 
-// y' = [v; F / m] for the first-order peers, with the same arithmetic as our loop (the
-// force model, times 1 / m computed once per run).
-template <problem P>
-inline void first_order_rhs(const P& p, double inv_mass, double t, const double* y, double* dydt) {
-  using vec = typename P::vec;
-  vec x(P::dim), v(P::dim);
-  for (int i = 0; i < P::dim; ++i) x[i] = y[i], v[i] = y[P::dim + i];
-  const vec a = p.force(t, x, v) * inv_mass;
-  for (int i = 0; i < P::dim; ++i) dydt[i] = v[i], dydt[P::dim + i] = a[i];
-}
 
 inline bool finite(std::span<const double> y) {
   for (double v : y)

@@ -39,6 +39,17 @@ inline std::vector<long> sample_steps(double horizon, double dt, int sample_coun
   return out;
 }
 
+// y' = [v; F / m] for first-order solvers (the references, the first-order peers), with
+// the same arithmetic as the step loop: the force model times 1 / m computed once.
+template <problem P>
+inline void first_order_rhs(const P& p, double inv_mass, double t, const double* y, double* dydt) {
+  using vec = typename P::vec;
+  vec x(P::dim), v(P::dim);
+  for (int i = 0; i < P::dim; ++i) x[i] = y[i], v[i] = y[P::dim + i];
+  const vec a = p.force(t, x, v) * inv_mass;
+  for (int i = 0; i < P::dim; ++i) dydt[i] = v[i], dydt[P::dim + i] = a[i];
+}
+
 // Counts force evaluations; the integrators see it as the problem.
 template <class P>
 struct counted_system {

@@ -153,7 +153,6 @@ int cmd_sweep(sweep_args a) {
     } else {
       throw usage_error(fmt::format("--set {}: name the problem (problem.{}=value) or select one --problem", s, name));
     }
-    make_problem(problem)->set(name, value);  // names an unknown problem or parameter now, not after the sweep
     a.opts.overrides[problem][name] = value;
   }
   validate(a.opts);

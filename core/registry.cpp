@@ -81,17 +81,8 @@ class problem_model final : public problem_instance {
     ode_system sys;
     sys.n = 2 * P::dim;
     sys.y0 = initial();
-    sys.rhs = [p = p_](double t, std::span<const double> y, std::span<double> dydt) {
-      vec x(P::dim), v(P::dim);
-      for (int i = 0; i < P::dim; ++i) {
-        x[i] = y[i];
-        v[i] = y[P::dim + i];
-      }
-      const vec a = p.force(t, x, v) / p.mass();
-      for (int i = 0; i < P::dim; ++i) {
-        dydt[i] = v[i];
-        dydt[P::dim + i] = a[i];
-      }
+    sys.rhs = [p = p_, inv_mass = 1.0 / p_.mass()](double t, std::span<const double> y, std::span<double> dydt) {
+      first_order_rhs(p, inv_mass, t, y.data(), dydt.data());
     };
     return sys;
   }

@@ -41,7 +41,9 @@ void validate(const sweep_options& opts) {
   if (finest > 1e8)
     throw std::invalid_argument(fmt::format(
         "the ladder's finest level would take {:.3g} steps (base_steps 2^(levels-1)); the limit is 1e8", finest));
-  for (const auto& [name, _] : opts.overrides) {
+  for (const auto& [name, params] : opts.overrides) {
+    auto problem = make_problem(name);  // throws, naming an unknown problem
+    for (const auto& [param, value] : params) problem->set(param, value);  // throws for an unknown parameter
     bool chosen = opts.problems.empty();
     for (const auto& p : opts.problems) chosen = chosen || p == name;
     if (!chosen) throw std::invalid_argument(fmt::format("--set names problem {}, which is not in the sweep", name));

@@ -1,12 +1,20 @@
 #pragma once
 // What a problem and an integrator are. These are compile-time contracts: the step
 // loop is instantiated per (problem, integrator) pair and inlines the force model.
-// Type erasure happens only in core/registry.hpp.
+// Type erasure happens only in the registry (study/registry.cpp), outside every loop.
+//
+// The integrator categories follow Boost.Odeint's: a stepper advances by a given dt;
+// an adaptive stepper tries a step, estimates its error and proposes the next dt (and
+// may interpolate inside the step it took: dense output). What a method needs or offers
+// beyond that (a Jacobian, symplecticity, reuse of the last force) is declared in its
+// `capabilities`, which the registry and the study file report.
 #include <array>
 #include <cmath>
 #include <concepts>
 #include <string>
 #include <string_view>
+
+#include <Eigen/Core>
 
 namespace stepbench {
 
@@ -22,7 +30,7 @@ struct param {
 // The state an integrator advances. `f` caches the force at (t, x, v) when `f_current`
 // is true, so a method whose last stage lands on the new state (velocity Verlet with a
 // velocity-independent force) pays one force evaluation per step, not two. Anything
-// that changes x or v from outside the integrator (an event, a reset) must clear
+// that changes x or v from outside the integrator (a contact, a reset) must clear
 // `f_current`.
 template <class Vec>
 struct step_state {
@@ -40,17 +48,20 @@ struct phase {
 };
 
 // A problem: the forces of one scene and nothing else (no general physics engine).
-// The integrators see F(t, x, v) and m, as in the lecture.
+// The integrators see F(t, x, v) and a scalar mass m, as in the lecture. `vec` is an
+// Eigen column vector, fixed-size (the step inlines to scalar code) or Eigen::VectorXd
+// for scenes sized at run time (`dim()` then reads a parameter). `force` writes into
+// `f`, which has dim() entries: it must not allocate, so that no step does.
 template <class P>
-concept problem = requires(const P& p, double t, const typename P::vec& x) {
+concept problem = requires(const P& p, double t, const typename P::vec& x, typename P::vec& f) {
   { P::name } -> std::convertible_to<std::string_view>;
   { P::description } -> std::convertible_to<std::string_view>;
-  { P::dim } -> std::convertible_to<int>;
   { P::position_unit } -> std::convertible_to<std::string_view>;  // "m", or "rad" for an angle
   { P::force_depends_on_velocity } -> std::convertible_to<bool>;
   { P::parameters() };
+  { p.dim() } -> std::convertible_to<int>;
   { p.mass() } -> std::convertible_to<double>;
-  { p.force(t, x, x) } -> std::convertible_to<typename P::vec>;
+  { p.force(t, x, x, f) };
   { p.initial() } -> std::same_as<phase<typename P::vec>>;
   { p.horizon() } -> std::convertible_to<double>;
   { p.validate() } -> std::convertible_to<std::string>;  // empty when the parameters are valid
@@ -66,13 +77,119 @@ concept has_energy = requires(const P& p, const typename P::vec& x) {
   { p.energy(x, x) } -> std::convertible_to<double>;
 };
 
-// A fixed-step integrator: a small value type with its name, its order and one step.
+// A problem may give the force Jacobians dF/dx and dF/dv itself (in a matrix type of
+// its choosing: dense for a few coordinates, banded for a chain); otherwise the
+// implicit methods get forward differences, whose force evaluations are counted.
+template <class P>
+concept has_jacobian = requires(const P& p, double t, const typename P::vec& x, typename P::jacobian_matrix& j) {
+  { p.jacobian(t, x, x, j, j) };
+  { p.make_jacobian() } -> std::same_as<typename P::jacobian_matrix>;  // zeroed, of the right shape
+};
+
+// What a method needs and offers, beyond advancing the state. Reported by `stepbench
+// list` and recorded in the study file.
+struct capabilities {
+  bool symplectic = false;          // preserves the symplectic form (bounded energy error on oscillators)
+  bool reuses_last_force = false;   // the last stage's force is the next step's first (FSAL)
+  bool needs_jacobian = false;      // solves with dF/dx, dF/dv (implicit methods)
+  bool error_estimate = false;      // estimates its local error (adaptive methods)
+  bool dense_output = false;        // interpolates inside its last step
+};
+
+// The work an integrator reports beyond force evaluations (implicit and adaptive
+// methods), counted by the system it steps (core/system.hpp).
+struct work_counters {
+  long force_evals = 0;
+  long jacobian_evals = 0;
+  long newton_iterations = 0;
+  long linear_solves = 0;
+};
+
+namespace detail {
+// A stand-in system, only to check in the concepts below that a step compiles.
+struct probe_system {
+  using vec = Eigen::Matrix<double, 1, 1>;
+  static constexpr bool force_depends_on_velocity = true;
+  int dim() const;
+  double mass() const;
+  double inverse_mass() const;
+  void force(double, const vec&, const vec&, vec&) const;
+};
+}  // namespace detail
+
+// Sizes workspace vectors like the state, once per run (a no-op for fixed-size
+// vectors), so that no step allocates.
+template <class Vec, class... More>
+inline void size_like(const Vec& like, Vec& first, More&... more) {
+  if constexpr (Vec::RowsAtCompileTime == Eigen::Dynamic) {
+    first.resize(like.size());
+    (more.resize(like.size()), ...);
+  }
+}
+
+// A method that needs scratch space (stage vectors, a Jacobian, a controller's memory)
+// declares `template <class Vec> struct stepper`, constructed from the method and sized
+// once per run by `resize(like)`; it holds the space as members and has the step, as
+// Odeint's steppers keep theirs, sized once by their resizer. A method without scratch
+// space has the step itself.
+template <class I, class Vec>
+concept has_stepper = requires { typename I::template stepper<Vec>; };
+
+// The object that steps states of type Vec for `method`, sized like `like`.
+template <class Vec, class I>
+inline auto make_stepper(const I& method, const Vec& like) {
+  if constexpr (has_stepper<I, Vec>) {
+    typename I::template stepper<Vec> s(method);
+    s.resize(like);
+    return s;
+  } else {
+    (void)like;
+    return method;
+  }
+}
+
+// A fixed-step integrator (Odeint's "stepper"): a small value type with its name, its
+// order, its capabilities and one step of a given dt.
 template <class I>
-concept integrator = requires {
+concept integrator = requires(const I& i, const detail::probe_system& sys, step_state<detail::probe_system::vec>& s) {
   { I::name } -> std::convertible_to<std::string_view>;
   { I::order } -> std::convertible_to<int>;
   { I::description } -> std::convertible_to<std::string_view>;
+  { I::traits } -> std::convertible_to<capabilities>;
+  { make_stepper(i, s.x).step(sys, 0.0, s, 0.1) };
 };
+
+// The outcome of one attempt of an adaptive step.
+struct step_attempt {
+  bool accepted = false;
+  double dt_taken = 0.0;  // the dt of an accepted step
+  double dt_next = 0.0;   // the controller's proposal for the next attempt
+};
+
+// An adaptive integrator (Odeint's "controlled stepper"): constructed with a tolerance,
+// it tries a step of at most dt, accepts or rejects it by its error estimate, and
+// proposes the next dt. On rejection the state is unchanged. `initial_dt` proposes the
+// first step of a run.
+template <class I>
+concept adaptive_integrator =
+    requires(const I& i, const detail::probe_system& sys, step_state<detail::probe_system::vec>& s) {
+      { I::name } -> std::convertible_to<std::string_view>;
+      { I::order } -> std::convertible_to<int>;
+      { I::description } -> std::convertible_to<std::string_view>;
+      { I::traits } -> std::convertible_to<capabilities>;
+      { I(1e-6) };
+      { make_stepper(i, s.x).initial_dt(sys, 0.0, s, 1.0) } -> std::convertible_to<double>;
+      { make_stepper(i, s.x).try_step(sys, 0.0, s, 0.1) } -> std::same_as<step_attempt>;
+    };
+
+// An adaptive integrator that interpolates inside its last accepted step (Odeint's
+// "dense-output stepper"): the drive loop records the sample times from the
+// interpolant instead of shortening steps to land on them.
+template <class I>
+concept dense_output_integrator =
+    adaptive_integrator<I> && requires(const I& i, detail::probe_system::vec& x) {
+      { make_stepper(i, x).interpolate(0.5, x, x) };
+    };
 
 // 1 / m. The integrators work with the force and fold 1 / m into their step
 // coefficients (v += (h / m) F, the momentum form's own idea): one multiplication less
@@ -91,7 +208,7 @@ inline double inverse_mass(const Sys& sys) {
 template <class Sys, class Vec>
 inline const Vec& current_force(const Sys& sys, double t, step_state<Vec>& s) {
   if (!s.f_current) {
-    s.f = sys.force(t, s.x, s.v);
+    sys.force(t, s.x, s.v, s.f);
     s.f_current = true;
   }
   return s.f;

@@ -1,5 +1,7 @@
 #include "core/convergence_fit.hpp"
 
+#include "core/statistics.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -14,15 +16,10 @@ double roundoff_noise(long steps, double scale) {
   return std::numeric_limits<double>::epsilon() * std::sqrt(static_cast<double>(std::max(1L, steps))) * scale;
 }
 
-namespace {
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+int declared_order_holds(double declared, const fit_result& fit) {
+  if (!std::isfinite(declared) || fit.state != fit_result::status::fitted) return -1;
+  return std::abs(fit.order - declared) <= declared_order_slack ? 1 : 0;
 }
-
-}  // namespace
 
 fit_result fit_order(const fit_input& in) {
   fit_result out;

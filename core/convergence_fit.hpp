@@ -55,4 +55,11 @@ double roundoff_noise(long steps, double scale);
 
 fit_result fit_order(const fit_input& in);
 
+// Whether a method achieves the order it declares: 1 when the fitted order is within
+// declared_order_slack of it, 0 when not (GSL's rk2 declares 2 and achieves 3; Boost's
+// velocity_verlet declares 1 and achieves 2), -1 when it cannot be said (no declared
+// order, or no fitted one). Recorded in the study file; every reader shows this value.
+inline constexpr double declared_order_slack = 0.5;
+int declared_order_holds(double declared, const fit_result& fit);
+
 }  // namespace stepbench

@@ -1,13 +1,24 @@
 #pragma once
-// The fixed-step loop: advances a problem from t = 0 to the horizon with one
-// integrator, counting force evaluations and recording the state at chosen steps.
-// Instantiated per (problem, integrator); everything inside the loop inlines.
+// The drive loops: advance a problem from t = 0 to the horizon with one integrator,
+// counting the work and recording the state at chosen times. Instantiated per
+// (problem, integrator); everything inside a loop inlines.
+//
+// Every loop runs the same named stages per step, as Box2D names its solver stages:
+//   advance     the integrator's step (or an adaptive attempt, repeated until accepted)
+//   after_step  the problem's hook, where a contact would be resolved; it clears the
+//               cached force when it changes the state
+//   record      the state at a requested time: reached by the step (fixed grid), by
+//               shortening a step to land on it, or from the method's dense output
 #include <algorithm>
 #include <cmath>
 #include <span>
+#include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "core/concepts.hpp"
+#include "core/system.hpp"
 
 namespace stepbench {
 
@@ -19,108 +30,234 @@ inline long steps_for(double horizon, double dt) {
   return std::max(1L, static_cast<long>(std::ceil(horizon / dt * (1.0 - 1e-12))));
 }
 
-// Time after step i of n (i = n is exactly the horizon).
+// Time after step i of n on the grid (i = n is exactly the horizon). t is i dt, not a
+// running sum, so it carries no accumulated rounding.
 inline double time_after_step(long i, long n, double dt, double horizon) {
   return i == n ? horizon : static_cast<double>(i) * dt;
 }
 
-// The steps at which a run is measured: the steps nearest to the fixed fractions
-// j / sample_count of the horizon, j = 1..sample_count (fewer when the run has fewer
-// steps). On the sweep's ladder every level has a multiple of sample_count steps, so
-// these are the same times t_j = j T / sample_count at every level.
-inline std::vector<long> sample_steps(double horizon, double dt, int sample_count) {
-  const long n = steps_for(horizon, dt);
-  std::vector<long> out;
-  for (int j = 1; j <= sample_count; ++j) {
-    const double t = horizon * j / sample_count;
-    long i = j == sample_count ? n : std::clamp(std::lround(t / dt), 1L, n);
-    if (out.empty() || i > out.back()) out.push_back(i);
-  }
-  return out;
-}
-
-// y' = [v; F / m] for first-order solvers (the references, the first-order peers), with
-// the same arithmetic as the step loop: the force model times 1 / m computed once.
-template <problem P>
-inline void first_order_rhs(const P& p, double inv_mass, double t, const double* y, double* dydt) {
-  using vec = typename P::vec;
-  vec x(P::dim), v(P::dim);
-  for (int i = 0; i < P::dim; ++i) x[i] = y[i], v[i] = y[P::dim + i];
-  const vec a = p.force(t, x, v) * inv_mass;
-  for (int i = 0; i < P::dim; ++i) dydt[i] = v[i], dydt[P::dim + i] = a[i];
-}
-
-// Counts force evaluations; the integrators see it as the problem.
-template <class P>
-struct counted_system {
-  const P& problem;
-  double inv_mass = 1.0 / problem.mass();
-  mutable long evals = 0;
-  static constexpr bool force_depends_on_velocity = P::force_depends_on_velocity;
-  double mass() const { return problem.mass(); }
-  double inverse_mass() const { return inv_mass; }
-  typename P::vec force(double t, const typename P::vec& x, const typename P::vec& v) const {
-    ++evals;
-    return problem.force(t, x, v);
-  }
+// Where a fixed-step run records. A time on the grid (within 1e-9 dt of i dt, or the
+// horizon) is reached by step `step`; a time off the grid lies inside step `step`,
+// which the loop splits to land on it (as it shortens the last step for the horizon).
+struct record_point {
+  double t = 0.0;
+  long step = 0;
+  bool on_grid = true;
 };
+
+// The plan for `times` (increasing, in (0, horizon]). Throws std::invalid_argument
+// otherwise.
+std::vector<record_point> plan_records(double horizon, double dt, std::span<const double> times);
+
+// The grid times nearest to the fixed fractions j / count of the horizon, j = 1..count
+// (fewer when the run has fewer steps): what `stepbench run` records at any dt, so the
+// run itself is not changed by where it is measured. On the sweep's ladder every level
+// has a multiple of count steps, so these are the times j T / count at every level.
+std::vector<double> nearest_grid_times(double horizon, double dt, int count);
+
+// The fractions j T / count, j = 1..count (the last exactly T).
+std::vector<double> sample_times(double horizon, int count);
 
 template <class Vec>
 struct drive_result {
-  long steps = 0;        // steps taken (fewer than planned when the run diverged)
-  long force_evals = 0;
+  long steps = 0;           // accepted steps taken
+  long rejected_steps = 0;  // adaptive methods: attempts the error test rejected
+  work_counters work{};
   bool non_finite = false;  // a NaN or Inf appeared: the run stopped there
+  std::string failure;      // why the run stopped early (step budget, step size underflow, ...), else empty
   std::vector<double> sample_t;
-  std::vector<phase<Vec>> samples;  // state after each sampled step
+  Eigen::MatrixXd samples;  // column j: [x; v] at sample_t[j]
   double t_final = 0.0;
   phase<Vec> final_state;
+
+  void start(int dim, std::size_t count) {
+    sample_t.reserve(count);
+    samples.resize(2 * dim, static_cast<Eigen::Index>(count));
+  }
+  template <class X, class V>
+  void record(double t, const Eigen::MatrixBase<X>& x, const Eigen::MatrixBase<V>& v) {
+    const auto j = static_cast<Eigen::Index>(sample_t.size());
+    const auto d = x.size();
+    samples.col(j).head(d) = x;
+    samples.col(j).tail(d) = v;
+    sample_t.push_back(t);
+  }
 };
 
 template <class Vec>
-inline bool all_finite(const step_state<Vec>& s) {
-  return s.x.allFinite() && s.v.allFinite();
+inline bool all_finite(const Vec& x, const Vec& v) {
+  return x.allFinite() && v.allFinite();
 }
 
-// Integrates `problem` to `horizon` with steps of `dt`; records the state after each
-// step listed in `record_steps` (increasing). A non-finite state stops the run.
+template <class P>
+concept has_after_step = requires(const P& p, double t, typename P::vec& x) {
+  { p.after_step(t, x, x) } -> std::convertible_to<bool>;
+};
+
+// Stage after_step: the problem's hook (contacts). A state it changes invalidates the
+// cached force.
+template <problem P, class Vec>
+inline void after_step(const P& problem, double t, step_state<Vec>& s) {
+  if constexpr (has_after_step<P>) {
+    if (problem.after_step(t, s.x, s.v)) s.f_current = false;
+  }
+}
+
+template <problem P>
+inline step_state<typename P::vec> start_state(const P& problem) {
+  using Vec = typename P::vec;
+  const phase<Vec> start = problem.initial();
+  return {start.x, start.v, Vec::Zero(start.x.size()), false};
+}
+
+// The fixed-step loop itself, shared by our drive loop and the peers' (which keep their
+// state in their own form): steps of exactly dt but a shortened last one, split where a
+// record time falls inside a step. `advance(t, h)` steps from t by h; `after_step(t)`
+// runs the problem's hook; `record(t)` stores the state at t and returns false when the
+// state is not finite, which stops the run. Returns the grid steps taken and the time
+// reached.
+struct loop_end {
+  long steps = 0;
+  double t = 0.0;
+};
+template <class Advance, class AfterStep, class Record>
+[[gnu::always_inline]] inline loop_end fixed_step_loop(double dt, double horizon, std::span<const record_point> plan,
+                                                   Advance&& advance, AfterStep&& after_step, Record&& record) {
+  const long n = steps_for(horizon, dt);
+  auto next = plan.begin();
+  long i = 0;
+  double t = 0.0;
+  while (i < n) {
+    double h = i + 1 == n ? horizon - t : dt;
+    if (next != plan.end() && next->step == i + 1 && !next->on_grid) {
+      // Record times inside this step: land on each (advance, after_step, record), then
+      // finish the step to the grid point.
+      do {
+        advance(t, next->t - t);
+        t = next->t;
+        after_step(t);
+        if (!record(t)) return {i, t};
+        ++next;
+      } while (next != plan.end() && next->step == i + 1 && !next->on_grid);
+      h = time_after_step(i + 1, n, dt, horizon) - t;
+    }
+    // advance
+    advance(t, h);
+    ++i;
+    t = time_after_step(i, n, dt, horizon);
+    // after_step
+    after_step(t);
+    // record
+    if (next != plan.end() && next->step == i) {
+      ++next;
+      if (!record(t)) return {i, t};
+    }
+  }
+  return {i, t};
+}
+
+// Integrates `problem` to `horizon` with steps of `dt`, recording where `plan` says. A
+// non-finite recorded state stops the run.
 // flatten: everything called from the loop (the step, the force model, Eigen's
 // expression templates) is inlined into it whatever the optimisation level; at -O2 GCC's
 // inliner otherwise stops a few calls deep and a step costs ~1.8x more.
 template <problem P, integrator I>
-[[gnu::flatten]] drive_result<typename P::vec> drive(const P& problem, I method, double dt, double horizon,
-                                    std::span<const long> record_steps) {
+[[gnu::flatten]] drive_result<typename P::vec> drive(const P& problem, const I& method, double dt, double horizon,
+                                                     std::span<const record_point> plan) {
   using Vec = typename P::vec;
   counted_system<P> sys{problem};
-  const phase<Vec> start = problem.initial();
-  step_state<Vec> s{start.x, start.v, Vec::Zero(start.x.size()), false};
-  const long n = steps_for(horizon, dt);
+  step_state<Vec> s = start_state(problem);
+  auto stepper = make_stepper(method, s.x);
+  drive_result<Vec> out;
+  out.start(problem.dim(), plan.size());
+  const loop_end end = fixed_step_loop(
+      dt, horizon, plan, [&](double t, double h) { stepper.step(sys, t, s, h); },
+      [&](double t) { stepbench::after_step(problem, t, s); },
+      [&](double t) {
+        if (!all_finite(s.x, s.v)) return out.non_finite = true, false;
+        out.record(t, s.x, s.v);
+        return true;
+      });
+  out.non_finite = out.non_finite || !all_finite(s.x, s.v);
+  out.steps = end.steps;
+  out.work = sys.work;
+  out.t_final = end.t;
+  out.final_state = {s.x, s.v};
+  return out;
+}
+
+// The adaptive loop. Steps are the method's own, shortened only to land on the horizon
+// and, for a method without dense output, on each record time (a method with dense
+// output interpolates the record times inside its steps instead). A run stops with a
+// recorded failure when the step size falls below round-off of t or when it would take
+// more than `max_steps` accepted steps.
+template <problem P, adaptive_integrator I>
+[[gnu::flatten]] drive_result<typename P::vec> drive_adaptive(const P& problem, const I& method, double horizon,
+                                                              std::span<const double> times, long max_steps) {
+  using Vec = typename P::vec;
+  counted_system<P> sys{problem};
+  step_state<Vec> s = start_state(problem);
+  auto stepper = make_stepper(method, s.x);
+  constexpr bool dense = dense_output_integrator<I>;
 
   drive_result<Vec> out;
-  out.sample_t.reserve(record_steps.size());
-  out.samples.reserve(record_steps.size());
-  auto next = record_steps.begin();
-  long i = 0;
+  out.start(problem.dim(), times.size());
+  Vec x_dense = s.x, v_dense = s.v;  // interpolated states (workspace)
+  auto next = times.begin();
   double t = 0.0;
-  while (i < n) {
-    // Every step is exactly dt except a shortened last one; t itself is i * dt, not
-    // a running sum, so it carries no accumulated rounding.
-    const double t_next = time_after_step(i + 1, n, dt, horizon);
-    method.step(sys, t, s, i + 1 == n ? horizon - t : dt);
-    ++i;
-    t = t_next;
-    if (next != record_steps.end() && *next == i) {
-      ++next;
-      if (!all_finite(s)) {
+  double h = stepper.initial_dt(sys, t, s, horizon);
+  while (t < horizon) {
+    const double target = dense || next == times.end() ? horizon : *next;
+    // Land on the target when the proposed step reaches it or nearly does (a sliver of a
+    // step left over would cost a whole step): Hairer's codes stretch by up to 1 %.
+    const bool lands = t + 1.01 * h >= target;
+    const double h_try = lands ? target - t : h;
+    if (!(h_try > 4.0 * std::numeric_limits<double>::epsilon() * std::max(std::abs(t), horizon))) {
+      out.failure = "step size underflow at t = " + std::to_string(t);
+      break;
+    }
+    // advance: attempts until one is accepted
+    const step_attempt a = stepper.try_step(sys, t, s, h_try);
+    h = a.dt_next;
+    if (!a.accepted) {
+      ++out.rejected_steps;
+      if (!std::isfinite(h)) {
         out.non_finite = true;
         break;
       }
-      out.sample_t.push_back(t);
-      out.samples.push_back({s.x, s.v});
+      continue;
+    }
+    const double t_old = t;
+    t = lands ? target : t + a.dt_taken;
+    ++out.steps;
+    // after_step
+    after_step(problem, t, s);
+    if (!all_finite(s.x, s.v)) {
+      out.non_finite = true;
+      break;
+    }
+    // record
+    if constexpr (dense) {
+      for (; next != times.end() && *next <= t; ++next) {
+        if (*next == t) {
+          out.record(t, s.x, s.v);
+        } else {
+          stepper.interpolate((*next - t_old) / (t - t_old), x_dense, v_dense);
+          out.record(*next, x_dense, v_dense);
+        }
+      }
+    } else {
+      if (next != times.end() && t == *next) {
+        out.record(t, s.x, s.v);
+        ++next;
+      }
+    }
+    if (out.steps >= max_steps && t < horizon) {
+      out.failure = "step budget of " + std::to_string(max_steps) + " steps exhausted at t = " + std::to_string(t);
+      break;
     }
   }
-  out.non_finite = out.non_finite || !all_finite(s);
-  out.steps = i;
-  out.force_evals = sys.evals;
+  out.work = sys.work;
   out.t_final = t;
   out.final_state = {s.x, s.v};
   return out;

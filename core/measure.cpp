@@ -9,6 +9,8 @@
 namespace stepbench {
 namespace {
 
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+
 double norm_diff(std::span<const double> a, std::span<const double> b, int offset, int dim) {
   double s = 0.0;
   for (int i = 0; i < dim; ++i) {
@@ -24,8 +26,9 @@ double norm_part(std::span<const double> y, int offset, int dim) {
   return std::sqrt(s);
 }
 
-// Kinetic energy of [x; v] is E([0; v]) - E([0; 0]) for every problem here (the
-// potential depends on x only), which needs no kinetic-energy hook in the interface.
+// Kinetic energy of [x; v] is E([x; v]) - E([x; 0]) for every problem here (the
+// potential depends on x only, the kinetic energy on v only), which needs no
+// kinetic-energy hook in the interface. Evaluated at x = 0 for both terms.
 double kinetic(const problem_instance& p, std::span<const double> y) {
   std::vector<double> moving(y.begin(), y.end()), rest(y.size(), 0.0);
   for (int i = 0; i < p.dim(); ++i) moving[i] = 0.0;
@@ -47,6 +50,11 @@ void set_scales(const problem_instance& p, truth_table& t) {
   t.energy_scale = es > 0.0 ? es : 1.0;
 }
 
+std::string disagreement(const agreement& a, double limit) {
+  return fmt::format("relative error {:.3e} (position) {:.3e} (velocity) exceeds the agreement limit {:.1e}",
+                     a.pos_rel, a.vel_rel, limit);
+}
+
 }  // namespace
 
 agreement compare(std::span<const std::vector<double>> a, std::span<const std::vector<double>> b, int dim,
@@ -62,84 +70,111 @@ agreement compare(std::span<const std::vector<double>> a, std::span<const std::v
 truth_table build_truth(const problem_instance& problem, std::span<const double> times, const truth_options& opts) {
   truth_table t;
   t.times.assign(times.begin(), times.end());
+  t.agreement_limit = opts.agreement_limit_factor * opts.tol.rtol;
   const bool closed = opts.use_closed_form && problem.has_closed_form();
   if (!closed && !opts.run_references)
     throw std::invalid_argument(fmt::format("problem {}: no closed form and references disabled", problem.name()));
+  const int dim = problem.dim();
 
   if (opts.run_references) {
     const ode_system sys = problem.ode();
-    for (const char* source : reference_sources)
-      t.references.push_back({solve_reference(source, sys, times, opts.tol), {}, {}});
+    for (const char* source : reference_sources) {
+      reference_check rc;
+      rc.source = source;
+      try {
+        rc.solution = solve_reference(source, sys, times, opts.tol);
+      } catch (const std::runtime_error& e) {
+        rc.status = "failed";
+        rc.reason = e.what();
+      }
+      t.references.push_back(std::move(rc));
+    }
   }
+  std::vector<reference_check*> ok;
+  for (auto& r : t.references)
+    if (r.status == "ok") ok.push_back(&r);
+
   if (closed) {
     t.source = "closed_form";
     for (double time : times) t.y.push_back(problem.exact(time));
-  }
-  const int dim = problem.dim();
-  if (!closed) {
-    // Scales from the first reference, used only to rank the references.
-    t.y = t.references.front().solution.y;
+    for (std::size_t j = 0; j < t.y.size(); ++j)
+      for (double value : t.y[j])
+        if (!std::isfinite(value))
+          throw std::runtime_error(fmt::format(
+              "the closed form of problem {} is not finite at t = {:g}: are the parameters in range?", problem.name(),
+              t.times[j]));
     set_scales(problem, t);
-    size_t best = 0;
-    double best_score = std::numeric_limits<double>::infinity();
-    for (size_t i = 0; i < t.references.size(); ++i) {
-      double score = 0.0;
-      for (size_t k = 0; k < t.references.size(); ++k)
-        if (k != i)
-          score = std::max(score, compare(t.references[i].solution.y, t.references[k].solution.y, dim,
-                                          t.pos_scale, t.vel_scale)
-                                      .worst());
-      if (score < best_score) best_score = score, best = i;
+    for (auto* r : ok) {
+      r->compared_with = t.source;
+      r->vs = compare(r->solution.y, t.y, dim, t.pos_scale, t.vel_scale);
+      if (!(r->vs.worst() <= t.agreement_limit)) r->status = "disagrees", r->reason = disagreement(r->vs, t.agreement_limit);
     }
-    t.source = t.references[best].solution.source;
-    t.y = t.references[best].solution.y;
+  } else {
+    // The best-agreeing pair, on scales from the first usable reference.
+    if (!ok.empty()) {
+      t.y = ok.front()->solution.y;
+      set_scales(problem, t);
+    }
+    std::size_t best_i = 0, best_k = 0;
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < ok.size(); ++i)
+      for (std::size_t k = i + 1; k < ok.size(); ++k) {
+        const double w = compare(ok[i]->solution.y, ok[k]->solution.y, dim, t.pos_scale, t.vel_scale).worst();
+        if (w < best) best = w, best_i = i, best_k = k;
+      }
+    if (ok.size() < 2 || !(best <= t.agreement_limit)) {
+      t.trusted = false;
+      t.source = "none";
+      t.note = ok.size() < 2 ? fmt::format("only {} of {} references completed, and no closed form to check them",
+                                           ok.size(), t.references.size())
+                             : fmt::format("no two references agree within {:.1e} (best pair {} and {}: {:.3e})",
+                                           t.agreement_limit, ok[best_i]->source, ok[best_k]->source, best);
+      t.y.assign(times.size(), std::vector<double>(2 * dim, nan));
+      for (auto* r : ok) r->status = "disagrees", r->reason = t.note;
+    } else {
+      reference_check& truth = *ok[best_i];
+      t.source = truth.source;
+      t.y = truth.solution.y;
+      set_scales(problem, t);
+      for (auto* r : ok) {
+        // The truth itself is reported against its partner, so its own row is not a 0.
+        const auto& other = r == &truth ? *ok[best_k] : truth;
+        r->compared_with = other.source;
+        r->vs = compare(r->solution.y, other.solution.y, dim, t.pos_scale, t.vel_scale);
+        if (!(r->vs.worst() <= t.agreement_limit))
+          r->status = "disagrees", r->reason = disagreement(r->vs, t.agreement_limit);
+      }
+    }
   }
-  set_scales(problem, t);
-  for (size_t j = 0; j < t.y.size(); ++j)
-    for (double value : t.y[j])
-      if (!std::isfinite(value))
-        throw std::runtime_error(fmt::format("the true solution of problem {} ({}) is not finite at t = {:g}: "
-                                             "are the parameters in range?",
-                                             problem.name(), t.source, t.times[j]));
   if (!std::isfinite(t.pos_scale) || !std::isfinite(t.vel_scale))
     throw std::runtime_error(fmt::format("the motion of problem {} overflows: are the parameters in range?", problem.name()));
-
-  const double limit = opts.agreement_limit_factor * opts.tol.rtol;
-  for (auto& ref : t.references) {
-    if (!closed && ref.solution.source == t.source) {
-      // The chosen truth is reported against the runner-up, so its own row is not a 0.
-      for (const auto& other : t.references)
-        if (other.solution.source != t.source) {
-          const auto a = compare(ref.solution.y, other.solution.y, dim, t.pos_scale, t.vel_scale);
-          if (ref.compared_with.empty() || a.worst() < ref.vs.worst()) ref.vs = a, ref.compared_with = other.solution.source;
-        }
-      continue;
-    }
-    ref.compared_with = t.source;
-    ref.vs = compare(ref.solution.y, t.y, dim, t.pos_scale, t.vel_scale);
-    if (!(ref.vs.worst() <= limit))
-      throw std::runtime_error(fmt::format(
-          "reference {} disagrees with {} on problem {}: relative error {:.3e} (position) {:.3e} (velocity) "
-          "exceeds the agreement limit {:.1e}",
-          ref.solution.source, t.source, problem.name(), ref.vs.pos_rel, ref.vs.vel_rel, limit));
-  }
   return t;
 }
 
 run_metrics measure(const problem_instance& problem, const run_result& run, const truth_table& truth) {
   run_metrics m;
   const int dim = problem.dim();
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  if (run.non_finite) {
-    m.diverged = true;
-    m.diverged_reason = "non-finite state";
-  } else if (run.sample_t.size() != truth.times.size()) {
-    throw std::logic_error("measure: the run's samples do not match the truth's times");
-  }
-  if (m.diverged) {
+  auto all_nan = [&] {
     m.err_pos_final = m.err_vel_final = m.err_pos_max = m.err_pos_rms = m.energy_drift = m.energy_err_max = nan;
     return m;
+  };
+  if (!run.failure.empty()) {
+    m.failed = true;
+    m.note = run.failure;
+    return all_nan();
   }
+  if (run.non_finite) {
+    m.diverged = true;
+    m.note = "non-finite state";
+    return all_nan();
+  }
+  if (!truth.trusted) {
+    m.failed = true;
+    m.note = "no trusted truth: " + truth.note;
+    return all_nan();
+  }
+  if (run.sample_t.size() != truth.times.size())
+    throw std::logic_error("measure: the run's samples do not match the truth's times");
   double sum_sq = 0.0, e_max = 0.0;
   for (size_t j = 0; j < truth.times.size(); ++j) {
     if (std::abs(run.sample_t[j] - truth.times[j]) > 1e-12 * std::max(1.0, truth.times[j]))
@@ -151,8 +186,7 @@ run_metrics measure(const problem_instance& problem, const run_result& run, cons
       e_max = std::max(e_max, std::abs(problem.energy(run.sample_y[j]) - problem.energy(truth.y[j])));
   }
   m.err_pos_rms = std::sqrt(sum_sq / static_cast<double>(truth.times.size()));
-  std::vector<double> y_final = run.position;
-  y_final.insert(y_final.end(), run.velocity.begin(), run.velocity.end());
+  const auto& y_final = run.final_y;
   const auto& y_true = truth.y.back();
   m.err_pos_final = norm_diff(y_final, y_true, 0, dim);
   m.err_vel_final = norm_diff(y_final, y_true, dim, dim);
@@ -164,7 +198,7 @@ run_metrics measure(const problem_instance& problem, const run_result& run, cons
   }
   if (!(m.err_pos_max <= blowup_factor * truth.pos_scale)) {
     m.diverged = true;
-    m.diverged_reason = fmt::format("position error {:.3g} exceeds {:g} times the amplitude", m.err_pos_max, blowup_factor);
+    m.note = fmt::format("position error {:.3g} exceeds {:g} times the amplitude", m.err_pos_max, blowup_factor);
   }
   return m;
 }

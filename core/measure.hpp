@@ -1,16 +1,18 @@
 #pragma once
 // Truth and error measurement.
 //
-// The truth for a problem is its closed form where it has one; there, every reference
-// is checked against it. Without a closed form, the references are checked against
-// each other and the truth is the reference that agrees best with the others (the
-// smallest worst-case disagreement). Either way a reference that disagrees beyond the
-// agreement limit is an error: measuring against a broken reference would make every
-// number downstream wrong.
+// The truth for a problem is its closed form where it has one; every reference is then
+// checked against it, and a reference that fails or disagrees is recorded with its
+// status and reason (the closed form still holds, so the study goes on). Without a
+// closed form the truth is the best-agreeing pair of references (the first of the
+// pair in reference order); a reference that disagrees with it is recorded as such. If
+// no two references agree within the limit, the problem has no trusted truth: every
+// error is NaN and the reason is recorded, rather than measuring against a solver that
+// may be wrong.
 #include <string>
 #include <vector>
 
-#include "core/registry.hpp"
+#include "core/problem_instance.hpp"
 #include "references/reference.hpp"
 
 namespace stepbench {
@@ -25,19 +27,25 @@ struct agreement {
 };
 
 struct reference_check {
+  std::string source;
+  std::string status = "ok";  // "ok", "failed" (the solver stopped), "disagrees" (beyond the limit)
+  std::string reason;         // why, when not ok
   reference_solution solution;
   std::string compared_with;  // "closed_form" or another reference source
   agreement vs;               // this reference against compared_with
 };
 
 struct truth_table {
-  std::string source;  // "closed_form" or the chosen reference
+  std::string source;   // "closed_form", the chosen reference, or "none"
+  bool trusted = true;  // false: no closed form and no two references agree
+  std::string note;     // why the truth is not trusted
   std::vector<double> times;
-  std::vector<std::vector<double>> y;  // [x; v] at times
+  std::vector<std::vector<double>> y;  // [x; v] at times (NaN when not trusted)
   std::vector<reference_check> references;
   double pos_scale = 1.0;     // max |x| over the initial state and the samples
   double vel_scale = 1.0;     // max |v| likewise
   double energy_scale = 1.0;  // max of |E| and kinetic energy likewise (see measure.cpp)
+  double agreement_limit = 0.0;
 };
 
 struct truth_options {
@@ -49,8 +57,8 @@ struct truth_options {
   double agreement_limit_factor = 1e4;
 };
 
-// Builds the truth at `times` (increasing, > 0). Throws std::runtime_error when a
-// reference fails or disagrees beyond the limit.
+// Builds the truth at `times` (increasing, > 0). Throws std::runtime_error only when
+// the closed form itself is not finite (parameters out of range).
 truth_table build_truth(const problem_instance& problem, std::span<const double> times, const truth_options& opts);
 
 agreement compare(std::span<const std::vector<double>> a, std::span<const std::vector<double>> b, int dim,
@@ -63,8 +71,9 @@ struct run_metrics {
   double err_pos_rms = 0.0;    // root mean square over the sample times
   double energy_drift = 0.0;   // (E(y_N) - E(y(T))) / energy_scale, signed; NaN without energy
   double energy_err_max = 0.0; // max over samples of |E(y_j) - E(y(t_j))| / energy_scale
-  bool diverged = false;
-  std::string diverged_reason;
+  bool diverged = false;       // blew up: non-finite, or beyond blowup_factor x the amplitude
+  bool failed = false;         // the method could not complete the run, or there is no trusted truth
+  std::string note;            // why diverged or failed
 };
 
 // Measures a run against the truth. The run's sample times must be the truth's

@@ -25,4 +25,22 @@ std::pair<std::string, double> parse_assignment(std::string_view text) {
   return {name, parse_number(text.substr(eq + 1), fmt::format("--set {}", name))};
 }
 
+void add_override(std::map<std::string, std::map<std::string, double>>& overrides, const std::string& text,
+                  const std::vector<std::string>& selected_problems) {
+  auto [name, value] = parse_assignment(text);
+  std::string problem;
+  if (const auto dot = name.find('.'); dot != std::string::npos) {
+    problem = name.substr(0, dot);
+    name = name.substr(dot + 1);
+    if (problem.empty() || name.empty())
+      throw std::invalid_argument(fmt::format("--set {}: expected problem.name=value", text));
+  } else if (selected_problems.size() == 1) {
+    problem = selected_problems.front();
+  } else {
+    throw std::invalid_argument(
+        fmt::format("--set {}: name the problem (problem.{}=value) or select one --problem", text, name));
+  }
+  overrides[problem][name] = value;
+}
+
 }  // namespace stepbench

@@ -11,6 +11,7 @@ struct euler {
   static constexpr std::string_view name = "euler";
   static constexpr std::string_view description = "explicit Euler: position with the old velocity";
   static constexpr int order = 1;
+  static constexpr capabilities traits{};
 
   template <class Sys, class Vec>
   void step(const Sys& sys, double t, step_state<Vec>& s, double dt) const {

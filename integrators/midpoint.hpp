@@ -12,16 +12,25 @@ struct midpoint {
   static constexpr std::string_view name = "midpoint";
   static constexpr std::string_view description = "explicit midpoint (RK2)";
   static constexpr int order = 2;
+  static constexpr capabilities traits{};
 
-  template <class Sys, class Vec>
-  void step(const Sys& sys, double t, step_state<Vec>& s, double dt) const {
-    const double h = 0.5 * dt, im = inverse_mass(sys);
-    const Vec x_mid = s.x + h * s.v;
-    const Vec v_mid = s.v + (h * im) * current_force(sys, t, s);
-    s.v += (dt * im) * sys.force(t + h, x_mid, v_mid);
-    s.x += dt * v_mid;
-    s.f_current = false;
-  }
+  template <class Vec>
+  struct stepper {
+    Vec x_mid, v_mid, f_mid;
+    explicit stepper(const midpoint&) {}
+    void resize(const Vec& like) { size_like(like, x_mid, v_mid, f_mid); }
+
+    template <class Sys>
+    void step(const Sys& sys, double t, step_state<Vec>& s, double dt) {
+      const double h = 0.5 * dt, im = inverse_mass(sys);
+      x_mid = s.x + h * s.v;
+      v_mid = s.v + (h * im) * current_force(sys, t, s);
+      sys.force(t + h, x_mid, v_mid, f_mid);
+      s.v += (dt * im) * f_mid;
+      s.x += dt * v_mid;
+      s.f_current = false;
+    }
+  };
 };
 
 }  // namespace stepbench

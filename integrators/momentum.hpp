@@ -2,9 +2,9 @@
 // The lecture's momentum form (digest section 6): integrate the force into momentum,
 // derive the velocity, then move.
 //   p_{n+1} = p_n + dt F(t_n, x_n, v_n),   v_{n+1} = p_{n+1} / m,   x_{n+1} = x_n + dt v_{n+1}.
-// With p = m v this is semi-implicit Euler up to rounding (first order); it is kept as
-// its own method because it is the form that carries over to rotation (angular
-// momentum, inertia tensor), where p, not v, is the natural state.
+// With p = m v this is semi-implicit Euler up to rounding (first order, symplectic); it
+// is kept as its own method because it is the form that carries over to rotation
+// (angular momentum, inertia tensor), where p, not v, is the natural state.
 #include "core/concepts.hpp"
 
 namespace stepbench {
@@ -13,15 +13,23 @@ struct momentum {
   static constexpr std::string_view name = "momentum";
   static constexpr std::string_view description = "momentum form: p += F dt, v = p / m, x += v dt";
   static constexpr int order = 1;
+  static constexpr capabilities traits{.symplectic = true};
 
-  template <class Sys, class Vec>
-  void step(const Sys& sys, double t, step_state<Vec>& s, double dt) const {
-    const double m = sys.mass();
-    const Vec p = m * s.v + dt * sys.force(t, s.x, s.v);
-    s.v = p / m;
-    s.x += dt * s.v;
-    s.f_current = false;
-  }
+  template <class Vec>
+  struct stepper {
+    Vec p;
+    explicit stepper(const momentum&) {}
+    void resize(const Vec& like) { size_like(like, p); }
+
+    template <class Sys>
+    void step(const Sys& sys, double t, step_state<Vec>& s, double dt) {
+      const double m = sys.mass();
+      p = m * s.v + dt * current_force(sys, t, s);
+      s.v = p / m;
+      s.x += dt * s.v;
+      s.f_current = false;
+    }
+  };
 };
 
 }  // namespace stepbench

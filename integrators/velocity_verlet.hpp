@@ -18,23 +18,32 @@ struct velocity_verlet {
   static constexpr std::string_view name = "velocity_verlet";
   static constexpr std::string_view description = "velocity Verlet (Stormer-Verlet, kick-drift-kick)";
   static constexpr int order = 2;
+  static constexpr capabilities traits{.symplectic = true, .reuses_last_force = true};
 
-  template <class Sys, class Vec>
-  void step(const Sys& sys, double t, step_state<Vec>& s, double dt) const {
-    const double h_im = 0.5 * dt * inverse_mass(sys);
-    const Vec f_n = current_force(sys, t, s);
-    const Vec v_half = s.v + h_im * f_n;
-    s.x += dt * v_half;
-    if constexpr (Sys::force_depends_on_velocity) {
-      const Vec v_pred = v_half + h_im * f_n;
-      s.v = v_half + h_im * sys.force(t + dt, s.x, v_pred);
-      s.f_current = false;
-    } else {
-      s.f = sys.force(t + dt, s.x, v_half);
-      s.v = v_half + h_im * s.f;
-      s.f_current = true;
+  template <class Vec>
+  struct stepper {
+    Vec f_n, v_half, v_pred, f_new;
+    explicit stepper(const velocity_verlet&) {}
+    void resize(const Vec& like) { size_like(like, f_n, v_half, v_pred, f_new); }
+
+    template <class Sys>
+    void step(const Sys& sys, double t, step_state<Vec>& s, double dt) {
+      const double h_im = 0.5 * dt * inverse_mass(sys);
+      f_n = current_force(sys, t, s);
+      v_half = s.v + h_im * f_n;
+      s.x += dt * v_half;
+      if constexpr (Sys::force_depends_on_velocity) {
+        v_pred = v_half + h_im * f_n;
+        sys.force(t + dt, s.x, v_pred, f_new);
+        s.v = v_half + h_im * f_new;
+        s.f_current = false;
+      } else {
+        sys.force(t + dt, s.x, v_half, s.f);
+        s.v = v_half + h_im * s.f;
+        s.f_current = true;
+      }
     }
-  }
+  };
 };
 
 }  // namespace stepbench

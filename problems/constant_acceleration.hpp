@@ -12,7 +12,7 @@ namespace stepbench {
 struct constant_acceleration {
   static constexpr std::string_view name = "constant_acceleration";
   static constexpr std::string_view description = "1-D body under a constant force (lecture's Euler example)";
-  static constexpr int dim = 1;
+  static constexpr int dim() { return 1; }
   static constexpr std::string_view position_unit = "m";
   static constexpr bool force_depends_on_velocity = false;
   using vec = Eigen::Matrix<double, 1, 1>;
@@ -41,7 +41,7 @@ struct constant_acceleration {
   }
 
   double mass() const { return mass_kg; }
-  vec force(double, const vec&, const vec&) const { return vec(force_n); }
+  void force(double, const vec&, const vec&, vec& f) const { f[0] = force_n; }
   phase<vec> initial() const { return {vec(x0), vec(v0)}; }
   double horizon() const { return duration; }
 

@@ -24,7 +24,7 @@ namespace stepbench {
 struct damped_spring {
   static constexpr std::string_view name = "damped_spring";
   static constexpr std::string_view description = "mass on a spring and damper (lecture's RK4 example)";
-  static constexpr int dim = 1;
+  static constexpr int dim() { return 1; }
   static constexpr std::string_view position_unit = "m";
   static constexpr bool force_depends_on_velocity = true;
   using vec = Eigen::Matrix<double, 1, 1>;
@@ -56,7 +56,7 @@ struct damped_spring {
   }
 
   double mass() const { return mass_kg; }
-  vec force(double, const vec& x, const vec& v) const { return -k_s * x - k_d * v; }
+  void force(double, const vec& x, const vec& v, vec& f) const { f = -k_s * x - k_d * v; }
   phase<vec> initial() const { return {vec(x0), vec(v0)}; }
   double horizon() const { return duration; }
 

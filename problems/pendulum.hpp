@@ -25,7 +25,7 @@ namespace stepbench {
 struct pendulum {
   static constexpr std::string_view name = "pendulum";
   static constexpr std::string_view description = "simple pendulum, large swing, released from rest";
-  static constexpr int dim = 1;
+  static constexpr int dim() { return 1; }
   static constexpr std::string_view position_unit = "rad";
   static constexpr bool force_depends_on_velocity = false;
   using vec = Eigen::Matrix<double, 1, 1>;
@@ -75,7 +75,7 @@ struct pendulum {
   double period() const { return 4.0 * quarter_period_k() / omega0(); }
 
   double mass() const { return mass_kg * length_m * length_m; }
-  vec force(double, const vec& x, const vec&) const { return vec(-mass_kg * gravity * length_m * std::sin(x[0])); }
+  void force(double, const vec& x, const vec&, vec& f) const { f[0] = -mass_kg * gravity * length_m * std::sin(x[0]); }
   phase<vec> initial() const { return {vec(theta0()), vec(0.0)}; }
   double horizon() const { return periods * period(); }
 

@@ -14,7 +14,7 @@ namespace stepbench {
 struct projectile {
   static constexpr std::string_view name = "projectile";
   static constexpr std::string_view description = "3-D ball under uniform gravity, launched from the ground";
-  static constexpr int dim = 3;
+  static constexpr int dim() { return 3; }
   static constexpr std::string_view position_unit = "m";
   static constexpr bool force_depends_on_velocity = false;
   using vec = Eigen::Vector3d;
@@ -46,7 +46,7 @@ struct projectile {
   vec g() const { return {0.0, 0.0, -gravity}; }
 
   double mass() const { return mass_kg; }
-  vec force(double, const vec&, const vec&) const { return mass_kg * g(); }
+  void force(double, const vec&, const vec&, vec& f) const { f = mass_kg * g(); }
   phase<vec> initial() const { return {vec::Zero(), launch_velocity()}; }
   double horizon() const { return flight_time(); }
 

@@ -1,16 +1,78 @@
-#include "core/registry.hpp"
+#include "study/registry.hpp"
 
+#include <limits>
 #include <stdexcept>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include "core/drive.hpp"
+#include "core/first_order.hpp"
+#include "core/type_list.hpp"
 #include "integrators/all.hpp"
+#include "peers/all.hpp"
 #include "problems/all.hpp"
 
 namespace stepbench {
 namespace {
+
+// Our integrators as registry entries: the same shape as a peer's (info, applies,
+// prepare), so that every method is run and measured by the same code.
+template <integrator I>
+struct ours_fixed {
+  static method_info info() {
+    return {std::string(I::name), std::string(I::description), method_origin::ours, method_kind::fixed_step,
+            static_cast<double>(I::order), I::traits, "stepbench"};
+  }
+  template <problem P>
+  static constexpr bool applies = true;
+  template <problem P>
+  static auto prepare(const P& p, double dt, double horizon, std::span<const double> times) {
+    return [p, dt, horizon, plan = plan_records(horizon, dt, times)] { return drive(p, I{}, dt, horizon, plan); };
+  }
+};
+
+template <adaptive_integrator I>
+struct ours_adaptive {
+  static method_info info() {
+    return {std::string(I::name), std::string(I::description), method_origin::ours, method_kind::adaptive,
+            static_cast<double>(I::order), I::traits, "stepbench"};
+  }
+  template <problem P>
+  static constexpr bool applies = true;
+  template <problem P>
+  static auto prepare(const P& p, double tol, double horizon, std::span<const double> times) {
+    return [p, tol, horizon, t = std::vector<double>(times.begin(), times.end())] {
+      return drive_adaptive(p, I(tol), horizon, t, adaptive_step_budget);
+    };
+  }
+};
+
+template <class I>
+struct entry_for;
+template <class I>
+  requires integrator<I>
+struct entry_for<I> {
+  using type = ours_fixed<I>;
+};
+template <class I>
+  requires adaptive_integrator<I>
+struct entry_for<I> {
+  using type = ours_adaptive<I>;
+};
+
+// Calls f.template operator()<Entry>() for every method entry: ours, then the peers.
+template <class F>
+void for_each_method(F&& f) {
+  for_each_type(all_integrators{}, [&]<class I>() { f.template operator()<typename entry_for<I>::type>(); });
+  for_each_type(all_peers{}, [&]<class M>() { f.template operator()<M>(); });
+}
+
+template <class M>
+const method_info& info_of() {
+  static const method_info info = M::info();
+  return info;
+}
 
 template <class Vec>
 std::vector<double> flatten(const Vec& x, const Vec& v) {
@@ -19,21 +81,59 @@ std::vector<double> flatten(const Vec& x, const Vec& v) {
   return y;
 }
 
+template <class Vec>
+run_result to_run_result(const drive_result<Vec>& r, double param, double horizon) {
+  run_result out;
+  out.param = param;
+  out.horizon = horizon;
+  out.steps = r.steps;
+  out.rejected_steps = r.rejected_steps;
+  out.work = r.work;
+  out.non_finite = r.non_finite;
+  out.failure = r.failure;
+  out.sample_t = r.sample_t;
+  for (std::size_t j = 0; j < r.sample_t.size(); ++j) {
+    const auto col = r.samples.col(static_cast<Eigen::Index>(j));
+    out.sample_y.emplace_back(col.data(), col.data() + col.size());
+  }
+  out.final_y = flatten(r.final_state.x, r.final_state.v);
+  return out;
+}
+
+[[noreturn]] void not_applicable(std::string_view method, std::string_view problem) {
+  throw std::invalid_argument(fmt::format("method {} does not run on problem {}", method, problem));
+}
+
 template <problem P>
 class problem_model final : public problem_instance {
   using vec = typename P::vec;
   P p_;
 
   vec unflatten(std::span<const double> y, int offset) const {
-    vec out(P::dim);
-    for (int i = 0; i < P::dim; ++i) out[i] = y[offset + i];
+    vec out(p_.dim());
+    for (int i = 0; i < p_.dim(); ++i) out[i] = y[offset + i];
     return out;
+  }
+
+  // Calls f.template operator()<M>() for the entry named `method` that applies to P.
+  template <class F>
+  void with_method(std::string_view method, F&& f) const {
+    find_method(method);  // throws for an unknown name
+    bool found = false;
+    for_each_method([&]<class M>() {
+      if (found || info_of<M>().name != method) return;
+      found = true;
+      if constexpr (M::template applies<P>)
+        f.template operator()<M>();
+      else
+        not_applicable(method, P::name);
+    });
   }
 
  public:
   std::string_view name() const override { return P::name; }
   std::string_view description() const override { return P::description; }
-  int dim() const override { return P::dim; }
+  int dim() const override { return p_.dim(); }
   std::string_view position_unit() const override { return P::position_unit; }
 
   std::vector<param_value> params() const override {
@@ -57,6 +157,7 @@ class problem_model final : public problem_instance {
   double horizon() const override { return p_.horizon(); }
   bool has_closed_form() const override { return stepbench::has_closed_form<P>; }
   bool has_energy() const override { return stepbench::has_energy<P>; }
+  bool has_jacobian() const override { return stepbench::has_jacobian<P>; }
 
   std::vector<double> exact(double t) const override {
     if constexpr (stepbench::has_closed_form<P>) {
@@ -68,7 +169,7 @@ class problem_model final : public problem_instance {
   }
   double energy(std::span<const double> y) const override {
     if constexpr (stepbench::has_energy<P>)
-      return p_.energy(unflatten(y, 0), unflatten(y, P::dim));
+      return p_.energy(unflatten(y, 0), unflatten(y, p_.dim()));
     else
       return std::numeric_limits<double>::quiet_NaN();
   }
@@ -76,37 +177,42 @@ class problem_model final : public problem_instance {
     const auto s = p_.initial();
     return flatten(s.x, s.v);
   }
+  ode_system ode() const override { return make_ode_system(p_); }
 
-  ode_system ode() const override {
-    ode_system sys;
-    sys.n = 2 * P::dim;
-    sys.y0 = initial();
-    sys.rhs = [p = p_, inv_mass = 1.0 / p_.mass()](double t, std::span<const double> y, std::span<double> dydt) {
-      first_order_rhs(p, inv_mass, t, y.data(), dydt.data());
-    };
-    return sys;
+  std::vector<method_info> methods() const override {
+    std::vector<method_info> out;
+    for_each_method([&]<class M>() {
+      if constexpr (M::template applies<P>) out.push_back(info_of<M>());
+    });
+    return out;
   }
 
-  run_result run(std::string_view integrator_name, double dt, double horizon,
-                 std::span<const long> record_steps) const override {
-    find_integrator(integrator_name);  // throws for an unknown name
+  run_result run(std::string_view method, double param, double horizon,
+                 std::span<const double> times) const override {
     run_result out;
-    for_each_type(all_integrators{}, [&]<class I>() {
-      if (I::name != integrator_name) return;
-      const auto r = drive(p_, I{}, dt, horizon, record_steps);
-      out.steps = r.steps;
-      out.force_evals = r.force_evals;
-      out.non_finite = r.non_finite;
-      out.position.assign(r.final_state.x.data(), r.final_state.x.data() + P::dim);
-      out.velocity.assign(r.final_state.v.data(), r.final_state.v.data() + P::dim);
-      out.sample_t = r.sample_t;
-      for (const auto& s : r.samples) out.sample_y.push_back(flatten(s.x, s.v));
+    with_method(method, [&]<class M>() {
+      auto run_once = M::prepare(p_, param, horizon, times);  // throws std::invalid_argument for bad times
+      try {
+        out = to_run_result(run_once(), param, horizon);
+      } catch (const std::invalid_argument&) {
+        throw;
+      } catch (const std::exception& e) {
+        // A solver error is the run's outcome, recorded with its reason; the study goes on.
+        out = {};
+        out.param = param;
+        out.horizon = horizon;
+        out.failure = e.what();
+      }
     });
-    out.problem = P::name;
-    out.integrator = std::string(integrator_name);
-    out.dt = dt;
-    out.horizon = horizon;
-    out.steps_planned = steps_for(horizon, dt);
+    return out;
+  }
+
+  std::function<double()> timed_run(std::string_view method, double param, double horizon,
+                                    std::span<const double> times) const override {
+    std::function<double()> out;
+    with_method(method, [&]<class M>() {
+      out = [run_once = M::prepare(p_, param, horizon, times)] { return run_once().final_state.x[0]; };
+    });
     return out;
   }
 
@@ -132,20 +238,28 @@ std::unique_ptr<problem_instance> make_problem(std::string_view name) {
   return out;
 }
 
-std::vector<integrator_info> integrators() {
-  std::vector<integrator_info> out;
-  for_each_type(all_integrators{},
-                [&]<class I>() { out.push_back({std::string(I::name), std::string(I::description), I::order}); });
+const std::vector<method_info>& all_methods() {
+  static const std::vector<method_info> all = [] {
+    std::vector<method_info> out;
+    for_each_method([&]<class M>() { out.push_back(info_of<M>()); });
+    return out;
+  }();
+  return all;
+}
+
+std::vector<method_info> integrators() {
+  std::vector<method_info> out;
+  for (const auto& m : all_methods())
+    if (m.origin == method_origin::ours) out.push_back(m);
   return out;
 }
 
-const integrator_info& find_integrator(std::string_view name) {
-  static const std::vector<integrator_info> all = integrators();
-  for (const auto& i : all)
-    if (i.name == name) return i;
+const method_info& find_method(std::string_view name) {
+  for (const auto& m : all_methods())
+    if (m.name == name) return m;
   std::vector<std::string> known;
-  for (const auto& i : all) known.push_back(i.name);
-  throw std::invalid_argument(fmt::format("unknown integrator '{}' (known: {})", name, fmt::join(known, ", ")));
+  for (const auto& m : all_methods()) known.push_back(m.name);
+  throw std::invalid_argument(fmt::format("unknown method '{}' (known: {})", name, fmt::join(known, ", ")));
 }
 
 }  // namespace stepbench

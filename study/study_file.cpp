@@ -1,6 +1,5 @@
-#include "core/study_file.hpp"
+#include "study/study_file.hpp"
 
-#include <H5Cpp.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -15,120 +14,37 @@
 #include <fmt/format.h>
 
 #include "build_info.hpp"
+#include "study/h5.hpp"
 
 namespace stepbench {
 namespace {
 
-// One row of /<problem>/<integrator>/convergence. Field names are the public format.
-struct convergence_record {
-  double dt;
-  std::int64_t steps;
-  std::int64_t force_evals;
-  double err_pos_final;
-  double err_vel_final;
-  double err_pos_max;
-  double err_pos_rms;
-  double energy_drift;
-  double energy_err_max;
-  std::int8_t diverged;
-  double time_ns;
-  std::int64_t repetitions;
-  std::int8_t cut;
-};
+using h5::attr;
 
-// One row of /<problem>/<peer>/work_precision.
-struct peer_record {
-  double param;
-  std::int64_t steps;
-  std::int64_t force_evals;
-  double err_pos_final;
-  double err_pos_max;
-  std::int8_t diverged;
-  double time_ns;
-  std::int64_t repetitions;
-  std::int8_t cut;
-};
-
-// The timing fields are written only for a timed study, so an untimed file does not
-// carry columns of NaN that a reader could mistake for measurements. This is the memory
-// type (the struct's full size, whatever members are chosen); the file gets it packed.
-H5::CompType convergence_type(bool timed) {
-  H5::CompType t(sizeof(convergence_record));
-#define STEPBENCH_FIELD(name, type) t.insertMember(#name, HOFFSET(convergence_record, name), type)
-  STEPBENCH_FIELD(dt, H5::PredType::NATIVE_DOUBLE);
-  STEPBENCH_FIELD(steps, H5::PredType::NATIVE_INT64);
-  STEPBENCH_FIELD(force_evals, H5::PredType::NATIVE_INT64);
-  STEPBENCH_FIELD(err_pos_final, H5::PredType::NATIVE_DOUBLE);
-  STEPBENCH_FIELD(err_vel_final, H5::PredType::NATIVE_DOUBLE);
-  STEPBENCH_FIELD(err_pos_max, H5::PredType::NATIVE_DOUBLE);
-  STEPBENCH_FIELD(err_pos_rms, H5::PredType::NATIVE_DOUBLE);
-  STEPBENCH_FIELD(energy_drift, H5::PredType::NATIVE_DOUBLE);
-  STEPBENCH_FIELD(energy_err_max, H5::PredType::NATIVE_DOUBLE);
-  STEPBENCH_FIELD(diverged, H5::PredType::NATIVE_INT8);
-  if (timed) {
-    STEPBENCH_FIELD(time_ns, H5::PredType::NATIVE_DOUBLE);
-    STEPBENCH_FIELD(repetitions, H5::PredType::NATIVE_INT64);
-    STEPBENCH_FIELD(cut, H5::PredType::NATIVE_INT8);
-  }
-#undef STEPBENCH_FIELD
-  return t;
+double metric_value(const run_metrics& m, const std::string& metric) {
+  if (metric == "err_pos_max") return m.err_pos_max;
+  if (metric == "err_pos_final") return m.err_pos_final;
+  if (metric == "err_pos_rms") return m.err_pos_rms;
+  if (metric == "err_vel_final") return m.err_vel_final;
+  throw std::logic_error("unknown metric " + metric);
 }
 
-H5::CompType peer_type() {
-  H5::CompType t(sizeof(peer_record));
-#define STEPBENCH_FIELD(name, type) t.insertMember(#name, HOFFSET(peer_record, name), type)
-  STEPBENCH_FIELD(param, H5::PredType::NATIVE_DOUBLE);
-  STEPBENCH_FIELD(steps, H5::PredType::NATIVE_INT64);
-  STEPBENCH_FIELD(force_evals, H5::PredType::NATIVE_INT64);
-  STEPBENCH_FIELD(err_pos_final, H5::PredType::NATIVE_DOUBLE);
-  STEPBENCH_FIELD(err_pos_max, H5::PredType::NATIVE_DOUBLE);
-  STEPBENCH_FIELD(diverged, H5::PredType::NATIVE_INT8);
-  STEPBENCH_FIELD(time_ns, H5::PredType::NATIVE_DOUBLE);
-  STEPBENCH_FIELD(repetitions, H5::PredType::NATIVE_INT64);
-  STEPBENCH_FIELD(cut, H5::PredType::NATIVE_INT8);
-#undef STEPBENCH_FIELD
-  return t;
-}
-
-void attr(H5::H5Object& obj, const std::string& name, const std::string& value) {
-  H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
-  obj.createAttribute(name, type, H5::DataSpace(H5S_SCALAR)).write(type, value);
-}
-void attr(H5::H5Object& obj, const std::string& name, const char* value) { attr(obj, name, std::string(value)); }
-void attr(H5::H5Object& obj, const std::string& name, double value) {
-  obj.createAttribute(name, H5::PredType::NATIVE_DOUBLE, H5::DataSpace(H5S_SCALAR))
-      .write(H5::PredType::NATIVE_DOUBLE, &value);
-}
-void attr(H5::H5Object& obj, const std::string& name, long value) {
-  const std::int64_t v = value;
-  obj.createAttribute(name, H5::PredType::NATIVE_INT64, H5::DataSpace(H5S_SCALAR)).write(H5::PredType::NATIVE_INT64, &v);
-}
-void attr(H5::H5Object& obj, const std::string& name, int value) { attr(obj, name, static_cast<long>(value)); }
-void attr(H5::H5Object& obj, const std::string& name, const std::vector<int>& values) {
-  const hsize_t n = values.size();
-  H5::DataSpace space = n ? H5::DataSpace(1, &n) : H5::DataSpace(H5S_NULL);
-  auto a = obj.createAttribute(name, H5::PredType::NATIVE_INT, space);
-  if (n) a.write(H5::PredType::NATIVE_INT, values.data());
-}
-
-void dataset(H5::Group& g, const std::string& name, const std::vector<double>& v) {
-  const hsize_t n = v.size();
-  g.createDataSet(name, H5::PredType::NATIVE_DOUBLE, H5::DataSpace(1, &n)).write(v.data(), H5::PredType::NATIVE_DOUBLE);
-}
-void dataset(H5::Group& g, const std::string& name, const std::vector<std::vector<double>>& rows) {
-  const hsize_t dims[2] = {rows.size(), rows.empty() ? 0 : rows.front().size()};
-  std::vector<double> flat;
-  for (const auto& r : rows) flat.insert(flat.end(), r.begin(), r.end());
-  g.createDataSet(name, H5::PredType::NATIVE_DOUBLE, H5::DataSpace(2, dims)).write(flat.data(), H5::PredType::NATIVE_DOUBLE);
+std::string metric_unit(const std::string& metric, std::string_view unit) {
+  return metric == "err_vel_final" ? std::string(unit) + "/s" : std::string(unit);
 }
 
 void write_reference(H5::Group& parent, const reference_check& ref, const std::string& truth_source, int dim) {
+  H5::Group g = parent.createGroup(ref.source);
+  attr(g, "status", ref.status);
+  attr(g, "reason", ref.reason);
+  attr(g, "is_truth", static_cast<int>(ref.source == truth_source));
   const auto& sol = ref.solution;
-  H5::Group g = parent.createGroup(sol.source);
-  const auto& y = sol.y.back();
-  dataset(g, "position", std::vector<double>(y.begin(), y.begin() + dim));
-  dataset(g, "velocity", std::vector<double>(y.begin() + dim, y.end()));
-  dataset(g, "state", sol.y);  // [x; v] at the problem's sample_times
+  if (ref.status != "failed" && !sol.y.empty()) {
+    const auto& y = sol.y.back();
+    h5::dataset(g, "position", std::vector<double>(y.begin(), y.begin() + dim));
+    h5::dataset(g, "velocity", std::vector<double>(y.begin() + dim, y.end()));
+    h5::dataset(g, "state", sol.y);  // [x; v] at the problem's sample_times
+  }
   attr(g, "steps", sol.stats.steps);
   attr(g, "failed_steps", sol.stats.failed_steps);
   attr(g, "rhs_evals", sol.stats.rhs_evals);
@@ -139,62 +55,144 @@ void write_reference(H5::Group& parent, const reference_check& ref, const std::s
   attr(g, "atol", sol.stats.atol);
   attr(g, "wall_seconds", sol.stats.wall_seconds);
   attr(g, "compared_with", ref.compared_with);
-  attr(g, "err_pos_rel", ref.vs.pos_rel);
-  attr(g, "err_vel_rel", ref.vs.vel_rel);
-  attr(g, "is_truth", static_cast<int>(sol.source == truth_source));
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  attr(g, "err_pos_rel", ref.compared_with.empty() ? nan : ref.vs.pos_rel);
+  attr(g, "err_vel_rel", ref.compared_with.empty() ? nan : ref.vs.vel_rel);
 }
 
-void write_fit(H5::Group& g, const fit_result& fit) {
-  attr(g, "observed_order", fit.order);
-  attr(g, "fit_status", to_string(fit.state));
+void write_method(H5::Group& parent, const method_study& ms, bool timed) {
+  H5::Group g = parent.createGroup(ms.info.name);
+  const auto& info = ms.info;
+  attr(g, "origin", std::string(to_string(info.origin)));
+  attr(g, "kind", std::string(to_string(info.kind)));
+  attr(g, "param_kind", std::string(param_name(info.kind)));
+  attr(g, "declared_order", info.declared_order);
+  attr(g, "description", info.description);
+  attr(g, "library", info.library);
+  attr(g, "symplectic", static_cast<int>(info.traits.symplectic));
+  attr(g, "reuses_last_force", static_cast<int>(info.traits.reuses_last_force));
+  attr(g, "needs_jacobian", static_cast<int>(info.traits.needs_jacobian));
+  attr(g, "error_estimate", static_cast<int>(info.traits.error_estimate));
+  attr(g, "dense_output", static_cast<int>(info.traits.dense_output));
+  // The fit: observed order against dt for fixed-step methods; for adaptive ones the
+  // slope of the error against the tolerance (1: the error follows the tolerance).
+  attr(g, "fit_status", to_string(ms.fit.state));
   attr(g, "fit_metric", "err_pos_max");
-  attr(g, "fit_levels", fit.levels);
-  attr(g, "fit_residual_log10", fit.residual);
-  attr(g, "fit_note", fit.note);
-}
+  attr(g, "fit_param", std::string(param_name(info.kind)));
+  attr(g, "fit_slope", ms.fit.order);
+  attr(g, "observed_order",
+       info.kind == method_kind::fixed_step ? ms.fit.order : std::numeric_limits<double>::quiet_NaN());
+  attr(g, "fit_levels", ms.fit.levels);
+  attr(g, "fit_residual_log10", ms.fit.residual);
+  attr(g, "fit_note", ms.fit.note);
+  attr(g, "exact_for_problem", static_cast<int>(ms.fit.state == fit_result::status::exact));
+  attr(g, "declared_order_holds", ms.declared_order_holds);
 
-void write_integrator(H5::Group& parent, const integrator_study& is, bool timed) {
-  H5::Group g = parent.createGroup(is.info.name);
-  attr(g, "expected_order", is.info.order);
-  attr(g, "exact_for_problem", static_cast<int>(is.fit.state == fit_result::status::exact));
-  write_fit(g, is.fit);
-  attr(g, "description", is.info.description);
-  std::vector<convergence_record> rows;
-  for (const auto& r : is.rows) {
-    const auto& m = r.metrics;
-    rows.push_back({r.dt, r.steps, r.force_evals, m.err_pos_final, m.err_vel_final, m.err_pos_max, m.err_pos_rms,
-                    m.energy_drift, m.energy_err_max, static_cast<std::int8_t>(m.diverged), r.time.time_ns,
-                    r.time.repetitions, static_cast<std::int8_t>(r.time.cut)});
+  h5::table t;
+  auto col = [&](auto get) {
+    using T = decltype(get(ms.rows.front()));
+    std::vector<T> v;
+    for (const auto& r : ms.rows) v.push_back(get(r));
+    return v;
+  };
+  t.add("param", col([](const method_row& r) { return r.param; }));
+  t.add("steps", col([](const method_row& r) { return std::int64_t{r.steps}; }));
+  t.add("rejected_steps", col([](const method_row& r) { return std::int64_t{r.rejected_steps}; }));
+  t.add("force_evals", col([](const method_row& r) { return std::int64_t{r.work.force_evals}; }));
+  t.add("jacobian_evals", col([](const method_row& r) { return std::int64_t{r.work.jacobian_evals}; }));
+  t.add("newton_iterations", col([](const method_row& r) { return std::int64_t{r.work.newton_iterations}; }));
+  t.add("linear_solves", col([](const method_row& r) { return std::int64_t{r.work.linear_solves}; }));
+  t.add("err_pos_final", col([](const method_row& r) { return r.metrics.err_pos_final; }));
+  t.add("err_vel_final", col([](const method_row& r) { return r.metrics.err_vel_final; }));
+  t.add("err_pos_max", col([](const method_row& r) { return r.metrics.err_pos_max; }));
+  t.add("err_pos_rms", col([](const method_row& r) { return r.metrics.err_pos_rms; }));
+  t.add("energy_drift", col([](const method_row& r) { return r.metrics.energy_drift; }));
+  t.add("energy_err_max", col([](const method_row& r) { return r.metrics.energy_err_max; }));
+  t.add("diverged", col([](const method_row& r) { return static_cast<std::int8_t>(r.metrics.diverged); }));
+  t.add("failed", col([](const method_row& r) { return static_cast<std::int8_t>(r.metrics.failed); }));
+  t.add("note", col([](const method_row& r) { return r.metrics.note; }));
+  // Timing fields only in a timed study, so an untimed file does not carry columns of
+  // NaN that a reader could mistake for measurements.
+  if (timed) {
+    t.add("time_ns", col([](const method_row& r) { return r.time.time_ns; }));
+    t.add("time_ns_min", col([](const method_row& r) { return r.time.time_ns_min; }));
+    t.add("time_ns_max", col([](const method_row& r) { return r.time.time_ns_max; }));
+    t.add("repetitions", col([](const method_row& r) { return std::int64_t{r.time.repetitions}; }));
+    t.add("cut", col([](const method_row& r) { return static_cast<std::int8_t>(r.time.cut); }));
   }
-  const hsize_t n = rows.size();
-  const auto memory_type = convergence_type(timed);
-  H5::CompType file_type;  // a copy (H5Tcopy): CompType's copy constructor shares the id
-  file_type.copy(memory_type);
-  file_type.pack();
-  g.createDataSet("convergence", file_type, H5::DataSpace(1, &n)).write(rows.data(), memory_type);
+  t.write(g, "runs");
 }
 
-void write_peer(H5::Group& parent, const peer_study& ps) {
-  H5::Group g = parent.createGroup(ps.name);
-  attr(g, "kind", ps.kind);
-  attr(g, "description", ps.description);
-  attr(g, "declared_order", ps.declared_order);
-  write_fit(g, ps.fit);
-  std::vector<peer_record> rows;
-  for (const auto& r : ps.rows)
-    rows.push_back({r.param, r.steps, r.force_evals, r.err_pos_final, r.err_pos_max, static_cast<std::int8_t>(r.diverged),
-                    r.time.time_ns, r.time.repetitions, static_cast<std::int8_t>(r.time.cut)});
-  const hsize_t n = rows.size();
-  const auto memory_type = peer_type();
-  H5::CompType file_type;  // a copy (H5Tcopy): CompType's copy constructor shares the id
-  file_type.copy(memory_type);
-  file_type.pack();
-  g.createDataSet("work_precision", file_type, H5::DataSpace(1, &n)).write(rows.data(), memory_type);
+// The equal-error table: for each metric and target, every method that reaches it with
+// its cheapest qualifying row, ranked (core/work_precision.hpp).
+void write_equal_error(H5::Group& g, const problem_study& ps, bool timed) {
+  std::vector<std::string> metric, method, origin, cost_kind, kind;
+  std::vector<double> target, param, error, cost, time_ns, force_evals;
+  std::vector<std::int64_t> rank;
+  std::vector<std::int8_t> is_answer;
+  for (const char* m : {"err_pos_max", "err_pos_final"}) {
+    const auto methods = work_precision_input(ps, m);
+    for (double tgt : equal_error_targets()) {
+      const auto r = cheapest(methods, tgt, timed, m, metric_unit(m, ps.problem->position_unit()));
+      const auto answer = r.answer(methods);
+      for (std::size_t k = 0; k < r.ranked.size(); ++k) {
+        const auto& p = r.ranked[k];
+        const auto& wm = methods[p.method];
+        const auto& row = wm.rows[p.row];
+        metric.emplace_back(m);
+        target.push_back(tgt);
+        rank.push_back(static_cast<std::int64_t>(k + 1));
+        method.push_back(wm.name);
+        origin.emplace_back(to_string(wm.origin));
+        kind.emplace_back(to_string(wm.kind));
+        param.push_back(row.param);
+        error.push_back(row.error);
+        cost_kind.push_back(r.cost);
+        cost.push_back(p.cost);
+        time_ns.push_back(row.time_ns);
+        force_evals.push_back(row.force_evals);
+        is_answer.push_back(static_cast<std::int8_t>(answer && answer->method == p.method));
+      }
+    }
+  }
+  h5::table t;
+  t.add("metric", metric);
+  t.add("target", target);
+  t.add("rank", rank);
+  t.add("method", method);
+  t.add("origin", origin);
+  t.add("kind", kind);
+  t.add("param", param);
+  t.add("error", error);
+  t.add("cost_kind", cost_kind);
+  t.add("cost", cost);
+  t.add("time_ns", time_ns);
+  t.add("force_evals", force_evals);
+  t.add("is_answer", is_answer);
+  t.write(g, "equal_error");
 }
 
-void write_problem(H5::H5File& file, const problem_study& ps, bool timed) {
+void write_front(H5::Group& g, const problem_study& ps, bool by_time, bool timed) {
+  const auto methods = work_precision_input(ps, "err_pos_max");
+  std::vector<std::string> method;
+  std::vector<double> param, cost, error;
+  for (const auto& p : pareto_front(methods, by_time, timed)) {
+    method.push_back(methods[p.method].name);
+    param.push_back(methods[p.method].rows[p.row].param);
+    cost.push_back(p.cost);
+    error.push_back(p.error);
+  }
+  h5::table t;
+  t.add("method", method);
+  t.add("param", param);
+  t.add("cost", cost);
+  t.add("err_pos_max", error);
+  t.write(g, by_time ? "front_time" : "front_force_evals");
+}
+
+void write_problem(H5::Group& parent, const problem_study& ps, bool timed) {
   const auto& p = *ps.problem;
-  H5::Group g = file.createGroup(std::string(p.name()));
+  H5::Group g = parent.createGroup(std::string(p.name()));
   for (const auto& param : p.params()) attr(g, param.name, param.value);
   attr(g, "horizon", ps.horizon);
   attr(g, "dim", p.dim());
@@ -202,21 +200,47 @@ void write_problem(H5::H5File& file, const problem_study& ps, bool timed) {
   attr(g, "description", std::string(p.description()));
   attr(g, "has_closed_form", static_cast<int>(p.has_closed_form()));
   attr(g, "has_energy", static_cast<int>(p.has_energy()));
+  attr(g, "has_jacobian", static_cast<int>(p.has_jacobian()));
   attr(g, "truth_source", ps.truth.source);
+  attr(g, "truth_trusted", static_cast<int>(ps.truth.trusted));
+  attr(g, "truth_note", ps.truth.note);
+  attr(g, "agreement_limit", ps.truth.agreement_limit);
   attr(g, "pos_scale", ps.truth.pos_scale);
   attr(g, "vel_scale", ps.truth.vel_scale);
   attr(g, "energy_scale", ps.truth.energy_scale);
-  dataset(g, "sample_times", ps.truth.times);
-  dataset(g, "truth_state", ps.truth.y);
+  h5::dataset(g, "sample_times", ps.truth.times);
+  h5::dataset(g, "truth_state", ps.truth.y);
   H5::Group refs = g.createGroup("reference");
   for (const auto& ref : ps.truth.references) write_reference(refs, ref, ps.truth.source, p.dim());
-  for (const auto& is : ps.integrators) write_integrator(g, is, timed);
-  for (const auto& peer : ps.peers) write_peer(g, peer);
+  H5::Group methods = g.createGroup("methods");
+  for (const auto& ms : ps.methods) write_method(methods, ms, timed);
+  write_equal_error(g, ps, timed);
+  write_front(g, ps, false, timed);
+  if (timed) write_front(g, ps, true, timed);
 }
 
 std::string temp_path_for(const std::string& path) { return fmt::format("{}.tmp.{}", path, ::getpid()); }
 
 }  // namespace
+
+std::vector<double> equal_error_targets() {
+  std::vector<double> out;
+  for (int e = 2; e <= 12; ++e) out.push_back(std::pow(10.0, -e));
+  return out;
+}
+
+std::vector<wp_method> work_precision_input(const problem_study& ps, const std::string& metric) {
+  std::vector<wp_method> out;
+  for (const auto& ms : ps.methods) {
+    wp_method m{ms.info.name, ms.info.origin, ms.info.kind, {}};
+    for (const auto& r : ms.rows)
+      m.rows.push_back({r.param, metric_value(r.metrics, metric), r.time.time_ns,
+                        static_cast<double>(r.work.force_evals), !r.metrics.diverged && !r.metrics.failed,
+                        r.metrics.diverged, r.time.cut});
+    out.push_back(std::move(m));
+  }
+  return out;
+}
 
 std::string cpu_model() {
   std::ifstream in("/proc/cpuinfo");
@@ -259,16 +283,19 @@ void write_study(const study& s, const std::string& path) {
     attr(file, "git_commit", build_info::git_commit);
     attr(file, "compiler", build_info::compiler);
     attr(file, "build_type", build_info::build_type);
+    attr(file, "dependencies", build_info::dependencies);
     attr(file, "created_utc", utc_now_iso8601());
     attr(file, "cpu", cpu_model());
     attr(file, "cores", static_cast<int>(std::thread::hardware_concurrency()));
     attr(file, "levels", s.options.levels);
     attr(file, "base_steps", s.options.base_steps);
     attr(file, "sample_count", s.options.sample_count);
+    attr(file, "tolerances", s.options.tolerances);
     attr(file, "reference_rtol", s.options.tol.rtol);
     attr(file, "reference_atol", s.options.tol.atol);
     attr(file, "fit_metric", "err_pos_max");
     attr(file, "divergence_factor", blowup_factor);
+    attr(file, "equal_error_targets", equal_error_targets());
     attr(file, "wall_seconds", s.wall_seconds);
     attr(file, "timing", static_cast<int>(s.timed.has_value()));
     if (s.timed) {
@@ -282,11 +309,15 @@ void write_study(const study& s, const std::string& path) {
       attr(file, "num_cpus", t.num_cpus);
       attr(file, "mhz_per_cpu", t.mhz_per_cpu);
     }
-    for (const auto& ps : s.problems) write_problem(file, ps, s.timed.has_value());
+    H5::Group problems = file.createGroup("problems");
+    for (const auto& ps : s.problems) write_problem(problems, ps, s.timed.has_value());
     file.close();
   } catch (const H5::Exception& e) {
     std::remove(tmp.c_str());
     throw std::runtime_error(fmt::format("cannot write results file '{}': HDF5: {}", path, e.getDetailMsg()));
+  } catch (...) {
+    std::remove(tmp.c_str());
+    throw;
   }
   std::error_code ec;
   std::filesystem::rename(tmp, path, ec);

@@ -2,12 +2,17 @@
 // The study file (HDF5): the public format users script against. Layout documented in
 // docs/study-format.md; bump study_format_version when it changes incompatibly.
 #include <string>
+#include <vector>
 
-#include "core/sweep.hpp"
+#include "core/work_precision.hpp"
+#include "study/sweep.hpp"
 
 namespace stepbench {
 
-inline constexpr int study_format_version = 1;
+inline constexpr int study_format_version = 2;
+
+// The targets of the equal-error table written with every problem: 1e-2 .. 1e-12.
+std::vector<double> equal_error_targets();
 
 // Throws std::runtime_error ("cannot write results file '<path>': <reason>") when the
 // path cannot be created; leaves nothing behind. Call before a long run.
@@ -16,6 +21,10 @@ void check_writable(const std::string& path);
 // Writes the study to a temporary file beside `path` and renames it into place, so an
 // existing file is replaced whole or not at all.
 void write_study(const study& s, const std::string& path);
+
+// The rows of a problem's methods in the shape the work-precision rule takes, for one
+// error metric (core/work_precision.hpp).
+std::vector<wp_method> work_precision_input(const problem_study& ps, const std::string& metric);
 
 // "Intel(R) Xeon(R) ..." from /proc/cpuinfo, or "unknown".
 std::string cpu_model();

@@ -1,7 +1,8 @@
-#include "core/sweep.hpp"
+#include "study/sweep.hpp"
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -11,28 +12,36 @@
 namespace stepbench {
 namespace {
 
-std::vector<std::string> selected(const std::vector<std::string>& chosen, std::vector<std::string> all) {
-  return chosen.empty() ? all : chosen;
+template <class T>
+bool contains(const std::vector<T>& v, const T& x) {
+  return std::find(v.begin(), v.end(), x) != v.end();
+}
+
+}  // namespace
+
+std::vector<double> tolerance_ladder(bool thinned) {
+  std::vector<double> out;
+  for (int e = 2; e <= 12; e += thinned ? 2 : 1) out.push_back(std::pow(10.0, -e));
+  return out;
 }
 
 std::unique_ptr<problem_instance> configured_problem(const std::string& name, const sweep_options& opts) {
   auto p = make_problem(name);
   if (auto it = opts.overrides.find(name); it != opts.overrides.end())
     for (const auto& [param, value] : it->second) p->set(param, value);
-  if (auto err = p->validate(); !err.empty())
-    throw std::invalid_argument(fmt::format("problem {}: {}", name, err));
+  if (auto err = p->validate(); !err.empty()) throw std::invalid_argument(fmt::format("problem {}: {}", name, err));
   return p;
 }
-
-}  // namespace
 
 void validate(const sweep_options& opts) {
   if (opts.levels < 2 || opts.levels > 20) throw std::invalid_argument("levels must be between 2 and 20");
   if (opts.base_steps < 1 || opts.sample_count < 1 || opts.base_steps % opts.sample_count != 0)
     throw std::invalid_argument("base_steps must be a positive multiple of sample_count");
   if (!(opts.tol.rtol > 0.0 && opts.tol.atol > 0.0)) throw std::invalid_argument("reference tolerances must be > 0");
-  for (const auto& name : selected(opts.integrators, {})) find_integrator(name);
-  for (const auto* names : {&opts.problems, &opts.integrators})
+  for (double tol : opts.tolerances)
+    if (!(tol > 0.0 && tol < 1.0)) throw std::invalid_argument(fmt::format("tolerance {:g} is not in (0, 1)", tol));
+  for (const auto& name : opts.methods) find_method(name);
+  for (const auto* names : {&opts.problems, &opts.methods})
     for (size_t i = 0; i < names->size(); ++i)
       for (size_t j = 0; j < i; ++j)
         if ((*names)[i] == (*names)[j]) throw std::invalid_argument(fmt::format("'{}' is named twice", (*names)[i]));
@@ -44,11 +53,18 @@ void validate(const sweep_options& opts) {
   for (const auto& [name, params] : opts.overrides) {
     auto problem = make_problem(name);  // throws, naming an unknown problem
     for (const auto& [param, value] : params) problem->set(param, value);  // throws for an unknown parameter
-    bool chosen = opts.problems.empty();
-    for (const auto& p : opts.problems) chosen = chosen || p == name;
-    if (!chosen) throw std::invalid_argument(fmt::format("--set names problem {}, which is not in the sweep", name));
+    if (!opts.problems.empty() && !contains(opts.problems, name))
+      throw std::invalid_argument(fmt::format("--set names problem {}, which is not in the sweep", name));
   }
-  for (const auto& name : selected(opts.problems, problem_names())) configured_problem(name, opts);
+  const auto names = opts.problems.empty() ? problem_names() : opts.problems;
+  for (const auto& name : names) configured_problem(name, opts);
+  // A method named explicitly must run on at least one selected problem.
+  for (const auto& m : opts.methods) {
+    bool runs = false;
+    for (const auto& name : names)
+      for (const auto& info : make_problem(name)->methods()) runs = runs || info.name == m;
+    if (!runs) throw std::invalid_argument(fmt::format("method {} runs on none of the selected problems", m));
+  }
 }
 
 std::vector<double> dt_ladder(double horizon, const sweep_options& opts) {
@@ -57,46 +73,69 @@ std::vector<double> dt_ladder(double horizon, const sweep_options& opts) {
   return out;
 }
 
+std::vector<double> param_ladder(const method_info& m, double horizon, const sweep_options& opts) {
+  return m.kind == method_kind::fixed_step ? dt_ladder(horizon, opts) : opts.tolerances;
+}
+
+void fit_rows(method_study& ms, double pos_scale) {
+  fit_input fit;
+  fit.scale = pos_scale;
+  for (const auto& row : ms.rows) {
+    fit.dt.push_back(row.param);
+    fit.error.push_back(row.metrics.err_pos_max);
+    fit.steps.push_back(row.steps);
+    fit.diverged.push_back(row.metrics.diverged || row.metrics.failed);
+  }
+  ms.fit = fit_order(fit);
+  ms.declared_order_holds =
+      ms.info.kind == method_kind::fixed_step ? declared_order_holds(ms.info.declared_order, ms.fit) : -1;
+}
+
+method_study run_method(const problem_study& ps, const method_info& m, const sweep_options& opts) {
+  method_study ms;
+  ms.info = m;
+  for (double param : param_ladder(m, ps.horizon, opts)) {
+    const run_result run = ps.problem->run(m.name, param, ps.horizon, ps.truth.times);
+    method_row row{param, run.steps, run.rejected_steps, run.work, measure(*ps.problem, run, ps.truth), {}};
+    ms.rows.push_back(std::move(row));
+  }
+  fit_rows(ms, ps.truth.pos_scale);
+  return ms;
+}
+
 study run_sweep(const sweep_options& opts) {
   validate(opts);
   const auto start = std::chrono::steady_clock::now();
   study out;
   out.options = opts;
-  std::vector<std::string> integrator_names;
-  for (const auto& i : integrators()) integrator_names.push_back(i.name);
-  integrator_names = selected(opts.integrators, integrator_names);
-
-  for (const auto& name : selected(opts.problems, problem_names())) {
+  for (const auto& name : opts.problems.empty() ? problem_names() : opts.problems) {
+    const auto t0 = std::chrono::steady_clock::now();
     problem_study ps;
     ps.problem = configured_problem(name, opts);
     ps.horizon = ps.problem->horizon();
-    std::vector<double> times;
-    for (int j = 1; j <= opts.sample_count; ++j)
-      times.push_back(j == opts.sample_count ? ps.horizon : ps.horizon * j / opts.sample_count);
-    ps.truth = build_truth(*ps.problem, times, {.tol = opts.tol});
-
-    const auto ladder = dt_ladder(ps.horizon, opts);
-    for (const auto& iname : integrator_names) {
-      integrator_study is;
-      is.info = find_integrator(iname);
-      fit_input fit;
-      fit.scale = ps.truth.pos_scale;
-      for (double dt : ladder) {
-        const auto steps = sample_steps(ps.horizon, dt, opts.sample_count);
-        const run_result run = ps.problem->run(iname, dt, ps.horizon, steps);
-        convergence_row row{dt, run.steps, run.force_evals, measure(*ps.problem, run, ps.truth), {}};
-        fit.dt.push_back(dt);
-        fit.error.push_back(row.metrics.err_pos_max);
-        fit.steps.push_back(run.steps_planned);
-        fit.diverged.push_back(row.metrics.diverged);
-        is.rows.push_back(std::move(row));
-      }
-      is.fit = fit_order(fit);
-      ps.integrators.push_back(std::move(is));
-    }
+    ps.truth = build_truth(*ps.problem, sample_times(ps.horizon, opts.sample_count), {.tol = opts.tol});
+    for (const auto& r : ps.truth.references)
+      if (r.status != "ok")
+        std::fprintf(stderr, "warning: %s: reference %s %s: %s\n", name.c_str(), r.source.c_str(), r.status.c_str(),
+                     r.reason.c_str());
+    if (!ps.truth.trusted)
+      std::fprintf(stderr, "warning: %s: no trusted truth (%s); its errors are recorded as NaN\n", name.c_str(),
+                   ps.truth.note.c_str());
+    for (const auto& m : ps.problem->methods())
+      if (opts.methods.empty() || contains(opts.methods, m.name)) ps.methods.push_back(run_method(ps, m, opts));
+    if (opts.progress)
+      std::fprintf(stderr, "swept %-22s %3zu methods in %.2f s\n", name.c_str(), ps.methods.size(),
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     out.problems.push_back(std::move(ps));
   }
   out.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+std::vector<std::string> untrusted_problems(const study& s) {
+  std::vector<std::string> out;
+  for (const auto& ps : s.problems)
+    if (!ps.truth.trusted) out.emplace_back(ps.problem->name());
   return out;
 }
 

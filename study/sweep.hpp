@@ -1,78 +1,70 @@
 #pragma once
-// The convergence sweep: every selected (problem, integrator) over a halving ladder of
-// timesteps, measured against the truth, with the observed order fitted.
+// The study: every selected method (ours, the peers, the baseline) on every selected
+// problem, over a halving ladder of timesteps (fixed-step methods) or a ladder of
+// tolerances (adaptive ones), each run measured against the truth by the same code,
+// with the observed order fitted. The benchmark adds timings to these rows.
 #include <limits>
 #include <map>
-#include <optional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/convergence_fit.hpp"
 #include "core/measure.hpp"
-#include "core/registry.hpp"
+#include "core/method.hpp"
+#include "study/registry.hpp"
 
 namespace stepbench {
 
+// Relative tolerances of the adaptive methods: 1e-2 .. 1e-12 (every other one when
+// `thinned`).
+std::vector<double> tolerance_ladder(bool thinned = false);
+
 struct sweep_options {
-  std::vector<std::string> problems;     // empty: all
-  std::vector<std::string> integrators;  // empty: all
+  std::vector<std::string> problems;  // empty: all
+  std::vector<std::string> methods;   // empty: all that run on each problem
   // Parameter overrides per problem: overrides["pendulum"]["theta0_deg"] = 30.
   std::map<std::string, std::map<std::string, double>> overrides;
-  int levels = 12;       // ladder length (at least 8 for the default study)
+  int levels = 12;       // dt ladder length (at least 8 for the default study)
   int base_steps = 32;   // steps at the coarsest level; dt_k = T / (base_steps 2^k)
   int sample_count = 32; // fixed sample times j T / sample_count; must divide base_steps
+  std::vector<double> tolerances = tolerance_ladder();
   reference_tolerances tol{};
+  bool progress = false;  // one line per problem on stderr
 };
 
 // Wall time of one whole run, from the benchmark (absent unless timed).
 struct timing {
-  double time_ns = std::numeric_limits<double>::quiet_NaN();  // median over repetitions
+  double time_ns = std::numeric_limits<double>::quiet_NaN();      // median over repetitions
+  double time_ns_min = std::numeric_limits<double>::quiet_NaN();  // fastest repetition
+  double time_ns_max = std::numeric_limits<double>::quiet_NaN();  // slowest repetition
   long repetitions = 0;
   bool cut = false;  // skipped by the per-case time budget
 };
 
-struct convergence_row {
-  double dt = 0.0;
+// One run of one method at one parameter: the single row shape of the study.
+struct method_row {
+  double param = 0.0;  // dt [s] or relative tolerance
   long steps = 0;
-  long force_evals = 0;
+  long rejected_steps = 0;
+  work_counters work{};
   run_metrics metrics;
   timing time;
 };
 
-// A peer: what a user might use instead of our methods (GSL, CVODE, Boost.Odeint, a
-// hand-inlined loop), run on the same problem and measured against the same truth.
-struct peer_row {
-  double param = 0.0;  // dt for fixed-step peers, relative tolerance for adaptive ones
-  long steps = 0;
-  long force_evals = 0;
-  double err_pos_final = 0.0;
-  double err_pos_max = 0.0;
-  bool diverged = false;
-  timing time;
-};
-
-struct peer_study {
-  std::string name;
-  std::string kind;  // "fixed_step" or "adaptive"
-  std::string description;
-  double declared_order = std::numeric_limits<double>::quiet_NaN();
-  std::vector<peer_row> rows;
-  fit_result fit;  // fixed-step peers only
-};
-
-struct integrator_study {
-  integrator_info info;
-  std::vector<convergence_row> rows;
-  fit_result fit;
+struct method_study {
+  method_info info;
+  std::vector<method_row> rows;
+  fit_result fit;  // against dt (fixed-step) or against the tolerance (adaptive)
+  int declared_order_holds = -1;  // see core/convergence_fit.hpp
 };
 
 struct problem_study {
   std::unique_ptr<problem_instance> problem;
   double horizon = 0.0;
   truth_table truth;
-  std::vector<integrator_study> integrators;
-  std::vector<peer_study> peers;
+  std::vector<method_study> methods;
 };
 
 // How the timings were taken (present only when the study was timed).
@@ -100,7 +92,23 @@ void validate(const sweep_options& opts);
 
 // The ladder's timesteps for a horizon.
 std::vector<double> dt_ladder(double horizon, const sweep_options& opts);
+// The ladder of a method: dts or tolerances.
+std::vector<double> param_ladder(const method_info& m, double horizon, const sweep_options& opts);
+
+// The problem with its overrides applied and checked.
+std::unique_ptr<problem_instance> configured_problem(const std::string& name, const sweep_options& opts);
+
+// Runs one method over its ladder on a problem whose truth is built, measures every
+// row and fits the order.
+method_study run_method(const problem_study& ps, const method_info& m, const sweep_options& opts);
+
+// Fits the observed order (or, for adaptive methods, the slope of error against the
+// tolerance) from the rows, and checks it against the declared order.
+void fit_rows(method_study& ms, double pos_scale);
 
 study run_sweep(const sweep_options& opts);
+
+// Problems whose truth is not trusted (no closed form, no two references agreeing).
+std::vector<std::string> untrusted_problems(const study& s);
 
 }  // namespace stepbench

@@ -38,8 +38,13 @@ import json, sys
 d = json.load(sys.stdin)
 names = {p["name"] for p in d["problems"]}
 assert names == {"constant_acceleration", "projectile", "damped_spring", "pendulum"}, names
-orders = {i["name"]: i["expected_order"] for i in d["integrators"]}
+orders = {m["name"]: m["declared_order"] for m in d["methods"] if m["origin"] == "ours" and m["kind"] == "fixed_step"}
 assert orders == {"euler": 1, "semi_implicit_euler": 1, "midpoint": 2, "rk4": 4, "momentum": 1, "velocity_verlet": 2}, orders
+origins = {m["name"]: m["origin"] for m in d["methods"]}
+assert origins["baseline_rk4"] == "baseline" and origins["gsl_rk4"] == "peer" and origins["cvode_bdf"] == "peer", origins
+caps = {m["name"]: m["capabilities"] for m in d["methods"]}
+assert caps["velocity_verlet"]["symplectic"] and caps["velocity_verlet"]["reuses_last_force"], caps
+assert not caps["rk4"]["symplectic"] and caps["cvode_bdf"]["error_estimate"], caps
 ' && ok || bad "list --json"
 
 # A parameter override changes the answer as the closed form says: 20 N gives 1000 m.
@@ -48,7 +53,7 @@ assert orders == {"euler": 1, "semi_implicit_euler": 1, "midpoint": 2, "rk4": 4,
 
 # Bad input.
 expect_error "unknown problem 'nope'" run --problem nope --integrator rk4 --dt 0.1
-expect_error "unknown integrator 'rk5'" run --problem pendulum --integrator rk5 --dt 0.1
+expect_error "unknown method 'rk5'" run --problem pendulum --integrator rk5 --dt 0.1
 expect_error "--dt must be > 0" run --problem pendulum --integrator rk4 --dt 0
 expect_error "--dt must be > 0" run --problem pendulum --integrator rk4 --dt -1
 expect_error "--dt must be a finite number, got 'abc'" run --problem pendulum --integrator rk4 --dt abc
@@ -63,7 +68,7 @@ expect_error "unknown parameter 'k' for problem pendulum" run --problem pendulum
 expect_error "theta0_deg must be in (0, 180)" run --problem pendulum --integrator rk4 --dt 0.1 --set theta0_deg=200
 expect_error "--problem is required" run --integrator rk4 --dt 0.1
 expect_error "unknown problem 'nope'" sweep --problem nope --out "$work/s.h5"
-expect_error "unknown integrator 'rk5'" sweep --integrator rk5 --out "$work/s.h5"
+expect_error "unknown method 'rk5'" sweep --integrator rk5 --out "$work/s.h5"
 expect_error "cannot write results file '$work/missing/s.h5'" sweep --levels 3 --out "$work/missing/s.h5"
 expect_error "it is a directory" sweep --levels 3 --out "$work"
 
@@ -78,7 +83,7 @@ expect_error "levels must be between 2 and 20" sweep --levels 1 --out "$work/stu
 "$bin" sweep --problem damped_spring --integrator rk4 --levels 3 --quiet --out "$work/study.h5" >/dev/null || bad "small sweep failed"
 head -c 4 "$work/study.h5" | grep -q HDF && ok || bad "study file is not HDF5"
 # h5dump (hdf5-tools) reads it: the compound convergence table with its documented fields.
-h5dump -d /damped_spring/rk4/convergence "$work/study.h5" >"$work/dump" 2>&1 &&
+h5dump -d /problems/damped_spring/methods/rk4/runs "$work/study.h5" >"$work/dump" 2>&1 &&
   grep -q '"err_pos_max"' "$work/dump" && grep -q '"diverged"' "$work/dump" && ok || bad "h5dump cannot read the study file"
 
 echo "cli: $passes passed, $fails failed"

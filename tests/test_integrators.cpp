@@ -8,6 +8,10 @@
 
 using namespace stepbench;
 
+namespace {
+constexpr std::span<const record_point> no_records{};
+}
+
 // Force evaluations of n steps: explicit methods pay their stage count every step;
 // velocity Verlet reuses a_{n+1} when the force ignores the velocity (n + 1), and
 // cannot when it does not (2 n).
@@ -16,7 +20,7 @@ TEST(integrators, force_evaluations_per_step) {
   const pendulum pend;
   const long n = 100;
   auto evals = [&](auto method, const auto& problem) {
-    return drive(problem, method, problem.horizon() / n, problem.horizon(), std::span<const long>{}).force_evals;
+    return drive(problem, method, problem.horizon() / n, problem.horizon(), no_records).work.force_evals;
   };
   EXPECT_EQ(evals(euler{}, spring), n);
   EXPECT_EQ(evals(semi_implicit_euler{}, spring), n);
@@ -36,10 +40,12 @@ TEST(integrators, one_step_matches_taylor_series_to_order) {
   p.k_d = 0.0;
   const double dt = 1e-2;
   for_each_type(all_integrators{}, [&]<class I>() {
-    const auto s = drive(p, I{}, dt, dt, std::span<const long>{}).final_state;
-    const double err = std::abs(s.x[0] - std::cos(dt)) + std::abs(s.v[0] + std::sin(dt));
-    EXPECT_LT(err, 2.0 * std::pow(dt, I::order + 1)) << I::name;
-    EXPECT_GT(err, 1e-3 * std::pow(dt, I::order + 2)) << I::name << " is suspiciously better than its order";
+    if constexpr (integrator<I>) {
+      const auto s = drive(p, I{}, dt, dt, no_records).final_state;
+      const double err = std::abs(s.x[0] - std::cos(dt)) + std::abs(s.v[0] + std::sin(dt));
+      EXPECT_LT(err, 2.0 * std::pow(dt, I::order + 1)) << I::name;
+      EXPECT_GT(err, 1e-3 * std::pow(dt, I::order + 2)) << I::name << " is suspiciously better than its order";
+    }
   });
 }
 
@@ -48,27 +54,56 @@ TEST(drive, steps_and_last_step_land_on_the_horizon) {
   EXPECT_EQ(steps_for(10.0, 3.0), 4);  // 3 + 3 + 3 + 1
   EXPECT_EQ(steps_for(1.0, 0.1), 10);  // 1.0 / 0.1 = 10.000000000000002 must not add a sliver
   const constant_acceleration p;
-  const auto r = drive(p, euler{}, 3.0, 10.0, std::span<const long>{});
+  const auto r = drive(p, euler{}, 3.0, 10.0, no_records);
   EXPECT_EQ(r.steps, 4);
   EXPECT_DOUBLE_EQ(r.t_final, 10.0);
   // Euler with steps 3, 3, 3, 1 under a = 10: x = sum v_i h_i = 0*3 + 30*3 + 60*3 + 90*1.
   EXPECT_DOUBLE_EQ(r.final_state.x[0], 360.0);
 }
 
-TEST(drive, sample_steps_hit_fixed_fractions) {
-  const auto s = sample_steps(10.0, 10.0 / 64, 32);
+TEST(drive, nearest_grid_times_hit_fixed_fractions) {
+  const auto s = nearest_grid_times(10.0, 10.0 / 64, 32);
   ASSERT_EQ(s.size(), 32u);
-  EXPECT_EQ(s.front(), 2);
-  EXPECT_EQ(s.back(), 64);
-  const auto few = sample_steps(10.0, 1.0, 32);  // fewer steps than samples: every step once
+  EXPECT_DOUBLE_EQ(s.front(), 2 * 10.0 / 64);
+  EXPECT_EQ(s.back(), 10.0);
+  const auto few = nearest_grid_times(10.0, 1.0, 32);  // fewer steps than samples: every step once
   EXPECT_EQ(few.size(), 10u);
+}
+
+// A record time on the grid is reached by its step (the run is unchanged by where it is
+// measured); one off the grid splits the step that contains it, so the state there is
+// recorded exactly at that time and the grid after it is the same.
+TEST(drive, record_plan_on_and_off_the_grid) {
+  const std::vector<double> times{2.0, 2.5, 10.0};
+  const auto plan = plan_records(10.0, 1.0, times);
+  ASSERT_EQ(plan.size(), 3u);
+  EXPECT_TRUE(plan[0].on_grid);
+  EXPECT_EQ(plan[0].step, 2);
+  EXPECT_FALSE(plan[1].on_grid);
+  EXPECT_EQ(plan[1].step, 3);
+  EXPECT_TRUE(plan[2].on_grid);
+  EXPECT_EQ(plan[2].step, 10);
+  // Explicit Euler under a = 10 from rest: x(2) = 0 + 10 (v = 10 over the second
+  // step); the step [2, 3] is split at 2.5, and x(2.5) = 10 + 0.5 * v(2) = 10 + 10.
+  const constant_acceleration p;
+  const auto r = drive(p, euler{}, 1.0, 10.0, plan);
+  ASSERT_EQ(r.sample_t.size(), 3u);
+  EXPECT_DOUBLE_EQ(r.sample_t[1], 2.5);
+  EXPECT_DOUBLE_EQ(r.samples(0, 0), 10.0);        // x(2): 0 + 10
+  EXPECT_DOUBLE_EQ(r.samples(0, 1), 10.0 + 10.0);  // + v(2) 0.5 = 20 * 0.5
+  EXPECT_EQ(r.steps, 10);                           // grid steps; the split step counts once
+  EXPECT_EQ(r.work.force_evals, 11);                // one evaluation more for the split
+  // Record times must increase within (0, horizon].
+  EXPECT_THROW(plan_records(10.0, 1.0, std::vector<double>{2.0, 1.0}), std::invalid_argument);
+  EXPECT_THROW(plan_records(10.0, 1.0, std::vector<double>{11.0}), std::invalid_argument);
+  EXPECT_THROW(plan_records(10.0, 1.0, std::vector<double>{0.0}), std::invalid_argument);
 }
 
 TEST(drive, non_finite_state_stops_the_run) {
   damped_spring p;
   p.k_s = 1e200;  // explicit Euler overflows within a few steps
-  const std::vector<long> record{1, 2, 3, 4, 5, 6, 7, 8, 9, 10};
-  const auto r = drive(p, euler{}, 1.0, 10.0, record);
+  const std::vector<double> times{1, 2, 3, 4, 5, 6, 7, 8, 9, 10};
+  const auto r = drive(p, euler{}, 1.0, 10.0, plan_records(10.0, 1.0, times));
   EXPECT_TRUE(r.non_finite);
   EXPECT_LT(r.steps, 10);
 }

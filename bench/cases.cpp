@@ -1,0 +1,100 @@
+#include "bench/cases.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "core/statistics.hpp"
+
+namespace stepbench::bench {
+
+void case_book::register_all(study& s) {
+  for (auto& ps : s.problems) {
+    const std::string pname(ps.problem->name());
+    for (auto& ms : ps.methods) {
+      const bool fixed = ms.info.kind == method_kind::fixed_step;
+      for (auto& row : ms.rows) {
+        if (row.metrics.diverged || row.metrics.failed) continue;
+        auto c = std::make_unique<timed_case>();
+        c->name = fmt::format("{}/{}/{}:{:.6g}", pname, ms.info.name, fixed ? "dt" : "tol", row.param);
+        c->family = pname + "/" + ms.info.name;
+        c->row = &row;
+        if (!by_name_.emplace(c->name, c.get()).second)
+          throw std::logic_error("two benchmark cases would share the name " + c->name);
+        const std::function<double()> run =
+            ps.problem->timed_run(ms.info.name, row.param, ps.horizon, ps.truth.times);
+        timed_case* tc = c.get();
+        const auto& m = row.metrics;
+        const long steps = row.steps;
+        const work_counters work = row.work;
+        const long rejected = row.rejected_steps;
+        benchmark::RegisterBenchmark(c->name.c_str(), [this, tc, run, m, steps, work, rejected](benchmark::State& state) {
+          if (over_budget(*tc)) {
+            state.SkipWithError("cut: the previous case of this family used over half the per-case time budget");
+            return;
+          }
+          const auto start = std::chrono::steady_clock::now();
+          for (auto _ : state) benchmark::DoNotOptimize(run());
+          const double ns = std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - start).count() /
+                            static_cast<double>(std::max<benchmark::IterationCount>(1, state.iterations()));
+          record(*tc, ns);
+          state.counters["err_pos_final"] = m.err_pos_final;
+          state.counters["err_pos_max"] = m.err_pos_max;
+          state.counters["steps"] = static_cast<double>(steps);
+          state.counters["force_evals"] = static_cast<double>(work.force_evals);
+          if (rejected) state.counters["rejected_steps"] = static_cast<double>(rejected);
+          if (work.newton_iterations) state.counters["newton_iterations"] = static_cast<double>(work.newton_iterations);
+          if (work.jacobian_evals) state.counters["jacobian_evals"] = static_cast<double>(work.jacobian_evals);
+          // Wall time per step (the case uses real time): Google Benchmark divides the
+          // elapsed time by steps x iterations (an inverted iteration-invariant rate) and
+          // prints it in seconds with an SI prefix (13.8n = 13.8 ns).
+          state.counters["time_per_step"] = benchmark::Counter(
+              static_cast<double>(std::max(1L, steps)), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+        })->Unit(benchmark::kMicrosecond)->UseRealTime();
+        cases_.push_back(std::move(c));
+      }
+    }
+  }
+}
+
+timed_case* case_book::find(const std::string& registered_name) {
+  const auto it = by_name_.find(registered_name);
+  return it == by_name_.end() ? nullptr : it->second;
+}
+
+bool case_book::over_budget(const timed_case& c) const {
+  const auto it = family_last_.find(c.family);
+  return it != family_last_.end() && it->second.first != &c && 2.0 * it->second.second > budget_s_ * 1e9;
+}
+
+void case_book::record(const timed_case& c, double ns) {
+  auto& last = family_last_[c.family];
+  last.second = last.first == &c ? std::max(last.second, ns) : ns;
+  last.first = &c;
+}
+
+void case_book::merge_into_rows() {
+  for (const auto& c : cases_) {
+    timing& t = c->row->time;
+    t = {};
+    if (!c->ns_per_run.empty()) {
+      t.time_ns = median(c->ns_per_run);
+      t.time_ns_min = *std::min_element(c->ns_per_run.begin(), c->ns_per_run.end());
+      t.time_ns_max = *std::max_element(c->ns_per_run.begin(), c->ns_per_run.end());
+      t.repetitions = static_cast<long>(c->ns_per_run.size());
+    } else {
+      t.cut = c->skipped.rfind("cut", 0) == 0;
+    }
+  }
+}
+
+bool case_book::any_timed() const {
+  for (const auto& c : cases_)
+    if (!c->ns_per_run.empty()) return true;
+  return false;
+}
+
+}  // namespace stepbench::bench

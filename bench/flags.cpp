@@ -1,0 +1,61 @@
+#include "bench/flags.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "core/parse.hpp"
+
+namespace stepbench::bench {
+
+options take_own_flags(int& argc, char** argv, std::vector<std::string>& extra) {
+  options o;
+  bool min_time_given = false, reps_given = false, budget_given = false;
+  int out = 1;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--quick") {
+      o.quick = true;
+    } else if (a.rfind("--set=", 0) == 0) {
+      const std::string assignment = a.substr(6);
+      if (assignment.find('.') == std::string::npos || assignment.find('.') > assignment.find('='))
+        throw std::invalid_argument("--set=" + assignment + ": name the problem, --set=problem.name=value");
+      add_override(o.overrides, assignment, {});
+    } else if (a == "--study_out" || a == "--case_budget" || a == "--set") {
+      throw std::invalid_argument(a + " takes its value after '=': " + a + "=VALUE");
+    } else if (a.rfind("--study_out=", 0) == 0) {
+      o.study_out = a.substr(12);
+      if (o.study_out.empty()) throw std::invalid_argument("--study_out needs a path");
+    } else if (a.rfind("--case_budget=", 0) == 0) {
+      o.case_budget_s = parse_number(a.substr(14), "--case_budget");
+      if (!(o.case_budget_s > 0)) throw std::invalid_argument("--case_budget must be > 0");
+      budget_given = true;
+    } else {
+      if (a.rfind("--benchmark_min_time=", 0) == 0) {
+        min_time_given = true;
+        o.min_time_s = parse_number(a.substr(21), "--benchmark_min_time");
+      }
+      if (a.rfind("--benchmark_repetitions=", 0) == 0) {
+        reps_given = true;
+        const double reps = parse_number(a.substr(24), "--benchmark_repetitions");
+        if (!(reps >= 1 && reps <= 1000 && reps == std::floor(reps)))
+          throw std::invalid_argument("--benchmark_repetitions must be a whole number from 1 to 1000");
+        o.repetitions = static_cast<int>(reps);
+      }
+      if (a == "--benchmark_list_tests" || a == "--benchmark_list_tests=true") o.list_only = true;
+      argv[out++] = argv[i];
+    }
+  }
+  argc = out;
+  if (o.quick) {
+    if (!min_time_given) o.min_time_s = 0.002;
+    if (!reps_given) o.repetitions = 1;
+    if (!budget_given) o.case_budget_s = 0.05;
+  }
+  if (!min_time_given) extra.push_back(fmt::format("--benchmark_min_time={}", o.min_time_s));
+  if (!reps_given) extra.push_back(fmt::format("--benchmark_repetitions={}", o.repetitions));
+  return o;
+}
+
+}  // namespace stepbench::bench

@@ -1,0 +1,29 @@
+#pragma once
+// stepbench_bench's own flags, taken out of argv before Google Benchmark sees it:
+//   --quick              short minimum time, 8-level ladder, thinned tolerances (CI)
+//   --study_out=PATH     write the study file with each timing next to its accuracy row
+//   --case_budget=S      cut a family's finer cases once one iteration would exceed S s
+//   --set=P.NAME=VALUE   a problem parameter, as `stepbench sweep --set` (repeatable)
+// Quick and full mode supply defaults for --benchmark_min_time and
+// --benchmark_repetitions unless those are given.
+#include <map>
+#include <string>
+#include <vector>
+
+namespace stepbench::bench {
+
+struct options {
+  bool quick = false;
+  std::string study_out;
+  double case_budget_s = 0.5;
+  double min_time_s = 0.025;
+  int repetitions = 3;
+  bool list_only = false;
+  std::map<std::string, std::map<std::string, double>> overrides;  // problem -> parameter -> value
+};
+
+// Removes our flags from argv (argc updated) and appends Google Benchmark flags for the
+// mode's defaults to `extra`. Throws std::invalid_argument on a malformed flag.
+options take_own_flags(int& argc, char** argv, std::vector<std::string>& extra);
+
+}  // namespace stepbench::bench

@@ -1,0 +1,78 @@
+// `stepbench advise`: the cheapest method and its dt (or tolerance) for an error, from a
+// study file (study/advise.hpp).
+#include <iostream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "cli/commands.hpp"
+#include "core/parse.hpp"
+#include "study/advise.hpp"
+
+namespace stepbench::cli {
+namespace {
+
+using json = nlohmann::json;
+
+struct advise_args {
+  std::string problem, tol_text, metric = "err_pos_max", study = "results/study.h5";
+  bool json = false;
+};
+
+json pick_json(const advice& a, const wp_pick& p) {
+  const auto& m = a.methods[p.method];
+  const auto& row = m.rows[p.row];
+  return {{"method", m.name},
+          {"origin", to_string(m.origin)},
+          {"param_name", param_name(m.kind)},
+          {"param", row.param},
+          {"force_evals", row.force_evals},
+          {"time_ns", row.time_ns},  // NaN (not timed) is written as null by nlohmann::json
+          {"error", row.error},
+          {"cost", p.cost},
+          {"diverged_rows", p.diverged_rows},
+          {"smallest_diverged", p.smallest_diverged ? json(*p.smallest_diverged) : json(nullptr)},
+          {"largest_diverged", p.largest_diverged ? json(*p.largest_diverged) : json(nullptr)}};
+}
+
+int run_advise(const advise_args& args) {
+  const double tol = parse_number(args.tol_text, "--tol");
+  if (!(tol > 0.0)) throw std::invalid_argument(fmt::format("--tol must be > 0, got {}", args.tol_text));
+  const study_data study = read_study(args.study);
+  const advice a = advise(study, args.problem, args.metric, tol);
+  const int code = a.met() ? 0 : advise_exit_no_method;
+  if (!args.json) {
+    fmt::print("{}", format_advice(a));
+    return code;
+  }
+  const auto answer = a.result.answer(a.methods);
+  json out = {{"problem", a.problem}, {"metric", a.metric}, {"tol", a.tol},  {"unit", a.unit},
+              {"cost", a.result.cost}, {"timings", a.timed}, {"met", a.met()}};
+  out["choice"] = answer ? pick_json(a, *answer) : json(nullptr);
+  out["runners_up"] = json::array();
+  for (const auto& p : a.result.ranked)
+    if (!answer || p.method != answer->method) out["runners_up"].push_back(pick_json(a, p));
+  out["excluded"] = json::array();
+  for (const auto& e : a.result.excluded)
+    out["excluded"].push_back({{"method", a.methods[e.method].name}, {"reason", e.reason}});
+  out["best_achieved"] = a.result.best_achieved ? pick_json(a, *a.result.best_achieved) : json(nullptr);
+  std::cout << out.dump(2) << "\n";
+  return code;
+}
+
+}  // namespace
+
+command add_advise(CLI::App& app) {
+  auto a = std::make_shared<advise_args>();
+  auto* sub = app.add_subcommand("advise",
+                                 "the cheapest stable method and its dt (or tolerance) for an error, from a study file");
+  sub->add_option("--problem", a->problem, "problem name (one in the study file)")->required();
+  sub->add_option("--tol", a->tol_text, "largest acceptable error, in the problem's units (> 0)")->required();
+  sub->add_option("--metric", a->metric, "err_pos_max, err_pos_final, err_pos_rms or err_vel_final")->capture_default_str();
+  sub->add_option("--study", a->study, "study file to read")->capture_default_str();
+  sub->add_flag("--json", a->json, "print JSON");
+  sub->footer("exit codes: 0 answer, 1 study file unreadable, 2 bad usage, 3 no method meets the tolerance\n");
+  return {sub, [a] { return run_advise(*a); }};
+}
+
+}  // namespace stepbench::cli

@@ -1,0 +1,23 @@
+#pragma once
+// The subcommands of `stepbench`, one file each. Each adds its options to the app and
+// returns the function that runs it; main() dispatches and turns exceptions into one
+// line and an exit code (2 bad usage: std::invalid_argument; 1 anything else).
+#include <functional>
+#include <stdexcept>
+
+#include <CLI/CLI.hpp>
+
+namespace stepbench::cli {
+
+struct command {
+  CLI::App* app = nullptr;
+  std::function<int()> run;
+};
+
+command add_list(CLI::App& app);
+command add_run(CLI::App& app);
+command add_sweep(CLI::App& app);
+command add_advise(CLI::App& app);
+command add_ratios(CLI::App& app);
+
+}  // namespace stepbench::cli

@@ -1,0 +1,126 @@
+// `stepbench run`: one problem, one method, one dt (or tolerance); prints the final state,
+// the true state, the errors and the work.
+#include <iostream>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <nlohmann/json.hpp>
+
+#include "cli/commands.hpp"
+#include "core/drive.hpp"
+#include "core/measure.hpp"
+#include "core/parse.hpp"
+#include "study/registry.hpp"
+
+namespace stepbench::cli {
+namespace {
+
+using json = nlohmann::json;
+
+struct run_args {
+  std::string problem, method, dt_text, tol_text, horizon_text;
+  std::vector<std::string> sets;
+  bool json = false;
+};
+
+int run_run(const run_args& a) {
+  auto problem = make_problem(a.problem);
+  const method_info& m = find_method(a.method);
+  for (const auto& s : a.sets) {
+    const auto [name, value] = parse_assignment(s);
+    problem->set(name, value);
+  }
+  if (auto err = problem->validate(); !err.empty())
+    throw std::invalid_argument(fmt::format("problem {}: {}", a.problem, err));
+  const bool fixed = m.kind == method_kind::fixed_step;
+  if (fixed && a.dt_text.empty()) throw std::invalid_argument(fmt::format("{} is a fixed-step method: give --dt", m.name));
+  if (!fixed && a.tol_text.empty()) throw std::invalid_argument(fmt::format("{} is adaptive: give --tol", m.name));
+  if (fixed && !a.tol_text.empty()) throw std::invalid_argument(fmt::format("{} is a fixed-step method: --tol does not apply", m.name));
+  if (!fixed && !a.dt_text.empty()) throw std::invalid_argument(fmt::format("{} is adaptive: --dt does not apply", m.name));
+  const double param = parse_number(fixed ? a.dt_text : a.tol_text, fixed ? "--dt" : "--tol");
+  if (!(param > 0.0))
+    throw std::invalid_argument(fmt::format("{} must be > 0, got {}", fixed ? "--dt" : "--tol", fixed ? a.dt_text : a.tol_text));
+  if (!fixed && !(param < 1.0)) throw std::invalid_argument(fmt::format("--tol must be < 1, got {}", a.tol_text));
+  double horizon = problem->horizon();
+  if (!a.horizon_text.empty()) {
+    horizon = parse_number(a.horizon_text, "--horizon");
+    if (!(horizon > 0.0)) throw std::invalid_argument(fmt::format("--horizon must be > 0, got {}", a.horizon_text));
+  }
+  if (fixed && horizon / param > 1e9)
+    throw std::invalid_argument(fmt::format("--dt {} needs more than 1e9 steps to reach {}", param, horizon));
+
+  // Fixed steps are measured at the grid times nearest j T / 32, so the run itself is
+  // the one a user would make; adaptive runs at j T / 32 exactly.
+  constexpr int sample_count = 32;
+  const auto times = fixed ? nearest_grid_times(horizon, param, sample_count) : sample_times(horizon, sample_count);
+  const run_result run = problem->run(m.name, param, horizon, times);
+  truth_options topts;
+  topts.run_references = !problem->has_closed_form();
+  const truth_table truth = build_truth(*problem, times, topts);
+  const run_metrics metrics = measure(*problem, run, truth);
+
+  const int dim = problem->dim();
+  auto part = [&](const std::vector<double>& y, int offset) {
+    return y.empty() ? std::vector<double>{} : std::vector<double>(y.begin() + offset, y.begin() + offset + dim);
+  };
+  json out = {{"problem", a.problem},
+              {"integrator", m.name},
+              {"origin", to_string(m.origin)},
+              {"kind", to_string(m.kind)},
+              {fixed ? "dt" : "tol", param},
+              {"horizon", horizon},
+              {"steps", run.steps},
+              {"rejected_steps", run.rejected_steps},
+              {"force_evals", run.work.force_evals},
+              {"jacobian_evals", run.work.jacobian_evals},
+              {"newton_iterations", run.work.newton_iterations},
+              {"linear_solves", run.work.linear_solves},
+              {"position", part(run.final_y, 0)},
+              {"velocity", part(run.final_y, dim)},
+              {"err_pos_final", metrics.err_pos_final},
+              {"err_vel_final", metrics.err_vel_final},
+              {"err_pos_max", metrics.err_pos_max},
+              {"err_pos_rms", metrics.err_pos_rms},
+              {"energy_drift", metrics.energy_drift},
+              {"diverged", metrics.diverged},
+              {"failed", metrics.failed},
+              {"truth_source", truth.source},
+              {"true_position", part(truth.y.back(), 0)},
+              {"true_velocity", part(truth.y.back(), dim)}};
+  if (!metrics.note.empty()) out["note"] = metrics.note;
+  if (a.json) {
+    std::cout << out.dump(2) << "\n";
+    return metrics.failed ? 1 : 0;
+  }
+  fmt::print("{} with {}: {} {:g} to t = {:g} s, {} steps ({} rejected), {} force evaluations\n", a.problem, m.name,
+             fixed ? "dt" : "tol", param, horizon, run.steps, run.rejected_steps, run.work.force_evals);
+  if (run.work.jacobian_evals || run.work.newton_iterations)
+    fmt::print("  {} Jacobian evaluations, {} Newton iterations, {} linear solves\n", run.work.jacobian_evals,
+               run.work.newton_iterations, run.work.linear_solves);
+  fmt::print("  position       {::.12g}   (true {::.12g}, from {})\n", part(run.final_y, 0), part(truth.y.back(), 0),
+             truth.source);
+  fmt::print("  velocity       {::.12g}   (true {::.12g})\n", part(run.final_y, dim), part(truth.y.back(), dim));
+  fmt::print("  err_pos_final  {:.6e}\n  err_vel_final  {:.6e}\n  err_pos_max    {:.6e}\n  err_pos_rms    {:.6e}\n",
+             metrics.err_pos_final, metrics.err_vel_final, metrics.err_pos_max, metrics.err_pos_rms);
+  if (problem->has_energy()) fmt::print("  energy_drift   {:+.6e} (relative, at the horizon)\n", metrics.energy_drift);
+  if (metrics.diverged) fmt::print("  DIVERGED: {}\n", metrics.note);
+  if (metrics.failed) fmt::print("  FAILED: {}\n", metrics.note);
+  return metrics.failed ? 1 : 0;
+}
+
+}  // namespace
+
+command add_run(CLI::App& app) {
+  auto a = std::make_shared<run_args>();
+  auto* sub = app.add_subcommand("run", "integrate one problem with one method and print the errors");
+  sub->add_option("--problem", a->problem, "problem name (see list)")->required();
+  sub->add_option("--integrator,--method", a->method, "method name (see list): ours or a peer")->required();
+  sub->add_option("--dt", a->dt_text, "timestep [s] (fixed-step methods)");
+  sub->add_option("--tol", a->tol_text, "relative tolerance (adaptive methods)");
+  sub->add_option("--horizon", a->horizon_text, "end time [s] (default: the problem's)");
+  sub->add_option("--set", a->sets, "override a parameter, name=value (repeatable)");
+  sub->add_flag("--json", a->json, "print JSON");
+  return {sub, [a] { return run_run(*a); }};
+}
+
+}  // namespace stepbench::cli

@@ -1,0 +1,86 @@
+// `stepbench sweep`: the accuracy study (every method on every problem over its ladder,
+// untimed) into an HDF5 study file.
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "cli/commands.hpp"
+#include "core/parse.hpp"
+#include "study/study_file.hpp"
+#include "study/sweep.hpp"
+
+namespace stepbench::cli {
+namespace {
+
+struct sweep_args {
+  sweep_options opts;
+  std::vector<std::string> sets;
+  std::string out = "results/study.h5";
+  bool quiet = false;
+  bool quick = false;
+};
+
+std::string observed(const method_study& ms) {
+  if (ms.fit.state == fit_result::status::fitted) return fmt::format("{:.3f}", ms.fit.order);
+  return ms.fit.state == fit_result::status::exact ? "exact" : "n/a";
+}
+
+int run_sweep_command(sweep_args a) {
+  for (const auto& s : a.sets) add_override(a.opts.overrides, s, a.opts.problems);
+  if (a.quick) {
+    a.opts.levels = 8;
+    a.opts.tolerances = tolerance_ladder(true);
+  }
+  a.opts.progress = !a.quiet;
+  validate(a.opts);
+  check_writable(a.out);  // before the work, so a bad path costs nothing
+  const study s = run_sweep(a.opts);
+  write_study(s, a.out);
+  if (!a.quiet) {
+    fmt::print("{:<22} {:<24} {:<10} {:>8} {:>9}  {}\n", "problem", "method", "kind", "declared", "observed",
+               "fit levels");
+    for (const auto& ps : s.problems)
+      for (const auto& ms : ps.methods) {
+        std::size_t bad = 0;
+        for (const auto& r : ms.rows) bad += r.metrics.diverged || r.metrics.failed;
+        fmt::print("{:<22} {:<24} {:<10} {:>8} {:>9}  {}{}\n", ps.problem->name(), ms.info.name,
+                   to_string(ms.info.kind),
+                   std::isfinite(ms.info.declared_order) ? fmt::format("{:g}", ms.info.declared_order) : "-",
+                   ms.info.kind == method_kind::fixed_step ? observed(ms) : "-", fmt::join(ms.fit.levels, ","),
+                   bad ? fmt::format("  ({} of {} rows diverged or failed)", bad, ms.rows.size()) : "");
+      }
+    for (const auto& ps : s.problems)
+      for (const auto& r : ps.truth.references)
+        fmt::print("reference {:<12} on {:<22} {:<9} vs {:<12} pos {:.2e} vel {:.2e}  ({} steps, {} f evals)\n",
+                   r.source, ps.problem->name(), r.status, r.compared_with.empty() ? "-" : r.compared_with,
+                   r.vs.pos_rel, r.vs.vel_rel, r.solution.stats.steps, r.solution.stats.rhs_evals_counted);
+  }
+  fmt::print(stderr, "wrote {} ({} problems, {} levels) in {:.2f} s\n", a.out, s.problems.size(), a.opts.levels,
+             s.wall_seconds);
+  // Every other problem has been measured and written; only then is a problem without a
+  // trusted truth an error.
+  if (const auto bad = untrusted_problems(s); !bad.empty()) {
+    fmt::print(stderr, "stepbench: error: no trusted truth for {} (errors recorded as NaN)\n", fmt::join(bad, ", "));
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace
+
+command add_sweep(CLI::App& app) {
+  auto a = std::make_shared<sweep_args>();
+  auto* sub = app.add_subcommand("sweep", "accuracy study of every (problem, method) into an HDF5 study file");
+  sub->add_option("--problem", a->opts.problems, "restrict to these problems (repeatable)");
+  sub->add_option("--integrator,--method", a->opts.methods, "restrict to these methods (repeatable)");
+  sub->add_option("--levels", a->opts.levels, "timesteps in the halving ladder")->capture_default_str();
+  sub->add_option("--base-steps", a->opts.base_steps, "steps at the coarsest level")->capture_default_str();
+  sub->add_option("--set", a->sets, "override a parameter, problem.name=value (repeatable)");
+  sub->add_option("--out", a->out, "study file to write")->capture_default_str();
+  sub->add_flag("--quick", a->quick, "8 levels and every other tolerance (the CI study)");
+  sub->add_flag("--quiet", a->quiet, "print only the summary line");
+  sub->footer("exit codes: 0 written; 1 a file error, or a problem without a trusted truth (the file is still "
+              "written); 2 bad usage\n");
+  return {sub, [a] { return run_sweep_command(*a); }};
+}
+
+}  // namespace stepbench::cli

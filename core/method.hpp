@@ -1,0 +1,55 @@
+#pragma once
+// What the registry says of a method, and one run of it in plain vectors: the shape
+// every method (ours, a library peer, the hand-written baseline) is measured in, by the
+// same code.
+#include <limits>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/concepts.hpp"
+
+namespace stepbench {
+
+// Where a method comes from. A baseline is a timing floor written by hand for one
+// problem, not a method a user could pick: it is shown for scale, never recommended.
+enum class method_origin { ours, peer, baseline };
+// What its parameter is: a timestep (a dt ladder) or a tolerance (a tolerance ladder).
+enum class method_kind { fixed_step, adaptive };
+
+inline std::string_view to_string(method_origin o) {
+  switch (o) {
+    case method_origin::ours: return "ours";
+    case method_origin::peer: return "peer";
+    default: return "baseline";
+  }
+}
+inline std::string_view to_string(method_kind k) { return k == method_kind::fixed_step ? "fixed_step" : "adaptive"; }
+inline std::string_view param_name(method_kind k) { return k == method_kind::fixed_step ? "dt" : "tolerance"; }
+
+struct method_info {
+  std::string name;
+  std::string description;
+  method_origin origin = method_origin::ours;
+  method_kind kind = method_kind::fixed_step;
+  double declared_order = std::numeric_limits<double>::quiet_NaN();  // NaN: the method declares none
+  capabilities traits{};
+  std::string library;  // "stepbench", "GSL", "SUNDIALS CVODE", "Boost.Odeint"
+};
+
+// One run of one method at one parameter, to the horizon, with the state recorded at
+// the requested times.
+struct run_result {
+  double param = 0.0;  // dt [s] or relative tolerance
+  double horizon = 0.0;
+  long steps = 0;           // accepted steps
+  long rejected_steps = 0;  // attempts rejected by an error test or a failed solve
+  work_counters work{};     // force (right-hand-side) evaluations and an implicit method's work
+  bool non_finite = false;  // a NaN or Inf appeared; the run stopped there
+  std::string failure;      // the method could not complete the run (solver error, step budget); empty if it did
+  std::vector<double> sample_t;
+  std::vector<std::vector<double>> sample_y;  // [x; v] at sample_t
+  std::vector<double> final_y;                // [x; v] where the run stopped
+};
+
+}  // namespace stepbench

@@ -1,0 +1,61 @@
+#pragma once
+// A problem with its parameters, type-erased: what the application (sweep, commands,
+// benchmark) holds. The registry (study/registry.cpp) implements it once per problem
+// type; every call below dispatches to code instantiated for that type, so no step loop
+// makes a virtual call.
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/method.hpp"
+#include "references/reference.hpp"
+
+namespace stepbench {
+
+struct param_value {
+  std::string name;
+  std::string unit;
+  std::string description;
+  double value = 0.0;
+};
+
+class problem_instance {
+ public:
+  virtual ~problem_instance() = default;
+  virtual std::string_view name() const = 0;
+  virtual std::string_view description() const = 0;
+  virtual int dim() const = 0;
+  virtual std::string_view position_unit() const = 0;
+  virtual std::vector<param_value> params() const = 0;
+  // Sets a parameter; throws std::invalid_argument naming an unknown parameter.
+  virtual void set(std::string_view param, double value) = 0;
+  virtual std::string validate() const = 0;  // "" when valid
+  virtual double horizon() const = 0;
+  virtual bool has_closed_form() const = 0;
+  virtual bool has_energy() const = 0;
+  virtual bool has_jacobian() const = 0;
+  // [x; v] of the closed form at t; throws std::logic_error without a closed form.
+  virtual std::vector<double> exact(double t) const = 0;
+  // Total energy of [x; v]; NaN when the problem defines none.
+  virtual double energy(std::span<const double> y) const = 0;
+  virtual std::vector<double> initial() const = 0;  // [x0; v0]
+  // The first-order form y' = [v; F/m] for the reference solvers.
+  virtual ode_system ode() const = 0;
+
+  // The methods that run on this problem, ours first, in registry order.
+  virtual std::vector<method_info> methods() const = 0;
+  // Runs `method` at `param` (dt or tolerance) to `horizon`, recording [x; v] at
+  // `times` (increasing, in (0, horizon]). A method that cannot complete the run
+  // returns with `failure` set; an unknown method throws std::invalid_argument.
+  virtual run_result run(std::string_view method, double param, double horizon, std::span<const double> times) const = 0;
+  // The same run, prepared once (the record plan) and performed whole by each call of
+  // the returned function, for timing. Returns a value of the final state to keep.
+  virtual std::function<double()> timed_run(std::string_view method, double param, double horizon,
+                                            std::span<const double> times) const = 0;
+  virtual std::unique_ptr<problem_instance> clone() const = 0;
+};
+
+}  // namespace stepbench

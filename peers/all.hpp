@@ -1,0 +1,22 @@
+#pragma once
+// The peer registry: what a user might run instead of our integrators, on the same
+// problems, measured by the same code. Adding a peer is its header plus one entry here.
+#include "core/type_list.hpp"
+#include "peers/baseline_rk4.hpp"
+#include "peers/gsl_fixed.hpp"
+#include "peers/library_adaptive.hpp"
+#include "peers/odeint.hpp"
+
+namespace stepbench {
+
+using all_peers = type_list<peers::gsl_fixed<peers::gsl_rk4_tag>, peers::gsl_fixed<peers::gsl_rk2_tag>,
+                            peers::gsl_fixed<peers::gsl_rkf45_tag>,
+#if STEPBENCH_HAVE_ODEINT
+                            peers::odeint_rk4, peers::odeint_velocity_verlet,
+#endif
+                            peers::baseline_rk4, peers::library_adaptive<peers::gsl_rkf45_solver>,
+                            peers::library_adaptive<peers::gsl_rk8pd_solver>,
+                            peers::library_adaptive<peers::cvode_adams_solver>,
+                            peers::library_adaptive<peers::cvode_bdf_solver>>;
+
+}  // namespace stepbench

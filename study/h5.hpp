@@ -1,0 +1,61 @@
+#pragma once
+// HDF5 in the shapes the study file uses (docs/study-format.md): scalar and array
+// attributes, and tables (1-D compound datasets) built column by column, written and
+// read by field name. Shared by the writer and every C++ reader, so the format is
+// spelled in one place. Errors surface as H5::Exception; callers turn them into one line.
+#include <H5Cpp.h>
+
+#include <cstdint>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace stepbench::h5 {
+
+void attr(H5::H5Object& obj, const std::string& name, const std::string& value);
+void attr(H5::H5Object& obj, const std::string& name, const char* value);
+void attr(H5::H5Object& obj, const std::string& name, double value);
+void attr(H5::H5Object& obj, const std::string& name, long value);
+void attr(H5::H5Object& obj, const std::string& name, int value);
+void attr(H5::H5Object& obj, const std::string& name, const std::vector<int>& values);
+void attr(H5::H5Object& obj, const std::string& name, const std::vector<double>& values);
+
+void dataset(H5::Group& g, const std::string& name, const std::vector<double>& v);
+void dataset(H5::Group& g, const std::string& name, const std::vector<std::vector<double>>& rows);
+
+// A table under construction: columns of equal length, written as one compound dataset
+// (packed in the file; fields in the order added).
+class table {
+ public:
+  void add(std::string name, std::vector<double> values);
+  void add(std::string name, std::vector<std::int64_t> values);
+  void add(std::string name, std::vector<std::int8_t> values);
+  void add(std::string name, std::vector<std::string> values);  // variable-length strings
+  void write(H5::Group& g, const std::string& dataset) const;
+
+ private:
+  using column = std::variant<std::vector<double>, std::vector<std::int64_t>, std::vector<std::int8_t>,
+                              std::vector<std::string>>;
+  std::vector<std::pair<std::string, column>> columns_;
+};
+
+// Readers. Fields and attributes are found by name; a missing one is an error that names it.
+bool has_link(const H5::Group& g, const std::string& name);
+bool is_group(const H5::Group& g, const std::string& name);
+bool is_dataset(const H5::Group& g, const std::string& name);
+bool has_field(const H5::DataSet& ds, const std::string& field);
+std::vector<std::string> children(const H5::Group& g);  // link names in creation or name order
+
+std::vector<double> read_doubles(const H5::DataSet& ds, const std::string& field);
+std::vector<std::int64_t> read_ints(const H5::DataSet& ds, const std::string& field);
+std::vector<std::string> read_strings(const H5::DataSet& ds, const std::string& field);
+std::vector<double> read_vector(const H5::DataSet& ds);  // a 1-D double dataset
+
+// Attribute readers: throw std::runtime_error("missing attribute '<name>' on <object>")
+// when absent or of the wrong kind.
+std::string string_attr(const H5::H5Object& obj, const std::string& name);
+double double_attr(const H5::H5Object& obj, const std::string& name);
+long long_attr(const H5::H5Object& obj, const std::string& name);
+std::vector<long> int_array_attr(const H5::H5Object& obj, const std::string& name);  // empty for a null dataspace
+
+}  // namespace stepbench::h5

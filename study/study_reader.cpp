@@ -1,0 +1,179 @@
+#include "study/study_reader.hpp"
+
+#include <H5Cpp.h>
+
+#include <cmath>
+#include <filesystem>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "study/h5.hpp"
+#include "study/study_file.hpp"
+
+namespace stepbench {
+namespace {
+
+method_origin parse_origin(const std::string& s) {
+  if (s == "ours") return method_origin::ours;
+  if (s == "peer") return method_origin::peer;
+  if (s == "baseline") return method_origin::baseline;
+  throw std::runtime_error(fmt::format("unknown method origin '{}'", s));
+}
+
+method_kind parse_kind(const std::string& s) {
+  if (s == "fixed_step") return method_kind::fixed_step;
+  if (s == "adaptive") return method_kind::adaptive;
+  throw std::runtime_error(fmt::format("unknown method kind '{}'", s));
+}
+
+study_method read_method(const H5::Group& g, const std::string& name) {
+  study_method m;
+  m.name = name;
+  m.origin = parse_origin(h5::string_attr(g, "origin"));
+  m.kind = parse_kind(h5::string_attr(g, "kind"));
+  m.description = h5::string_attr(g, "description");
+  m.library = h5::string_attr(g, "library");
+  m.declared_order = h5::double_attr(g, "declared_order");
+  m.fit_status = h5::string_attr(g, "fit_status");
+  m.fit_slope = h5::double_attr(g, "fit_slope");
+  m.declared_order_holds = static_cast<int>(h5::long_attr(g, "declared_order_holds"));
+  m.fit_levels = h5::int_array_attr(g, "fit_levels");
+  if (!h5::is_dataset(g, "runs")) throw std::runtime_error(fmt::format("missing dataset 'runs' in {}", g.getObjName()));
+  const H5::DataSet ds = g.openDataSet("runs");
+  if (ds.getTypeClass() != H5T_COMPOUND) throw std::runtime_error(fmt::format("{}/runs is not a table", g.getObjName()));
+  const H5::CompType type = ds.getCompType();
+  for (int i = 0; i < type.getNmembers(); ++i) {
+    const std::string field = type.getMemberName(i);
+    const auto cls = type.getMemberClass(i);
+    if (cls == H5T_FLOAT) {
+      m.columns[field] = h5::read_doubles(ds, field);
+    } else if (cls == H5T_INTEGER) {
+      const auto ints = h5::read_ints(ds, field);
+      m.columns[field].assign(ints.begin(), ints.end());
+    } else if (cls == H5T_STRING && field == "note") {
+      m.notes = h5::read_strings(ds, field);
+    }
+  }
+  for (const char* required : {"param", "steps", "force_evals", "err_pos_final", "err_vel_final", "err_pos_max",
+                               "err_pos_rms", "diverged", "failed"})
+    if (!m.columns.count(required))
+      throw std::runtime_error(fmt::format("missing field '{}' in {}/runs", required, g.getObjName()));
+  return m;
+}
+
+study_problem read_problem(const H5::Group& g, const std::string& name) {
+  study_problem p;
+  p.name = name;
+  p.unit = h5::string_attr(g, "position_unit");
+  p.truth_source = h5::string_attr(g, "truth_source");
+  p.truth_trusted = h5::long_attr(g, "truth_trusted") != 0;
+  p.horizon = h5::double_attr(g, "horizon");
+  p.pos_scale = h5::double_attr(g, "pos_scale");
+  for (unsigned i = 0; i < static_cast<unsigned>(g.getNumAttrs()); ++i) {
+    const H5::Attribute a = g.openAttribute(i);
+    if (a.getTypeClass() == H5T_FLOAT && a.getSpace().getSimpleExtentNpoints() == 1) {
+      double v = 0;
+      a.read(H5::PredType::NATIVE_DOUBLE, &v);
+      p.params[a.getName()] = v;
+    }
+  }
+  if (h5::is_group(g, "reference")) {
+    const H5::Group refs = g.openGroup("reference");
+    for (const auto& src : h5::children(refs)) {
+      const H5::Group r = refs.openGroup(src);
+      p.references.push_back({src, h5::string_attr(r, "status"), h5::string_attr(r, "reason"),
+                              h5::string_attr(r, "compared_with"), h5::double_attr(r, "err_pos_rel"),
+                              h5::double_attr(r, "err_vel_rel"), h5::long_attr(r, "is_truth") != 0});
+    }
+  }
+  if (!h5::is_group(g, "methods")) throw std::runtime_error(fmt::format("missing group 'methods' in {}", g.getObjName()));
+  const H5::Group methods = g.openGroup("methods");
+  for (const auto& m : h5::children(methods)) p.methods.push_back(read_method(methods.openGroup(m), m));
+  return p;
+}
+
+}  // namespace
+
+const std::vector<double>& study_method::col(const std::string& field) const {
+  const auto it = columns.find(field);
+  if (it == columns.end()) throw std::runtime_error(fmt::format("method {} has no field '{}'", name, field));
+  return it->second;
+}
+
+const study_method* study_problem::find(const std::string& method) const {
+  for (const auto& m : methods)
+    if (m.name == method) return &m;
+  return nullptr;
+}
+
+const study_problem* study_data::find(const std::string& problem) const {
+  for (const auto& p : problems)
+    if (p.name == problem) return &p;
+  return nullptr;
+}
+
+study_data read_study(const std::string& path) {
+  const auto fail = [&](const std::string& what) {
+    return std::runtime_error(fmt::format("cannot read study file '{}': {}", path, what));
+  };
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw fail("no such file");
+  if (std::filesystem::is_directory(path, ec)) throw fail("it is a directory");
+  H5::Exception::dontPrint();
+  study_data out;
+  out.path = path;
+  try {
+    if (!H5::H5File::isHdf5(path)) throw fail("not an HDF5 file");
+    const H5::H5File file(path, H5F_ACC_RDONLY);
+    if (!file.attrExists("format_version")) throw fail("not a stepbench study (no format_version)");
+    out.format_version = h5::long_attr(file, "format_version");
+    if (out.format_version > study_format_version)
+      throw fail(fmt::format("written by a newer stepbench (format_version {}; this build reads {} to {})",
+                             out.format_version, study_format_read_min, study_format_version));
+    if (out.format_version < study_format_read_min)
+      throw fail(fmt::format("format_version {} is older than this build reads ({}); run the study again",
+                             out.format_version, study_format_read_min));
+    for (unsigned i = 0; i < static_cast<unsigned>(file.getNumAttrs()); ++i) {
+      const H5::Attribute a = file.openAttribute(i);
+      if (a.getTypeClass() == H5T_STRING) {
+        std::string v;
+        a.read(a.getStrType(), v);
+        out.meta[a.getName()] = v;
+      }
+    }
+    out.timed = h5::long_attr(file, "timing") != 0;
+    if (!h5::is_group(file, "problems")) throw fail("missing group 'problems'");
+    const H5::Group problems = file.openGroup("problems");
+    for (const auto& name : h5::children(problems)) out.problems.push_back(read_problem(problems.openGroup(name), name));
+  } catch (const H5::Exception& e) {
+    throw fail(fmt::format("HDF5: {} (truncated or corrupt?)", e.getDetailMsg()));
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    if (what.rfind("cannot read study file", 0) == 0) throw;
+    throw fail(what);
+  }
+  return out;
+}
+
+std::vector<wp_method> work_precision_input(const study_problem& p, const std::string& metric, bool timed) {
+  std::vector<wp_method> out;
+  for (const auto& m : p.methods) {
+    wp_method w{m.name, m.origin, m.kind, {}};
+    const auto& param = m.col("param");
+    const auto& err = m.col(metric);
+    const auto& evals = m.col("force_evals");
+    const auto& diverged = m.col("diverged");
+    const auto& failed = m.col("failed");
+    const std::vector<double> none(param.size(), std::numeric_limits<double>::quiet_NaN()), zeros(param.size(), 0.0);
+    const auto& time = timed ? m.col("time_ns") : none;
+    const auto& cut = timed ? m.col("cut") : zeros;
+    for (std::size_t i = 0; i < param.size(); ++i)
+      w.rows.push_back({param[i], err[i], time[i], evals[i], diverged[i] == 0 && failed[i] == 0, diverged[i] != 0,
+                        cut[i] != 0});
+    out.push_back(std::move(w));
+  }
+  return out;
+}
+
+}  // namespace stepbench

@@ -1,0 +1,68 @@
+#pragma once
+// Reading a study file (docs/study-format.md) back, for the commands that answer from
+// it (advise, compare, ratios). Every required attribute and field is checked: a file
+// that lacks one is an error naming it, never a silent fallback to a constant.
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/method.hpp"
+#include "core/work_precision.hpp"
+
+namespace stepbench {
+
+struct study_method {
+  std::string name;
+  method_origin origin = method_origin::ours;
+  method_kind kind = method_kind::fixed_step;
+  std::string description, library;
+  double declared_order = 0.0;  // NaN when none
+  std::string fit_status;       // "fitted", "exact", "insufficient"
+  double fit_slope = 0.0;       // observed order (fixed-step) or error-per-tolerance slope (adaptive)
+  int declared_order_holds = -1;
+  std::vector<long> fit_levels;
+  // The `runs` table: every numeric field as doubles (integers converted), by name.
+  std::map<std::string, std::vector<double>> columns;
+  std::vector<std::string> notes;
+  std::size_t rows() const { return columns.at("param").size(); }
+  const std::vector<double>& col(const std::string& field) const;  // throws naming a missing field
+};
+
+struct study_reference {
+  std::string source, status, reason, compared_with;
+  double err_pos_rel = 0.0, err_vel_rel = 0.0;
+  bool is_truth = false;
+};
+
+struct study_problem {
+  std::string name, unit, truth_source;
+  bool truth_trusted = true;
+  double horizon = 0.0, pos_scale = 1.0;
+  std::map<std::string, double> params;  // every numeric attribute of the problem group
+  std::vector<study_reference> references;
+  std::vector<study_method> methods;
+  const study_method* find(const std::string& method) const;
+};
+
+struct study_data {
+  std::string path;
+  long format_version = 0;
+  std::map<std::string, std::string> meta;  // string root attributes (version, compiler, cpu, ...)
+  bool timed = false;
+  std::vector<study_problem> problems;
+  const study_problem* find(const std::string& problem) const;
+};
+
+// The newest format this build reads (and writes), and the oldest.
+inline constexpr long study_format_read_min = 2;
+
+// Reads the whole file. Throws std::runtime_error with one line, "cannot read study file
+// '<path>': <what is wrong>", for a missing, non-HDF5, truncated, corrupt or foreign
+// file, a format_version this build does not read, or a missing attribute or field.
+study_data read_study(const std::string& path);
+
+// The rows of a problem's methods in the shape the work-precision rule takes.
+std::vector<wp_method> work_precision_input(const study_problem& p, const std::string& metric, bool timed);
+
+}  // namespace stepbench

@@ -1,0 +1,211 @@
+// The work-precision rule (core/work_precision.hpp) on hand-made rows: every exclusion
+// reason, the cost switch between time and force evaluations, the stability margin, the
+// baseline shown but never the answer, the Pareto front; and `stepbench advise` reading
+// it back from a real study file written by the sweep.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <fmt/format.h>
+
+#include "core/work_precision.hpp"
+#include "study/advise.hpp"
+#include "study/study_file.hpp"
+#include "study/study_reader.hpp"
+#include "study/sweep.hpp"
+
+using namespace stepbench;
+
+namespace {
+
+wp_row row(double dt, double evals, double err, double time_ns = NAN, bool cut = false, bool diverged = false) {
+  return {dt, diverged ? NAN : err, time_ns, evals, !diverged, diverged, cut};
+}
+
+wp_method method(std::string name, std::vector<wp_row> rows, method_origin origin = method_origin::ours,
+                 method_kind kind = method_kind::fixed_step) {
+  return {std::move(name), origin, kind, std::move(rows)};
+}
+
+// A four-level ladder for three methods: a first-order one that never gets below 1e-3, a
+// second-order one, and a fourth-order one that diverged at the coarsest dt.
+std::vector<wp_method> untimed() {
+  return {method("first", {row(0.4, 10, 0.4), row(0.2, 20, 0.2), row(0.1, 40, 0.1), row(0.05, 80, 0.05)}),
+          method("second", {row(0.4, 20, 1e-1), row(0.2, 40, 2.5e-2), row(0.1, 80, 6e-3), row(0.05, 160, 1.5e-3)}),
+          method("fourth", {row(0.4, 40, 0, NAN, false, true), row(0.2, 80, 1e-3), row(0.1, 160, 6e-5),
+                            row(0.05, 320, 4e-6)})};
+}
+
+const wp_exclusion* excluded(const cheapest_result& r, const std::vector<wp_method>& ms, std::string_view name) {
+  for (const auto& e : r.excluded)
+    if (ms[e.method].name == name) return &e;
+  return nullptr;
+}
+
+}  // namespace
+
+TEST(work_precision, cheapest_qualifying_row_per_method_ranked_by_force_evals) {
+  const auto ms = untimed();
+  const auto r = cheapest(ms, 1e-2, false, "err_pos_max", "m");
+  EXPECT_EQ(r.cost, "force_evals");
+  ASSERT_EQ(r.ranked.size(), 2u);
+  // fourth reaches 1e-3 at dt 0.2 with 80 evals; second reaches 6e-3 at dt 0.1, also 80
+  // evals: the tie goes to the lower error.
+  EXPECT_EQ(ms[r.ranked[0].method].name, "fourth");
+  EXPECT_DOUBLE_EQ(ms[r.ranked[0].method].rows[r.ranked[0].row].param, 0.2);
+  EXPECT_EQ(ms[r.ranked[1].method].name, "second");
+  // Stable at the chosen dt even though it diverged at a coarser one; the margin is kept.
+  ASSERT_TRUE(r.ranked[0].largest_diverged.has_value());
+  EXPECT_DOUBLE_EQ(*r.ranked[0].largest_diverged, 0.4);
+  EXPECT_EQ(r.ranked[0].diverged_rows, 1);
+  EXPECT_FALSE(r.ranked[1].largest_diverged.has_value());
+  const auto* e = excluded(r, ms, "first");
+  ASSERT_NE(e, nullptr);
+  EXPECT_EQ(e->reason, "too inaccurate: best err_pos_max 0.05 m at dt 0.05 s");
+  EXPECT_FALSE(r.best_achieved.has_value());
+  EXPECT_THROW(cheapest(ms, 0.0, false, "err_pos_max", "m"), std::invalid_argument);
+  EXPECT_THROW(cheapest(ms, NAN, false, "err_pos_max", "m"), std::invalid_argument);
+}
+
+TEST(work_precision, diverged_everywhere_is_a_reason) {
+  auto ms = untimed();
+  ms.push_back(method("blowup", {row(0.4, 10, 0, NAN, false, true), row(0.2, 20, 0, NAN, false, true)}));
+  const auto r = cheapest(ms, 1e-2, false, "err_pos_max", "m");
+  ASSERT_NE(excluded(r, ms, "blowup"), nullptr);
+  EXPECT_EQ(excluded(r, ms, "blowup")->reason, "diverged or failed at every dt");
+}
+
+TEST(work_precision, time_is_the_cost_when_every_qualifying_row_is_timed) {
+  auto ms = untimed();
+  // second is cheaper per evaluation in time than fourth: 80 evals in 500 ns vs 80 in 900 ns.
+  for (auto& m : ms)
+    for (auto& r : m.rows) r.time_ns = r.force_evals * (m.name == "second" ? 6.25 : 11.25);
+  const auto r = cheapest(ms, 1e-2, true, "err_pos_max", "m");
+  EXPECT_EQ(r.cost, "time_ns");
+  ASSERT_EQ(r.ranked.size(), 2u);
+  EXPECT_EQ(ms[r.ranked[0].method].name, "second");
+  EXPECT_DOUBLE_EQ(r.ranked[0].cost, 500.0);
+  // One qualifying row without a time: the ranking falls back to force evaluations.
+  ms[2].rows[2].time_ns = NAN;
+  EXPECT_EQ(cheapest(ms, 1e-2, true, "err_pos_max", "m").cost, "force_evals");
+}
+
+TEST(work_precision, cut_rows_are_too_slow) {
+  auto ms = untimed();
+  for (auto& m : ms)
+    for (auto& r : m.rows) r.time_ns = 10.0 * r.force_evals;
+  // Only the two finest rows of fourth reach 1e-4, and both were cut by the budget.
+  ms[2].rows[2].cut = ms[2].rows[3].cut = true;
+  ms[2].rows[2].time_ns = ms[2].rows[3].time_ns = NAN;
+  const auto r = cheapest(ms, 1e-4, true, "err_pos_max", "m");
+  EXPECT_TRUE(r.ranked.empty());
+  ASSERT_NE(excluded(r, ms, "fourth"), nullptr);
+  EXPECT_EQ(excluded(r, ms, "fourth")->reason,
+            "too slow: cut by the time budget (would reach err_pos_max 4e-06 m at dt 0.05 s)");
+}
+
+TEST(work_precision, no_method_meets_the_target_names_the_best) {
+  const auto ms = untimed();
+  const auto r = cheapest(ms, 1e-9, false, "err_pos_max", "m");
+  EXPECT_TRUE(r.ranked.empty());
+  ASSERT_TRUE(r.best_achieved.has_value());
+  EXPECT_EQ(ms[r.best_achieved->method].name, "fourth");
+  EXPECT_DOUBLE_EQ(ms[r.best_achieved->method].rows[r.best_achieved->row].error, 4e-6);
+  EXPECT_EQ(r.excluded.size(), 3u);
+}
+
+// The hand-written baseline is a timing floor, not a method to pick: ranked (for scale)
+// but never the answer, even when it is the cheapest.
+TEST(work_precision, the_baseline_is_never_the_answer) {
+  auto ms = untimed();
+  ms.push_back(method("baseline_rk4", {row(0.2, 1, 1e-3)}, method_origin::baseline));
+  const auto r = cheapest(ms, 1e-2, false, "err_pos_max", "m");
+  ASSERT_EQ(ms[r.ranked.front().method].name, "baseline_rk4");
+  const auto answer = r.answer(ms);
+  ASSERT_TRUE(answer.has_value());
+  EXPECT_EQ(ms[answer->method].name, "fourth");
+  // Only the baseline meets the target: no answer, and the best achieved is not the baseline.
+  const auto only = cheapest({ms[0], ms[3]}, 1e-2, false, "err_pos_max", "m");
+  EXPECT_FALSE(only.answer({ms[0], ms[3]}).has_value());
+  ASSERT_TRUE(only.best_achieved.has_value());
+  EXPECT_EQ(only.best_achieved->method, 0u);
+}
+
+TEST(work_precision, adaptive_methods_report_a_tolerance) {
+  const std::vector<wp_method> ms{method("cvode_bdf", {row(1e-4, 300, 2e-3), row(1e-6, 900, 3e-5), row(1e-8, 2000, 4e-7)},
+                                         method_origin::peer, method_kind::adaptive)};
+  const auto r = cheapest(ms, 1e-4, false, "err_pos_max", "m");
+  ASSERT_EQ(r.ranked.size(), 1u);
+  EXPECT_EQ(format_param(ms[0].kind, ms[0].rows[r.ranked[0].row].param), "tol 1e-06");
+}
+
+// The front: a point joins only if it beats every cheaper point's error.
+TEST(work_precision, pareto_front) {
+  const auto ms = untimed();
+  const auto front = pareto_front(ms, false, false);
+  // By force evals: first 10 (0.4), 20 (second 0.1 < 0.2), 40 (second 2.5e-2), 80 (fourth 1e-3 < 6e-3),
+  // 160 (fourth 6e-5), 320 (fourth 4e-6).
+  std::vector<std::pair<std::string, double>> got;
+  for (const auto& p : front) got.emplace_back(ms[p.method].name, p.error);
+  const std::vector<std::pair<std::string, double>> want{{"first", 0.4},    {"second", 0.1},    {"second", 2.5e-2},
+                                                         {"fourth", 1e-3},  {"fourth", 6e-5},   {"fourth", 4e-6}};
+  EXPECT_EQ(got, want);
+}
+
+// advise on a file the sweep wrote: every method is a candidate with its rows as the
+// sweep computed them, and the answer is the cheapest row meeting the tolerance.
+TEST(advise, reads_a_study_file) {
+  sweep_options opts;
+  opts.problems = {"damped_spring"};
+  opts.levels = 6;
+  const study s = run_sweep(opts);
+  const auto path = (std::filesystem::temp_directory_path() / fmt::format("test_advise_{}.h5", ::getpid())).string();
+  write_study(s, path);
+  const study_data file = read_study(path);
+  EXPECT_FALSE(file.timed);
+  const auto a = advise(file, "damped_spring", "err_pos_final", 1e-4);
+  EXPECT_EQ(a.unit, "m");
+  ASSERT_EQ(a.methods.size(), s.problems.front().methods.size());
+  double best_evals = INFINITY;
+  std::string best_name;
+  for (const auto& ms : s.problems.front().methods) {
+    const auto it = std::find_if(a.methods.begin(), a.methods.end(), [&](const auto& m) { return m.name == ms.info.name; });
+    ASSERT_NE(it, a.methods.end()) << ms.info.name;
+    ASSERT_EQ(it->rows.size(), ms.rows.size());
+    for (std::size_t k = 0; k < ms.rows.size(); ++k) {
+      EXPECT_EQ(it->rows[k].param, ms.rows[k].param);
+      EXPECT_EQ(it->rows[k].force_evals, static_cast<double>(ms.rows[k].work.force_evals));
+      EXPECT_TRUE(it->rows[k].error == ms.rows[k].metrics.err_pos_final ||
+                  (std::isnan(it->rows[k].error) && std::isnan(ms.rows[k].metrics.err_pos_final)));
+      const bool ok = !ms.rows[k].metrics.diverged && !ms.rows[k].metrics.failed;
+      if (ok && ms.info.origin != method_origin::baseline && ms.rows[k].metrics.err_pos_final <= 1e-4 &&
+          ms.rows[k].work.force_evals < best_evals) {
+        best_evals = static_cast<double>(ms.rows[k].work.force_evals);
+        best_name = ms.info.name;
+      }
+    }
+  }
+  const auto answer = a.result.answer(a.methods);
+  ASSERT_TRUE(answer.has_value());
+  EXPECT_EQ(a.methods[answer->method].name, best_name);
+  EXPECT_DOUBLE_EQ(answer->cost, best_evals);
+
+  try {
+    advise(file, "nope", "err_pos_max", 1e-4);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("problem 'nope' is not in the study file"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("(it has: damped_spring)"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(advise(file, "damped_spring", "err_bogus", 1e-4), std::invalid_argument);
+  std::filesystem::remove(path);
+  EXPECT_THROW(read_study(path), std::runtime_error);
+  // Not an HDF5 file at all.
+  std::ofstream(path) << "not hdf5\n";
+  EXPECT_THROW(read_study(path), std::runtime_error);
+  std::filesystem::remove(path);
+}

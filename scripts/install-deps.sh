@@ -7,7 +7,7 @@ packages=(
   libeigen3-dev libgsl-dev libsundials-dev libhdf5-dev hdf5-tools
   libbenchmark-dev libbenchmark-tools libcli11-dev libfmt-dev nlohmann-json3-dev libboost-dev
   googletest libgtest-dev
-  python3-h5py python3-matplotlib python3-numpy python3-scipy python3-pytest
+  python3-h5py python3-matplotlib python3-numpy python3-scipy python3-pytest python3-markdown
 )
 missing=()
 for p in "${packages[@]}"; do

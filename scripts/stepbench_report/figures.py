@@ -17,26 +17,30 @@ plt.rcParams.update({
     "axes.grid": True, "grid.alpha": 0.3, "grid.linewidth": 0.6, "savefig.dpi": DPI,
 })
 
-OUR_MARKERS = ["o", "s", "^", "D", "v", "P", "X", "*"]
-PEER_MARKERS = ["o", "s", "^", "D", "v", "P", "X", "*", "h", "<", ">", "p"]
+OUR_MARKERS = ["o", "s", "^", "D", "v", "P", "X", "h"]
+PEER_MARKERS = ["o", "s", "^", "D", "v", "P", "X", "h", "<", ">", "p", "d"]
+# The baseline is a timing floor, not a method to pick: black, dotted, a star.
+BASELINE_STYLE = dict(color="black", marker="*", linestyle=":", markerfacecolor="white")
 
 
 class Styles:
-    """One colour and marker per method, the same in every figure."""
+    """One colour and marker per method, the same in every figure: ours solid with
+    filled markers, peers dashed with hollow ones, the baseline black and dotted."""
 
     def __init__(self, study):
-        # First appearance over the problems keeps the study's order (by order, then name).
-        ours = list(dict.fromkeys(m.name for p in study.problems for m in p.integrators))
-        peers = list(dict.fromkeys(m.name for p in study.problems for m in p.peers))
+        # First appearance over the problems keeps the study's order (ours by order, then peers).
+        names = list(dict.fromkeys((m.name, m.origin) for p in study.problems for m in p.methods))
+        ours = [n for n, o in names if o == "ours"]
+        peers = [n for n, o in names if o == "peer"]
         tab10 = plt.get_cmap("tab10").colors
-        # Peers: dashed lines and hollow markers, colours from a second palette so that
-        # none repeats one of ours (Dark2, then the darker half of tab20b).
+        # Peer colours from a second palette so that none repeats one of ours (Dark2,
+        # then the darker half of tab20b).
         peer_colors = list(plt.get_cmap("Dark2").colors) + list(plt.get_cmap("tab20b").colors)[::4]
-        self.style = {}
+        self.style = {n: dict(BASELINE_STYLE) for n, o in names if o == "baseline"}
         for i, n in enumerate(ours):
             self.style[n] = dict(color=tab10[i % 10], marker=OUR_MARKERS[i % len(OUR_MARKERS)], linestyle="-")
         for i, n in enumerate(peers):
-            self.style[n] = dict(color=peer_colors[i % len(peer_colors)], marker=PEER_MARKERS[(i + 3) % len(PEER_MARKERS)],
+            self.style[n] = dict(color=peer_colors[i % len(peer_colors)], marker=PEER_MARKERS[i % len(PEER_MARKERS)],
                                  linestyle="--", markerfacecolor="white")
 
     def __call__(self, name):
@@ -49,8 +53,13 @@ def error_label(metric, unit):
     return f"{what} [{unit}]" if unit else what
 
 
-def _save(fig, path):
-    fig.savefig(path, dpi=DPI, bbox_inches="tight", pad_inches=0.12)
+def _save(fig, path, tight=True):
+    """tight: crop to what was drawn (a legend outside the axes). The panel figures are
+    laid out in inches by _panels and skip it, which saves a second draw."""
+    if tight:
+        fig.savefig(path, dpi=DPI, bbox_inches="tight", pad_inches=0.12)
+    else:
+        fig.savefig(path, dpi=DPI)
     plt.close(fig)
 
 
@@ -85,18 +94,35 @@ def _edge_markers(ax, xs, where, style, size=8):
             markersize=size, **style)
 
 
+def _fit_label(m):
+    """The legend's account of a fixed-step method's fit, from its attributes."""
+    status = m.attrs["fit_status"]
+    declared = f"{m.declared_order:g}" if np.isfinite(m.declared_order) else "none"
+    if status == "exact":
+        return f"{tables.label(m)}: exact for this problem"
+    word = "order" if m.origin == "ours" else "declares"
+    if status == "fitted":
+        return f"{tables.label(m)}: slope {m.attrs['fit_slope']:.2f} ({word} {declared})"
+    return f"{tables.label(m)}: not fitted ({word} {declared})"
+
+
 def convergence(problem, styles, path):
-    """Log-log max position error against dt, every integrator, fitted slope in the
-    legend, guide lines of orders 1, 2, 4. Fit levels filled, others hollow."""
-    fig, ax = plt.subplots(figsize=(10, 5.4))
+    """Log-log max position error against dt: our fixed-step methods in full (fitted
+    slope in the legend, fit levels filled, others hollow, diverged rows as x marks in a
+    top band), the fixed-step peers and the baseline drawn faintly behind them, guide
+    lines of orders 1, 2, 4. Adaptive methods run over tolerances, not timesteps: they
+    are on the work-precision figures."""
+    fig, ax = plt.subplots(figsize=(10.5, 6.0))
+    ours = [m for m in problem.by_origin("ours", adaptive=False)]
+    faint = [m for m in problem.methods if m.origin != "ours" and not m.adaptive]
     all_err, all_dt = [], []
-    diverging = [m.name for m in problem.integrators if m.diverged.any()]
-    for m in problem.integrators:
-        dt, err = m.param, m.col("err_pos_max")
-        all_dt += list(dt)
-        # Diverged rows may carry huge finite errors (over divergence_factor x the scale): they
-        # are drawn as x marks, so they must not stretch the axis.
-        all_err += list(err[~m.diverged & np.isfinite(err) & (err > 0)])
+    for m in ours + faint:
+        err = m.col("err_pos_max")
+        all_dt += list(m.param)
+        # Diverged rows may carry huge finite errors (over divergence_factor x the scale):
+        # they are drawn as x marks, so they must not stretch the axis.
+        all_err += list(err[m.completed & np.isfinite(err) & (err > 0)])
+    diverging = [m.name for m in ours if m.diverged.any()]
     lo, hi = _log_limits(all_err)
     # Room at the top for one row of x marks per diverging method.
     band = 0.05 * len(diverging)
@@ -105,24 +131,17 @@ def convergence(problem, styles, path):
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_ylim(lo, hi)
-    dmin, dmax = min(all_dt) / 1.5, max(all_dt) * 1.5
-    ax.set_xlim(dmin, dmax)
+    if all_dt:
+        ax.set_xlim(min(all_dt) / 1.5, max(all_dt) * 1.5)
     any_div = any_zero = False
     handles, labels = [], []
-    same_as = coincident([(m.name, m.param, m.col("err_pos_max")) for m in problem.integrators])
-    for k, m in enumerate(problem.integrators):
+    same_as = coincident([(m.name, m.param, m.col("err_pos_max")) for m in ours + faint])
+    for k, m in enumerate(ours):
         st = styles(m.name)
-        dt, err, div = m.param, m.col("err_pos_max"), m.diverged
-        a = m.attrs
-        levels = set(int(v) for v in np.atleast_1d(a.get("fit_levels", [])))
-        ok = ~div & np.isfinite(err) & (err > 0)
-        zero = ~div & (err == 0)
-        if int(a.get("exact_for_problem", 0) or 0) == 1 or a.get("fit_status") == "exact":
-            label = f"{m.name}: exact for this problem"
-        elif a.get("fit_status") == "fitted":
-            label = f"{m.name}: slope {a['observed_order']:.2f} (order {m.expected_order:g})"
-        else:
-            label = f"{m.name}: not fitted (order {m.expected_order:g})"
+        dt, err = m.param, m.col("err_pos_max")
+        ok = m.completed & np.isfinite(err) & (err > 0)
+        zero = m.completed & (err == 0)
+        label = _fit_label(m)
         # Identical curves would hide each other: say so, and draw later ones with smaller
         # markers so the earlier ones show around them.
         if m.name in same_as:
@@ -130,7 +149,7 @@ def convergence(problem, styles, path):
         group = [n for n in same_as if same_as[n] == same_as.get(m.name)]  # later copies of the same curve
         size = 8.5 - 2.0 * (group.index(m.name) + 1) if m.name in same_as else 8.5
         ax.plot(dt[ok], err[ok], color=st["color"], linestyle="-", linewidth=1.4, zorder=3 + k * 0.01)
-        fit = np.array([i in levels for i in range(len(dt))])
+        fit = np.isin(np.arange(len(dt)), m.fit_levels)
         ax.plot(dt[ok & fit], err[ok & fit], linestyle="none", marker=st["marker"], color=st["color"],
                 markersize=size, zorder=4 + k * 0.01)
         ax.plot(dt[ok & ~fit], err[ok & ~fit], linestyle="none", marker=st["marker"], markerfacecolor="white",
@@ -139,14 +158,20 @@ def convergence(problem, styles, path):
             any_zero = True
             _edge_markers(ax, dt[zero], 0, dict(marker=st["marker"], color=st["color"], markerfacecolor="white"),
                           size=size + 1)
-        if div.any():
+        if m.diverged.any():
             any_div = True
             row = 0.985 - 0.05 * diverging.index(m.name)  # axes fraction: its own row in the top band
-            _edge_markers(ax, dt[div], row, dict(marker="x", color=st["color"], markeredgewidth=2), size=7)
+            _edge_markers(ax, dt[m.diverged], row, dict(marker="x", color=st["color"], markeredgewidth=2), size=7)
         handles.append(Line2D([], [], color=st["color"], marker=st["marker"], markersize=6, linewidth=1.4))
         labels.append(label)
-    _guides(ax, (1, 2, 4), [(m.param[~m.diverged], m.col("err_pos_max")[~m.diverged]) for m in problem.integrators],
-            top=1 - band)
+    for m in faint:
+        st = styles(m.name)
+        err = m.col("err_pos_max")
+        ok = m.completed & np.isfinite(err) & (err > 0)
+        ax.plot(m.param[ok], err[ok], linewidth=1.0, markersize=4.5, alpha=0.45, zorder=2, **st)
+        handles.append(Line2D([], [], linewidth=1.0, markersize=4.5, alpha=0.6, **st))
+        labels.append(_fit_label(m) + (f" (= {same_as[m.name]})" if m.name in same_as else ""))
+    _guides(ax, (1, 2, 4), [(m.param[m.completed], m.col("err_pos_max")[m.completed]) for m in ours], top=1 - band)
     if band:
         edge = lo * (hi / lo) ** (1 - band)
         ax.axhline(edge, color="0.6", linewidth=0.8)
@@ -154,11 +179,15 @@ def convergence(problem, styles, path):
                 fontsize=8, color="0.35")
     ax.set_xlabel("timestep dt [s]")
     ax.set_ylabel(error_label("err_pos_max", problem.unit))
-    ax.set_title(f"{problem.name}: convergence (horizon {problem.attrs.get('horizon', float('nan')):.4g} s)")
+    ax.set_title(f"{problem.name}: convergence (horizon {problem.attrs['horizon']:.4g} s)")
     handles.append(Line2D([], [], color="grey", marker="o", linestyle="none"))
     labels.append("filled: levels used by the fit")
     handles.append(Line2D([], [], color="grey", marker="o", markerfacecolor="white", linestyle="none"))
     labels.append("hollow: not used (round-off, pre-asymptotic)")
+    if faint:
+        handles.append(Line2D([], [], color="grey", linestyle="--", alpha=0.6))
+        labels.append("faint: " + " and ".join(w for w, o in (("the peers", "peer"), ("the baseline", "baseline"))
+                                               if any(m.origin == o for m in faint)) + " (fixed step)")
     if any_zero:
         handles.append(Line2D([], [], color="grey", marker="o", markerfacecolor="white", linestyle="none"))
         labels.append("on the bottom edge: error exactly 0")
@@ -166,7 +195,7 @@ def convergence(problem, styles, path):
         handles.append(Line2D([], [], color="grey", marker="x", linestyle="none", markeredgewidth=2))
         labels.append("x in the top band: diverged (a row per method)")
     ax.legend(handles, labels, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0, frameon=False)
-    fig.subplots_adjust(left=0.09, right=0.62, top=0.92, bottom=0.11)
+    fig.subplots_adjust(left=0.09, right=0.58, top=0.93, bottom=0.1)
     _save(fig, path)
 
 
@@ -244,80 +273,94 @@ def _finish(fig, handles, labels, ncol, title):
     fig.legend(handles, labels, loc="lower center", ncol=ncol, frameon=False, bbox_to_anchor=(0.5, 0.0))
 
 
-def work_precision(study, styles, path, x_field):
-    """Error against cost, one panel per problem, every method (peers dashed); the
-    Pareto front (points no other beats in both cost and error) drawn as a thick band."""
-    timings = study.timings
+# Where each work-precision figure takes its cost from: the rows' field, the factor to
+# the plotted unit, and the C++ front drawn on it.
+WORK_AXES = {
+    "force_evals": ("force_evals", 1.0, "force evaluations per run"),
+    "time": ("time_ns", 1e-9, "median wall time per run [s]"),
+}
+
+
+def work_precision(study, styles, path, front_key):
+    """Error against cost, one panel per problem, every method (peers dashed, the
+    baseline dotted, for scale); the Pareto front the study computed (`front_<key>`)
+    drawn as a thick gold band under them."""
+    field, to_unit, xlabel = WORK_AXES[front_key]
     probs = study.problems
     names = list(dict.fromkeys(m.name for p in probs for m in p.methods))
-    fig, axes, ncol = _panels(len(probs), len(names) + 2, 1 if timings else 2)
+    fig, axes, ncol = _panels(len(probs), len(names) + 2, 1 if study.timed else 2)
     seen, any_zero = {}, False
     for ax, p in zip(axes.flat, probs):
-        pts = tables.work_points(p, x_field, timings)
-        same_as = coincident([(n, x, e) for n, (x, e, _, _) in pts.items()])
-        front = tables.pareto_front(pts)
-        all_e = [e for (_, es, _, _) in pts.values() for e in es]
-        lo, hi = _log_limits(all_e)
+        # Every row with an error and a cost: completed, and in a timed study not cut
+        # (the rows the front was taken over).
+        curves = []
+        for m in p.methods:
+            x, e = m.col(field) * to_unit, m.col("err_pos_max")
+            ok = m.completed & np.isfinite(x) & (x > 0) & np.isfinite(e) & ~(study.timed & m.cut)
+            if ok.any():
+                curves.append((m, x[ok], e[ok]))
+        same_as = coincident([(m.name, x, e) for m, x, e in curves])
+        lo, hi = _log_limits([v for _, _, e in curves for v in e])
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_ylim(lo, hi)
-        if front:
-            fx = [f[1] for f in front]
-            fy = [max(f[2], lo) for f in front]
-            ax.step(fx, fy, where="post", color="gold", linewidth=7, alpha=0.45, zorder=1, solid_capstyle="round")
-        for name, (xs, es, _, m) in pts.items():
-            st = styles(name)
+        front = p.fronts[front_key]
+        if len(front):
+            ax.step(front["cost"] * to_unit, np.maximum(front["err_pos_max"], lo), where="post", color="gold",
+                    linewidth=7, alpha=0.45, zorder=1, solid_capstyle="round")
+        for m, xs, es in curves:
+            st = styles(m.name)
             pos = es > 0
-            size = 4.0 if name in same_as else 6.0
+            size = 4.0 if m.name in same_as else 6.0
+            if m.origin == "baseline":
+                size += 2  # a star reads smaller than a circle
             ax.plot(xs[pos], es[pos], markersize=size, linewidth=1.1, zorder=3, **st)
-            h = Line2D([], [], markersize=6, **st)
             if (~pos).any():
                 any_zero = True
                 _edge_markers(ax, xs[~pos], 0, dict(marker=st["marker"], color=st["color"], markerfacecolor="white"),
                               size=6)
-            seen.setdefault(name, (h, m))
+            seen.setdefault(m.name, (Line2D([], [], markersize=6, **st), m))
         ax.set_title(p.name)
-        ax.set_xlabel("median wall time per run [s]" if x_field == "time_s" else "force evaluations per run")
+        ax.set_xlabel(xlabel)
         ax.set_ylabel(error_label("err_pos_max", p.unit))
-    names = list(seen)
-    handles = [seen[n][0] for n in names]
-    labels = [n + (" (peer)" if seen[n][1].peer else "") for n in names]
+    handles = [h for h, _ in seen.values()]
+    labels = [tables.label(m) for _, m in seen.values()]
     handles.append(Line2D([], [], color="gold", linewidth=7, alpha=0.45))
-    labels.append("Pareto front (nothing beats it in both cost and error)")
+    labels.append("Pareto front (nothing beats it in both cost and error; baseline excluded)")
     if any_zero:
         handles.append(Line2D([], [], color="grey", marker="o", markerfacecolor="white", linestyle="none"))
         labels.append("on the bottom edge: error exactly 0")
-    what = "time" if x_field == "time_s" else "force evaluations"
-    title = f"Work-precision: error against {what}"
-    if not timings:
+    title = f"Work-precision: error against {'time' if front_key == 'time' else 'force evaluations'}"
+    if not study.timed:
         title += "\n(the study has no timings: run the benchmark study for error against time)"
     _finish(fig, handles, labels, ncol, title)
-    _save(fig, path)
+    _save(fig, path, tight=False)
 
 
 def energy(study, styles, path):
     """|energy drift| at the horizon against dt, per problem with an energy."""
-    probs = [p for p in study.problems if int(p.attrs.get("has_energy", 0) or 0) == 1]
+    probs = [p for p in study.problems if int(p.attrs["has_energy"]) == 1]
     if not probs:
         return False
-    names = list(dict.fromkeys(m.name for p in probs for m in p.integrators))
+    names = list(dict.fromkeys(m.name for p in probs for m in p.by_origin("ours", adaptive=False)))
     fig, axes, ncol = _panels(len(probs), len(names) + 2, 1)
     seen = {}
     for ax, p in zip(axes.flat, probs):
         vals = []
-        for m in p.integrators:
+        ours = p.by_origin("ours", adaptive=False)
+        for m in ours:
             d = m.col("energy_drift")
-            ok = ~m.diverged & np.isfinite(d) & (np.abs(d) > 0)
+            ok = m.completed & np.isfinite(d) & (np.abs(d) > 0)
             vals += list(np.abs(d[ok]))
         lo, hi = _log_limits(vals)
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_ylim(lo, hi)
-        same_as = coincident([(m.name, m.param, np.abs(m.col("energy_drift"))) for m in p.integrators])
-        for m in p.integrators:
+        same_as = coincident([(m.name, m.param, np.abs(m.col("energy_drift"))) for m in ours])
+        for m in ours:
             st = styles(m.name)
             dt, d = m.param, m.col("energy_drift")
-            ok = ~m.diverged & np.isfinite(d) & (np.abs(d) > 0)
+            ok = m.completed & np.isfinite(d) & (np.abs(d) > 0)
             size = 3.5 if m.name in same_as else 5.5  # coinciding curves nest instead of hiding
             ax.plot(dt[ok], np.abs(d[ok]), color=st["color"], linewidth=1.1, zorder=2)
             gain, loss = ok & (d > 0), ok & (d < 0)
@@ -334,7 +377,7 @@ def energy(study, styles, path):
                                             linestyle="none")]
     labels = list(seen) + ["filled: gained energy", "hollow: lost energy"]
     _finish(fig, handles, labels, ncol, "Energy error at the horizon (relative to the energy scale)")
-    _save(fig, path)
+    _save(fig, path, tight=False)
     return True
 
 

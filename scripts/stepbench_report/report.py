@@ -6,52 +6,50 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 
 from . import figures, render, tables, theory
-from .tables import fmt_num, fmt_param, fmt_time_ns
+from .tables import fmt_num
 
-META_KEYS = ["version", "git_commit", "compiler", "build_type", "created_utc", "cpu", "cores", "format_version",
-             "levels", "base_steps", "sample_count", "reference_rtol", "reference_atol", "fit_metric", "wall_seconds"]
-BENCH_KEYS = ["timing", "benchmark_mode", "benchmark_min_time_s", "benchmark_repetitions", "benchmark_case_budget_s",
+TITLE = "stepbench report: accuracy, stability and cost of time integrators"
+META_KEYS = ["version", "git_commit", "compiler", "build_type", "dependencies", "created_utc", "cpu", "cores",
+             "format_version", "levels", "base_steps", "tolerances", "sample_count", "reference_rtol",
+             "reference_atol", "fit_metric", "divergence_factor", "equal_error_targets", "wall_seconds", "timing"]
+BENCH_KEYS = ["benchmark_mode", "benchmark_min_time_s", "benchmark_repetitions", "benchmark_case_budget_s",
               "benchmark_wall_seconds", "cpu_scaling_enabled", "num_cpus", "mhz_per_cpu"]
-PROBLEM_KEYS = {"horizon", "dim", "description", "has_closed_form", "has_energy", "truth_source", "pos_scale",
-                "vel_scale", "energy_scale", "position_unit"}
+# Problem attributes the problems table shows in their own columns or not at all; every
+# other attribute is a parameter of the scene.
+PROBLEM_KEYS = {"horizon", "dim", "description", "has_closed_form", "has_energy", "has_jacobian", "truth_source",
+                "truth_trusted", "truth_note", "agreement_limit", "pos_scale", "vel_scale", "energy_scale",
+                "position_unit"}
 
 
 def _value(v):
-    if isinstance(v, float):
-        return f"{v:.6g}"
+    if isinstance(v, (float, np.floating)):
+        return f"{float(v):.6g}"
     if isinstance(v, np.ndarray):
         return ", ".join(_value(x) for x in v.tolist())
-    if isinstance(v, (np.floating,)):
-        return f"{float(v):.6g}"
     return str(v)
 
 
-def _cost_text(cost, row):
-    return fmt_time_ns(row["time_ns"]) if cost == "time_ns" else f"{int(row['force_evals'])} force evals"
-
-
 def _oscillator_problems(study):
-    """Problems with a linear spring (k_s, mass_kg): the oscillator theory applies with
-    w0 = sqrt(k_s / m) and damping ratio zeta = k_d / (2 sqrt(k_s m))."""
+    """Problems with a linear spring (k_s, mass_kg, k_d): the oscillator theory applies
+    with w0 = sqrt(k_s / m) and damping ratio zeta = k_d / (2 sqrt(k_s m))."""
     out = []
     for p in study.problems:
         a = p.attrs
-        if "k_s" in a and "mass_kg" in a:
-            ks, m, kd = float(a["k_s"]), float(a["mass_kg"]), float(a.get("k_d", 0.0))
+        if {"k_s", "mass_kg", "k_d"} <= set(a):
+            ks, m, kd = float(a["k_s"]), float(a["mass_kg"]), float(a["k_d"])
             out.append((p, math.sqrt(ks / m), kd / (2 * math.sqrt(ks * m))))
     return out
 
 
 def _figure_jobs(study, figdir):
-    """(function, args) for every figure; they are independent, so they can be drawn in
-    parallel processes."""
-    jobs = []
-    for p in study.problems:
-        jobs.append(("convergence", p.name, os.path.join(figdir, f"convergence_{p.name}.png")))
-    jobs.append(("wp", "force_evals", os.path.join(figdir, "work_precision_force_evals.png")))
-    if study.timings:
-        jobs.append(("wp", "time_s", os.path.join(figdir, "work_precision_time.png")))
+    """(kind, argument, path) for every figure; they are independent, so they can be
+    drawn in parallel processes. The panel figures take longest and go first, so that
+    the workers finish together."""
+    jobs = [("wp", "force_evals", os.path.join(figdir, "work_precision_force_evals.png"))]
+    if study.timed:
+        jobs.append(("wp", "time", os.path.join(figdir, "work_precision_time.png")))
     jobs.append(("energy", None, os.path.join(figdir, "energy_drift.png")))
+    jobs += [("convergence", p.name, os.path.join(figdir, f"convergence_{p.name}.png")) for p in study.problems]
     jobs.append(("stability", None, os.path.join(figdir, "stability_regions.png")))
     return jobs
 
@@ -94,115 +92,130 @@ def build(study, outdir, workers=2):
     figdir = os.path.join(outdir, "fig")
     os.makedirs(figdir, exist_ok=True)
     made = set(os.path.basename(p) for p in draw_figures(study, figdir, workers))
-    doc = document(study, made)
+    text = render.markdown(document(study, made))
     with open(os.path.join(outdir, "REPORT.md"), "w") as f:
-        f.write(render.markdown(doc))
+        f.write(text)
     with open(os.path.join(outdir, "index.html"), "w") as f:
-        f.write(render.to_html(doc))
-    return doc
+        f.write(render.to_html(text, TITLE))
 
 
 def document(study, figs):
-    a = study.attrs
-    doc = render.Doc("stepbench report: accuracy, stability and cost of time integrators")
+    doc = render.Doc(TITLE)
     doc.note("Generated by `scripts/report` from the study file; do not edit, regenerate it. "
-             "Errors are absolute, in the problem's unit (m, or rad for the pendulum).")
+             "Errors are absolute, in the problem's position unit (see the problems table). Every ranking, "
+             "front and fit below was computed by stepbench when it wrote the file; this report draws and "
+             "formats it.")
+    _metadata(doc, study)
+    _summary(doc, study)
+    _convergence(doc, study, figs)
+    _work_precision(doc, study)
+    _stability(doc, study)
+    _energy(doc, study, figs)
+    doc.h(2, "Game loop")
+    gl = study.optional.get("game_loop")
+    if gl:
+        _generic_section(doc, gl)
+    else:
+        doc.note("Game-loop figures: absent (this study has no game-loop data).")
+    _references(doc, study)
+    return doc
 
-    # --- metadata first ------------------------------------------------------------------
+
+def _metadata(doc, study):
+    a = study.attrs
     doc.h(2, "Study")
-    rows = [["study file", study.path]] + [[k, _value(a[k])] for k in META_KEYS if k in a]
-    doc.table(["field", "value"], rows)
+    doc.table(["field", "value"], [["study file", study.path]] + [[k, _value(a[k])] for k in META_KEYS])
     for gap in study.gaps:
         doc.note(f"Incomplete study file: {gap}. The tables below rank only what the file holds.")
-    bench = [[k, _value(a[k])] for k in BENCH_KEYS if k in a]
-    if study.timings and bench:
-        doc.table(["benchmark setting", "value"], bench, caption="Timing run (Google Benchmark):")
-        if str(a.get("cpu_scaling_enabled", "0")) == "1":
+    if study.timed:
+        doc.table(["benchmark setting", "value"], [[k, _value(a[k])] for k in BENCH_KEYS],
+                  caption="Timing run (Google Benchmark):")
+        if int(a["cpu_scaling_enabled"]) == 1:
             doc.note("CPU frequency scaling was on during the timing run: times may be noisy.")
     else:
-        doc.p("Timings: absent (a plain sweep). Work-precision is shown against force evaluations only; "
-              "`stepbench_bench --study_out` adds measured times and the peer methods.")
-    prow = []
+        doc.p("Timings: absent (a plain sweep). Costs are counted force evaluations; "
+              "`stepbench_bench --study_out` adds measured times.")
+    rows = []
     for p in study.problems:
         pa = p.attrs
         params = ", ".join(f"{k} = {_value(v)}" for k, v in sorted(pa.items()) if k not in PROBLEM_KEYS)
-        prow.append([p.name, pa.get("description", ""), fmt_num(pa.get("horizon"), 4) + " s", p.unit,
-                     pa.get("truth_source", ""), params])
-    doc.table(["problem", "scene", "horizon", "position unit", "truth", "parameters"], prow, caption="Problems:")
-
-    # --- summary -------------------------------------------------------------------------
-    doc.h(2, "Summary: cheapest method per error target")
-    doc.p("For each problem and each target error (1e-2, 1e-4, 1e-6, absolute, in the problem's unit), the "
-          "cheapest run in the study that reaches it: by measured time when the study has timings for every "
-          "qualifying run, else by counted force evaluations. Diverged runs and runs the time budget cut are not "
-          "candidates. The first table asks for the final position error (`err_pos_final`, at the horizon); the "
-          "second for the max position error over the run (`err_pos_max`), which a game needs at every frame: "
-          "a final error can be small by luck (a damped motion that has died out, a pendulum back at its turning "
-          "point) and the note says so. `stepbench advise --problem P --tol X` answers the same question for any "
-          "target, by default on the max error.")
+        truth = pa["truth_source"] if int(pa["truth_trusted"]) else f"none trusted: {pa['truth_note']}"
+        rows.append([p.name, pa["description"], fmt_num(pa["horizon"], 4) + " s", p.unit, truth, params])
+    doc.table(["problem", "scene", "horizon", "position unit", "truth", "parameters"], rows, caption="Problems:")
     for p in study.problems:
-        doc.h(3, f"{p.name}: cheapest method", anchor=f"summary-{p.name}")
-        for metric, title in (("err_pos_final", "by final error"), ("err_pos_max", "by max error over the run")):
-            doc.h(4, f"{p.name}: cheapest {title}", anchor=f"summary-{p.name}-{metric}")
-            doc.table(*_summary_table(p, metric, study.timings))
+        if not int(p.attrs["truth_trusted"]):
+            doc.note(f"{p.name} has no trusted truth ({p.attrs['truth_note']}): every error on it is NaN, "
+                     "every run is marked failed, and it has no cheapest method or front.")
 
-    # --- convergence ---------------------------------------------------------------------
+
+def _summary(doc, study):
+    doc.h(2, "Summary: cheapest method per error target")
+    doc.p("For each problem and each target error (absolute, in the problem's unit), the cheapest method whose "
+          "run reaches it, from the study's `equal_error` table: by measured time when the study has a time for "
+          "every qualifying run, else by counted force evaluations; diverged or failed runs and runs the time "
+          "budget cut do not count; only measured rows, no interpolation. The hand-written baseline is a timing "
+          "floor, never the answer: where it reaches the target its cost is shown for scale. The first table asks "
+          "for the final position error (`err_pos_final`, at the horizon); the second for the max position error "
+          "over the run (`err_pos_max`), which a game needs at every frame: a final error can be small by luck "
+          "(a damped motion that has died out, a pendulum back at its turning point) and the note says so. "
+          "`stepbench advise --problem P --tol X` answers the same question for any target by the same rule.")
+    for p in study.problems:
+        doc.h(3, f"{p.name}: cheapest method")
+        for metric, title in tables.SUMMARY_METRICS:
+            doc.h(4, f"{p.name}: cheapest {title}")
+            doc.table(*tables.summary_rows(p, metric))
+
+
+def _convergence(doc, study, figs):
     doc.h(2, "Convergence")
-    doc.p("Max position error over the run (`err_pos_max`, the study's fit metric) against the timestep, log-log. "
+    doc.p("Max position error over the run (`err_pos_max`, the study's fit metric) against the timestep, log-log, "
+          "for every fixed-step method: ours in full, the peers and the baseline faint and dashed behind them. "
           "The legend gives the fitted slope (observed order); dashed grey lines are reference slopes 1, 2 and 4. "
           "Filled markers are the ladder levels the fit used; hollow ones were left out (round-off floor, or "
-          "errors above 10 % of the motion before the asymptotic range).")
+          "errors above 10 % of the motion before the asymptotic range). Adaptive methods run over tolerances, "
+          "not timesteps: they are under Work-precision. \"Declared order holds\" is stepbench's verdict: the "
+          "observed order within 0.5 of the declared one.")
     for p in study.problems:
-        doc.h(3, f"{p.name}: convergence", anchor=f"convergence-{p.name}")
+        doc.h(3, f"{p.name}: convergence")
         name = f"convergence_{p.name}.png"
         if name in figs:
             doc.img(f"fig/{name}", f"convergence on {p.name}")
-        rows = [[r["method"], r["expected"], r["observed"], r["levels"], r["dt_range"], r["residual"]]
-                for r in tables.order_rows(p)]
-        doc.h(4, f"{p.name}: observed order", anchor=f"order-{p.name}")
-        doc.table(["integrator", "expected order", "observed order", "fit levels", "fit dt range [s]",
-                   "fit residual (log10)"], rows)
-        peer_rows = tables.order_rows(p, peers=True)
-        if peer_rows:
-            def agreement(r):
-                # A peer whose declared order is off by more than half an order from what it
-                # achieves is reported, not hidden (GSL's rk2 advances with its third-order
-                # member; Boost's velocity_verlet declares 1).
-                try:
-                    declared, observed = float(r["expected"]), float(r["observed_value"])
-                except (TypeError, ValueError):
-                    return ""
-                if not (np.isfinite(declared) and np.isfinite(observed)):
-                    return ""
-                return "yes" if abs(observed - declared) <= 0.5 else f"NO: declares {declared:g}, achieves {observed:.2f}"
-            doc.table(["peer (fixed step)", "declared order", "observed order", "fit levels", "fit dt range [s]",
-                       "fit residual (log10)", "declaration holds"],
-                      [[r["method"], r["expected"], r["observed"], r["levels"], r["dt_range"], r["residual"],
-                        agreement(r)] for r in peer_rows])
+        doc.h(4, f"{p.name}: observed order")
+        doc.table(tables.ORDER_HEAD, tables.order_rows(p))
 
-    # --- work-precision ------------------------------------------------------------------
+
+def _work_precision(doc, study):
     doc.h(2, "Work-precision")
-    if study.timings:
+    if study.timed:
         doc.p("Error against measured time (median wall time of one whole run) and against counted force "
-              "evaluations, every method including the peers (dashed). The thick gold band is the Pareto front: "
-              "runs that no other run beats in both cost and error.")
+              "evaluations, every method: ours solid, the peers dashed, the hand-written baseline dotted (for scale). "
+              "The thick gold band is the study's Pareto front: runs that no other run beats in both cost and "
+              "error (the baseline left out). Runs the time budget cut are not drawn.")
         doc.img("fig/work_precision_time.png", "work-precision against time")
     else:
         doc.note("Timings are absent from this study, so work-precision is shown against force evaluations only "
-                 "(a proxy for cost that ignores per-step overhead). Run the benchmark study for error against time "
-                 "and for the peer methods.")
+                 "(a proxy for cost that ignores per-step overhead). Run the benchmark study for error against time.")
     doc.img("fig/work_precision_force_evals.png", "work-precision against force evaluations")
-    x_field = "time_s" if study.timings else "force_evals"
+    primary = "time" if study.timed else "force_evals"
     for p in study.problems:
-        front = tables.pareto_front(tables.work_points(p, x_field, study.timings))
-        doc.h(3, f"{p.name}: Pareto front", anchor=f"pareto-{p.name}")
-        methods = list(dict.fromkeys(f[0] for f in front))
-        doc.p("Methods on the front (by " + ("time" if study.timings else "force evaluations") + "): "
-              + (", ".join(methods) if methods else "none") + ".")
-        doc.table(["method", "runs", "dt or tolerance", "time per run" if study.timings else "force evals",
-                   f"err_pos_max [{p.unit}]"], _front_rows(front, study.timings))
+        doc.h(3, f"{p.name}: Pareto front")
+        methods = tables.front_methods(p, primary)
+        text = (f"Methods on the front by {'time' if study.timed else 'force evaluations'}: "
+                + (", ".join(methods) if methods else "none") + ".")
+        if study.timed:
+            by_evals = tables.front_methods(p, "force_evals")
+            text += " By force evaluations: " + (", ".join(by_evals) if by_evals else "none") + "."
+        doc.p(text)
+        doc.table(*tables.front_rows(p, primary))
+        rows = tables.adaptive_rows(p)
+        if rows:
+            doc.h(4, f"{p.name}: adaptive methods")
+            doc.p("The adaptive methods run over the tolerance ladder (rtol = atol = tol). The slope is fitted to "
+                  "log `err_pos_max` against log tol: near 1, the error follows the tolerance asked for.")
+            doc.table(tables.ADAPTIVE_HEAD, rows)
 
-    # --- stability -----------------------------------------------------------------------
+
+def _stability(doc, study):
     doc.h(2, "Stability")
     stab = study.optional.get("stability")
     if stab:
@@ -226,7 +239,7 @@ def document(study, figs):
             row += ["none (unstable)" if r["dt_limit"] == 0 else f"{r['dt_limit']:.4g}",
                     "none (unstable)" if r["dt_limit_damped"] == 0 else f"{r['dt_limit_damped']:.4g}"]
         rows.append(row)
-    doc.h(3, "Theoretical limits on the oscillator", anchor="stability-theory")
+    doc.h(3, "Theoretical limits on the oscillator")
     doc.p("One step of each method on x'' = -w^2 x is a 2x2 matrix M(y) with y = w dt, built symbolically from "
           "the step code (exact rational coefficients). The motion stays bounded while both eigenvalues of M lie in "
           "the unit disk; the limits below are the first roots of det M - 1, 1 - trace M + det M and "
@@ -236,27 +249,30 @@ def document(study, figs):
           "|trace M| < 2. With damping the same matrices give the problem's own limit.")
     doc.table(head, rows)
     doc.img("fig/stability_regions.png", "stability regions")
+    factor = float(study.attrs["divergence_factor"])
     for p, w0, zeta in osc:
         lim = {r["method"]: r for r in theory.oscillator_table(list(theory.STEPS), w0, zeta)}
         rows = []
-        for m in p.integrators:
+        for m in p.by_origin("ours", adaptive=False):
             if m.name not in lim:
                 continue
             dl = lim[m.name]["dt_limit_damped"]
             dt, err, div = m.param, m.col("err_pos_max"), m.diverged
             above = dt >= dl
-            big = err[above & ~div & np.isfinite(err)]
+            big = err[above & m.completed & np.isfinite(err)]
             rows.append([m.name, f"{dl:.4g}", f"{dt.max():.4g}", str(int(above.sum())), str(int((above & div).sum())),
                          fmt_num(big.max()) + f" {p.unit}" if len(big) else "", str(int((~above & div).sum()))])
-        doc.h(3, f"{p.name}: ladder against the limits", anchor=f"ladder-{p.name}")
+        doc.h(3, f"{p.name}: ladder against the limits")
         doc.p(f"Each ladder row against the theoretical limit (with the damping) on {p.name}. A run counts as "
-              f"diverged when its error exceeds {study.attrs.get('divergence_factor', 1e6):g} x the motion's scale, "
-              "so a row just above the limit may grow "
-              "without being flagged within the horizon; a diverged row below the limit would contradict the theory.")
-        doc.table(["integrator", "theoretical dt limit [s]", "coarsest dt in the study [s]", "rows at or above the limit",
-                   "of those, diverged", "largest error of the others", "diverged rows below the limit"], rows)
+              f"diverged when its position error exceeds {factor:g} x the motion's scale (`divergence_factor`), "
+              "so a row just above the limit may grow without being flagged within the horizon; a diverged row "
+              "below the limit would contradict the theory.")
+        doc.table(["integrator", "theoretical dt limit [s]", "coarsest dt in the study [s]",
+                   "rows at or above the limit", "of those, diverged", "largest error of the others",
+                   "diverged rows below the limit"], rows)
 
-    # --- energy --------------------------------------------------------------------------
+
+def _energy(doc, study, figs):
     doc.h(2, "Energy")
     runs = study.optional.get("energy_runs")
     if runs:
@@ -264,76 +280,24 @@ def document(study, figs):
         _generic_section(doc, runs)
     else:
         doc.note("Energy drift over time on long runs: absent (this study has no long runs). Shown instead: the "
-                 "energy error at the horizon of every convergence run.")
+                 "energy error at the horizon of every run of our fixed-step methods.")
     if "energy_drift.png" in figs:
         doc.img("fig/energy_drift.png", "energy drift at the horizon")
 
-    # --- game loop -----------------------------------------------------------------------
-    doc.h(2, "Game loop")
-    gl = study.optional.get("game_loop")
-    if gl:
-        _generic_section(doc, gl)
-    else:
-        doc.note("Game-loop figures: absent (this study has no game-loop data).")
 
-    # --- references ----------------------------------------------------------------------
+def _references(doc, study):
     doc.h(2, "References")
     doc.p("The reference solutions every error is measured against (or checked with, where a closed form exists): "
-          "accepted steps, rejected attempts, right-hand-side calls as the solver reports them, the extra calls "
-          "CVODE makes for its difference-quotient Jacobian, and every call counted by a wrapper; agreement is the "
-          "max over the sample times of |difference| relative to the motion's scale.")
+          "status, accepted steps, rejected attempts, right-hand-side calls as the solver reports them, the extra "
+          "calls CVODE makes for its difference-quotient Jacobian, and every call counted by a wrapper; agreement "
+          "is the max over the sample times of |difference| relative to the motion's scale.")
     for p in study.problems:
-        rows = [[r["source"], r["truth"], _value(r["steps"]), _value(r["failed"]), _value(r["rhs_evals"]),
-                 _value(r["lin_rhs_evals"]), _value(r["rhs_evals_counted"]), r["compared_with"],
-                 fmt_num(r["err_pos_rel"], 2), fmt_num(r["err_vel_rel"], 2)] for r in tables.reference_rows(p)]
-        doc.h(3, f"{p.name}: references", anchor=f"references-{p.name}")
+        doc.h(3, f"{p.name}: references")
+        rows = tables.reference_rows(p)
         if rows:
-            doc.table(["source", "is truth", "steps", "failed steps", "rhs_evals", "lin_rhs_evals",
-                       "rhs_evals_counted", "compared with", "position agreement (rel.)",
-                       "velocity agreement (rel.)"], rows)
+            doc.table(tables.REFERENCE_HEAD, rows)
         else:
             doc.p("No references recorded.")
-    return doc
-
-
-def _summary_table(p, metric, timings):
-    rows = []
-    for tol in tables.THRESHOLDS:
-        win, cost, best = tables.cheapest(p, tol, timings, metric)
-        if win is None:
-            best_text = (f"none reaches it; best in the study: {fmt_num(best['err'])} {p.unit} by "
-                         f"{best['method'].name} ({fmt_param(best['method'], best['param'])})") if best else ""
-            rows.append([f"{tol:g}", "none", "", "", "", "", best_text])
-            continue
-        m = win["method"]
-        note = ""
-        if metric == "err_pos_final" and np.isfinite(win["err_pos_max"]) and win["err_pos_max"] > 10 * tol:
-            note = f"small at the horizon only: the max error over the run is {fmt_num(win['err_pos_max'])} {p.unit}"
-        rows.append([f"{tol:g}", m.name + (" (peer)" if m.peer else ""), fmt_param(m, win["param"]),
-                     _cost_text(cost, win), fmt_num(win["err_final"]), fmt_num(win["err_pos_max"]), note])
-    head = [f"target {metric} [{p.unit}]", "cheapest method", "dt or tolerance", "cost",
-            f"err_pos_final [{p.unit}]", f"err_pos_max [{p.unit}]", "note"]
-    return head, rows
-
-
-def _front_rows(front, timings):
-    """The Pareto front, consecutive runs of one method merged into one row."""
-    groups = []
-    for f in front:
-        if groups and groups[-1][0][0] == f[0]:
-            groups[-1].append(f)
-        else:
-            groups.append([f])
-    rows = []
-    for g in groups:
-        m = g[0][4]
-        cost = (lambda x: fmt_time_ns(x * 1e9)) if timings else (lambda x: str(int(x)))
-        span = lambda a, b, f: f(a) if a == b else f"{f(a)} .. {f(b)}"  # noqa: E731
-        pfmt = (lambda v: f"{v:.3g}") if m.adaptive else (lambda v: f"{v:.6g}")
-        rows.append([g[0][0] + (" (peer)" if m.peer else ""), str(len(g)),
-                     ("rtol " if m.adaptive else "dt ") + span(g[0][3], g[-1][3], pfmt) + ("" if m.adaptive else " s"),
-                     span(g[0][1], g[-1][1], cost), span(g[0][2], g[-1][2], fmt_num)])
-    return rows
 
 
 def _generic_section(doc, data):

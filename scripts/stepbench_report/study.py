@@ -1,23 +1,56 @@
-"""Reading a study file (docs/study-format.md) into plain Python objects.
+"""Reading a study file (docs/study-format.md, format 2) into plain Python objects.
 
-The report works on two shapes of file: a plain sweep (convergence rows without
-timings, no peers) and a timed study (time_ns / repetitions / cut in `convergence`,
-peer groups with `work_precision`, benchmark root attributes). Everything optional is
-read as "absent", never assumed.
+Every method (ours, the peers, the baseline) has one row shape, `methods/<m>/runs`; the
+figures derived from the rows (the cheapest method per error target, the Pareto
+fronts) are computed in C++ and stored beside them. This module reads them as they are
+and checks that everything the report uses is there: a file that lacks a documented
+attribute, field or dataset is a StudyError naming the file and what is missing.
+Nothing is filled in with a default.
 """
+import os
 from dataclasses import dataclass, field
 
 import h5py
 import numpy as np
 
-# The position unit of each problem: the format says SI, "metres, or radians for
-# pendulum, whose state is the angle". A `position_unit` attribute, if a writer adds one,
-# takes precedence over this table.
-POSITION_UNIT = {"pendulum": "rad"}
+FORMAT_VERSION = 2  # the only format_version this report reads
+
+# What docs/study-format.md documents, and the report reads, at each level.
+ROOT_ATTRS = ("format_version", "version", "git_commit", "compiler", "build_type", "dependencies", "created_utc",
+              "cpu", "cores", "levels", "base_steps", "tolerances", "sample_count", "reference_rtol",
+              "reference_atol", "fit_metric", "divergence_factor", "equal_error_targets", "wall_seconds", "timing")
+TIMED_ROOT_ATTRS = ("benchmark_mode", "benchmark_min_time_s", "benchmark_repetitions", "benchmark_case_budget_s",
+                    "benchmark_wall_seconds", "cpu_scaling_enabled", "num_cpus", "mhz_per_cpu")
+PROBLEM_ATTRS = ("horizon", "dim", "position_unit", "description", "has_closed_form", "has_energy", "has_jacobian",
+                 "truth_source", "truth_trusted", "truth_note", "agreement_limit", "pos_scale", "vel_scale",
+                 "energy_scale")
+REFERENCE_ATTRS = ("status", "reason", "is_truth", "steps", "failed_steps", "rhs_evals", "lin_rhs_evals",
+                   "jac_evals", "rhs_evals_counted", "rtol", "atol", "wall_seconds", "compared_with", "err_pos_rel",
+                   "err_vel_rel")
+METHOD_ATTRS = ("origin", "kind", "param_kind", "declared_order", "description", "library", "symplectic",
+                "reuses_last_force", "needs_jacobian", "error_estimate", "dense_output", "fit_status", "fit_metric",
+                "fit_param", "fit_slope", "observed_order", "fit_levels", "fit_residual_log10", "fit_note",
+                "exact_for_problem", "declared_order_holds")
+RUN_FIELDS = ("param", "steps", "rejected_steps", "force_evals", "jacobian_evals", "newton_iterations",
+              "linear_solves", "err_pos_final", "err_vel_final", "err_pos_max", "err_pos_rms", "energy_drift",
+              "energy_err_max", "diverged", "failed", "note")
+TIMED_RUN_FIELDS = ("time_ns", "time_ns_min", "time_ns_max", "repetitions", "cut")
+EQUAL_ERROR_FIELDS = ("metric", "target", "rank", "method", "origin", "kind", "param", "error", "cost_kind", "cost",
+                      "time_ns", "force_evals", "is_answer")
+FRONT_FIELDS = ("method", "param", "cost", "err_pos_max")
+
+# The targets of the report's summary: the file must have computed `equal_error` for
+# each (the issue's "errors of 1e-2, 1e-4 and 1e-6").
+SUMMARY_TARGETS = (1e-2, 1e-4, 1e-6)
+
+# The closed vocabularies of the format: any other value is an error, not a guess.
+ORIGINS = ("ours", "peer", "baseline")
+PARAM_KIND = {"fixed_step": "dt", "adaptive": "tolerance"}  # kind -> what `param` is
+FIT_STATUSES = ("fitted", "exact", "insufficient")
 
 # Root groups that later issues will add (stability limits, long energy runs, game-loop
-# figures). Their layout is not defined yet; these are the optional hooks: when a root
-# group of one of these names exists the report shows a generic section for it.
+# figures). Their layout is not defined yet; when a root group of one of these names
+# exists the report shows a generic section for it.
 OPTIONAL_SECTIONS = {
     "stability": "Measured stability limits",
     "energy_runs": "Energy drift over time (long runs)",
@@ -26,85 +59,102 @@ OPTIONAL_SECTIONS = {
 
 
 class StudyError(Exception):
-    """The file is missing, not HDF5, or not a study file."""
+    """The file is missing, not HDF5, damaged, of another format_version, or lacks
+    something the format requires. The message is one line and names the file."""
 
 
 def _text(value):
-    if isinstance(value, h5py.Empty):  # a null dataspace, e.g. fit_levels of an exact fit
+    """h5py hands strings back as bytes in compound fields and as str in attributes;
+    the report sees str."""
+    if isinstance(value, h5py.Empty):  # a null dataspace: fit_levels of a fit that used none
         return np.array([], dtype=int)
     if isinstance(value, bytes):
         return value.decode()
-    if isinstance(value, np.ndarray) and value.dtype.kind in "SO" and value.shape == ():
-        return _text(value[()])
     return value
 
 
-def _attrs(obj):
-    return {k: _text(v) for k, v in obj.attrs.items()}
+def _decoded(rows):
+    """A structured array with its string fields (HDF5 variable-length strings, read as
+    bytes objects) turned into str, so that `rows["method"] == "rk4"` works."""
+    if rows.dtype.names is None:
+        return rows
+    out = rows.copy()
+    for name in rows.dtype.names:
+        if rows.dtype[name].kind in "OS":
+            out[name] = [_text(v) for v in rows[name]]
+    return out
 
 
 @dataclass
 class Method:
-    """An integrator (`convergence`) or a peer (`work_precision`) of one problem."""
+    """One method on one problem: its attributes and its `runs`, one row per ladder entry."""
     name: str
-    peer: bool
     attrs: dict
-    rows: np.ndarray  # the structured dataset as read
+    runs: np.ndarray
+
+    @property
+    def origin(self):
+        return self.attrs["origin"]
 
     @property
     def adaptive(self):
-        return self.peer and self.attrs.get("kind") == "adaptive"
-
-    @property
-    def param_name(self):
-        return "rtol" if self.adaptive else "dt"
+        return self.attrs["kind"] == "adaptive"
 
     @property
     def param(self):
-        return self.col("param" if self.peer else "dt")
-
-    def has(self, name):
-        return name in (self.rows.dtype.names or ())
+        return self.runs["param"]
 
     def col(self, name):
-        """A field as float64 (NaN where absent), so missing fields need no special case."""
-        if not self.has(name):
-            return np.full(len(self.rows), np.nan)
-        return np.asarray(self.rows[name], dtype=float)
+        return np.asarray(self.runs[name], dtype=float)
+
+    @property
+    def completed(self):
+        """Rows that ran to the horizon: neither diverged nor failed (their errors mean something)."""
+        return (self.runs["diverged"] == 0) & (self.runs["failed"] == 0)
 
     @property
     def diverged(self):
-        """Integrators record `diverged`; a peer row with a non-finite error failed too."""
-        bad = ~np.isfinite(self.col("err_pos_max"))
-        if self.has("diverged"):
-            bad |= self.col("diverged") != 0
-        return bad
-
-    @property
-    def timed(self):
-        return self.has("time_ns")
+        return self.runs["diverged"] != 0
 
     @property
     def cut(self):
-        return self.col("cut") == 1 if self.has("cut") else np.zeros(len(self.rows), bool)
+        """Rows whose timing the time budget skipped (timed study only; False elsewhere)."""
+        if "cut" not in self.runs.dtype.names:
+            return np.zeros(len(self.runs), bool)
+        return self.runs["cut"] != 0
 
     @property
-    def expected_order(self):
-        return self.attrs.get("expected_order", self.attrs.get("declared_order", float("nan")))
+    def declared_order(self):
+        return float(self.attrs["declared_order"])
+
+    @property
+    def fit_levels(self):
+        return [int(k) for k in np.atleast_1d(self.attrs["fit_levels"])]
+
+    def row_at(self, param):
+        """The index of the row run at `param` (a dt or tolerance the file names elsewhere)."""
+        hits = np.flatnonzero(self.param == param)
+        return int(hits[0]) if len(hits) else None
 
 
 @dataclass
 class Problem:
     name: str
     attrs: dict
-    unit: str
-    integrators: list = field(default_factory=list)
-    peers: list = field(default_factory=list)
-    references: dict = field(default_factory=dict)  # source -> attrs
+    methods: list  # Method, ours first (by declared order), then the peers, then the baseline
+    references: dict  # source -> attrs
+    equal_error: np.ndarray  # the C++ cheapest-method table, strings decoded
+    fronts: dict  # "force_evals" and, in a timed study, "time" -> the C++ Pareto front
 
     @property
-    def methods(self):
-        return self.integrators + self.peers
+    def unit(self):
+        return self.attrs["position_unit"]
+
+    def method(self, name):
+        return next(m for m in self.methods if m.name == name)
+
+    def by_origin(self, *origins, adaptive=None):
+        return [m for m in self.methods if m.origin in origins and (adaptive is None or m.adaptive == adaptive)]
 
 
 @dataclass
@@ -116,77 +166,170 @@ class Study:
     gaps: list = field(default_factory=list)  # what a complete study would have and this one lacks
 
     @property
-    def timings(self):
-        """Timings exist when the root says so or any row carries time_ns."""
-        if int(self.attrs.get("timing", 0) or 0) == 1:
-            return True
-        return any(m.timed for p in self.problems for m in p.methods)
-
-    @property
-    def has_peers(self):
-        return any(p.peers for p in self.problems)
+    def timed(self):
+        return int(self.attrs["timing"]) == 1
 
 
 def _method_sort_key(m):
-    order = m.expected_order
-    return (m.peer, order if np.isfinite(order) else 99, m.name)
+    order = m.declared_order
+    return (ORIGINS.index(m.origin), m.adaptive, order if np.isfinite(order) else 99, m.name)
+
+
+class _Reader:
+    """Reads one open file; every lookup of something required goes through `need_*`,
+    which raises a StudyError naming the object and what it lacks."""
+
+    def __init__(self, path, f):
+        self.path, self.f = path, f
+
+    def error(self, what):
+        return StudyError(f"cannot read study file '{self.path}': {what}")
+
+    def need_attrs(self, obj, names):
+        missing = [n for n in names if n not in obj.attrs]
+        if missing:
+            where = "the root group" if obj.name == "/" else obj.name
+            raise self.error(f"{where} lacks attribute{'s' if len(missing) > 1 else ''} {', '.join(missing)}")
+        return {k: _text(v) for k, v in obj.attrs.items()}
+
+    def need_group(self, parent, name):
+        g = parent.get(name)
+        if not isinstance(g, h5py.Group):
+            raise self.error(f"{parent.name.rstrip('/')}/{name} is missing (a group)")
+        return g
+
+    def need_table(self, parent, name, fields):
+        ds = parent.get(name)
+        if not isinstance(ds, h5py.Dataset):
+            raise self.error(f"{parent.name.rstrip('/')}/{name} is missing (a dataset)")
+        names = ds.dtype.names or ()
+        missing = [n for n in fields if n not in names]
+        if missing:
+            raise self.error(f"{ds.name} lacks field{'s' if len(missing) > 1 else ''} {', '.join(missing)}")
+        return _decoded(ds[()])
+
+    def need_value(self, obj, key, value, allowed):
+        if value not in allowed:
+            raise self.error(f"{obj.name}: {key} is '{value}', not one of {', '.join(map(str, allowed))}")
+
+    def method(self, g, timed):
+        attrs = self.need_attrs(g, METHOD_ATTRS)
+        self.need_value(g, "origin", attrs["origin"], ORIGINS)
+        self.need_value(g, "kind", attrs["kind"], tuple(PARAM_KIND))
+        self.need_value(g, "param_kind", attrs["param_kind"], (PARAM_KIND[attrs["kind"]],))
+        self.need_value(g, "fit_status", attrs["fit_status"], FIT_STATUSES)
+        self.need_value(g, "declared_order_holds", int(attrs["declared_order_holds"]), (-1, 0, 1))
+        runs = self.need_table(g, "runs", RUN_FIELDS + (TIMED_RUN_FIELDS if timed else ()))
+        name = g.name.rsplit("/", 1)[1]
+        levels = np.atleast_1d(attrs["fit_levels"])
+        if len(levels) and (levels.min() < 0 or levels.max() >= len(runs)):
+            raise self.error(f"{g.name}: fit_levels {levels.tolist()} name rows beyond its {len(runs)} runs")
+        return Method(name, attrs, runs)
+
+    def problem(self, g, timed):
+        attrs = self.need_attrs(g, PROBLEM_ATTRS)
+        methods = [self.method(mg, timed) for mg in self.need_group(g, "methods").values()
+                   if isinstance(mg, h5py.Group)]
+        methods.sort(key=_method_sort_key)
+        refs = g.get("reference")
+        references = {}
+        if isinstance(refs, h5py.Group):  # absent references are a gap (see _gaps), not a fault
+            references = {src: self.need_attrs(r, REFERENCE_ATTRS) for src, r in refs.items()
+                          if isinstance(r, h5py.Group)}
+        fronts = {"force_evals": self.need_table(g, "front_force_evals", FRONT_FIELDS)}
+        if timed:
+            fronts["time"] = self.need_table(g, "front_time", FRONT_FIELDS)
+        p = Problem(g.name.rsplit("/", 1)[1], attrs, methods, references,
+                    self.need_table(g, "equal_error", EQUAL_ERROR_FIELDS), fronts)
+        self.check_derived(g, p)
+        return p
+
+    def check_derived(self, g, p):
+        """The derived tables name rows of `runs` by (method, param): each must exist, or
+        the report would print a figure it cannot trace to a run."""
+        names = {m.name: m for m in p.methods}
+        tables = [("equal_error", p.equal_error)] + [(f"front_{k}", v) for k, v in p.fronts.items()]
+        for table, rows in tables:
+            for r in rows:
+                m = names.get(r["method"])
+                if m is None or m.row_at(r["param"]) is None:
+                    raise self.error(f"{g.name}/{table} names a run that {g.name}/methods lacks "
+                                     f"({r['method']} at {r['param']:g})")
+
+    def study(self):
+        f = self.f
+        if "format_version" not in f.attrs:
+            raise self.error("not a stepbench study (an HDF5 file without format_version)")
+        version = int(f.attrs["format_version"])
+        if version > FORMAT_VERSION:
+            raise self.error(f"written by a newer stepbench (format_version {version}; "
+                             f"this report reads {FORMAT_VERSION})")
+        if version < FORMAT_VERSION:
+            raise self.error(f"format_version {version} is older than this report reads ({FORMAT_VERSION}); "
+                             "run the study again with this stepbench")
+        attrs = self.need_attrs(f, ROOT_ATTRS)
+        self.need_value(f, "timing", int(attrs["timing"]), (0, 1))
+        targets = np.atleast_1d(attrs["equal_error_targets"])
+        absent = [t for t in SUMMARY_TARGETS if not np.isclose(targets, t, rtol=1e-9, atol=0).any()]
+        if absent:
+            raise self.error(f"equal_error_targets lacks {', '.join(f'{t:g}' for t in absent)} "
+                             "(the report's summary targets)")
+        timed = int(attrs["timing"]) == 1
+        if timed:
+            self.need_attrs(f, TIMED_ROOT_ATTRS)
+        problems = [self.problem(g, timed) for g in self.need_group(f, "problems").values()
+                    if isinstance(g, h5py.Group)]
+        if not problems:
+            raise self.error("/problems holds no problem")
+        optional = {name: {"title": title, "attrs": {k: _text(v) for k, v in f[name].attrs.items()},
+                           "datasets": {k: v.shape for k, v in f[name].items() if isinstance(v, h5py.Dataset)}}
+                    for name, title in OPTIONAL_SECTIONS.items() if isinstance(f.get(name), h5py.Group)}
+        return Study(path=str(self.path), attrs=attrs, problems=problems, optional=optional, gaps=_gaps(problems))
 
 
 def load(path):
+    """The study at `path`, checked; StudyError (one line, naming the file) otherwise."""
+    def error(what):
+        return StudyError(f"cannot read study file '{path}': {what}")
+    if not os.path.exists(path):
+        raise error("no such file")
+    if os.path.isdir(path):
+        raise error("it is a directory")
     try:
+        if not h5py.is_hdf5(path):
+            raise error("not an HDF5 file")
         f = h5py.File(path, "r")
-    except FileNotFoundError:
-        raise StudyError(f"cannot read study file '{path}': no such file") from None
-    except OSError as e:
-        raise StudyError(f"cannot read study file '{path}': {str(e).splitlines()[0]}") from None
-    with f:
-        if "format_version" not in f.attrs:
-            raise StudyError(f"cannot read study file '{path}': not a stepbench study (no format_version)")
-        problems, optional = [], {}
-        for name, g in f.items():
-            if not isinstance(g, h5py.Group):
-                continue
-            if name in OPTIONAL_SECTIONS:
-                optional[name] = {
-                    "title": OPTIONAL_SECTIONS[name],
-                    "attrs": _attrs(g),
-                    "datasets": {k: v.shape for k, v in g.items() if isinstance(v, h5py.Dataset)},
-                }
-                continue
-            attrs = _attrs(g)
-            unit = attrs.get("position_unit") or POSITION_UNIT.get(name, "m")
-            p = Problem(name=name, attrs=attrs, unit=unit)
-            for child_name, child in g.items():
-                if child_name == "reference" or not isinstance(child, h5py.Group):
-                    continue
-                # The format's rule: an integrator group holds `convergence`, a peer group
-                # holds `work_precision`.
-                if isinstance(child.get("convergence"), h5py.Dataset):
-                    p.integrators.append(Method(child_name, False, _attrs(child), child["convergence"][()]))
-                elif isinstance(child.get("work_precision"), h5py.Dataset):
-                    p.peers.append(Method(child_name, True, _attrs(child), child["work_precision"][()]))
-            if isinstance(g.get("reference"), h5py.Group):
-                p.references = {k: _attrs(v) for k, v in g["reference"].items() if isinstance(v, h5py.Group)}
-            if not p.integrators and not p.peers:
-                continue
-            p.integrators.sort(key=_method_sort_key)
-            p.peers.sort(key=_method_sort_key)
-            problems.append(p)
-        if not problems:
-            raise StudyError(f"cannot read study file '{path}': it holds no problem with integrators")
-        return Study(path=str(path), attrs=_attrs(f), problems=problems, optional=optional, gaps=_gaps(problems))
+    except StudyError:
+        raise
+    except OSError as e:  # HDF5's signature is there but the file cannot be opened
+        raise error(f"damaged or truncated HDF5 file: {_first_line(e)}") from None
+    try:
+        with f:
+            return _Reader(path, f).study()
+    except StudyError:
+        raise
+    except (OSError, KeyError, ValueError, RuntimeError) as e:  # h5py's errors on a damaged object
+        raise error(f"damaged or truncated HDF5 file: {_first_line(e)}") from None
+
+
+def _first_line(e):
+    return str(e).splitlines()[0] if str(e) else type(e).__name__
 
 
 def _gaps(problems):
-    """A study written by stepbench has every integrator (and, when timed, every peer) on
-    every problem and the references of each; a file with less was cut down or damaged,
-    and the report says so rather than ranking what is left as if it were everything."""
+    """A study written by stepbench has, on every problem, each method that applies to it
+    and the references; a file with less was cut down or damaged, and the report says so
+    rather than ranking what is left as if it were everything. A method that every other
+    problem has and this one lacks is such a gap; one that applies to only some of the
+    problems (the baseline) is not."""
     gaps = []
-    integrators = set().union(*({m.name for m in p.integrators} for p in problems))
     for p in problems:
-        missing = sorted(integrators - {m.name for m in p.integrators})
-        if missing:
-            gaps.append(f"{p.name}: no convergence data for {', '.join(missing)}")
+        others = [q for q in problems if q is not p]
+        if others:
+            everywhere_else = set.intersection(*({m.name for m in q.methods} for q in others))
+            missing = sorted(everywhere_else - {m.name for m in p.methods})
+            if missing:
+                gaps.append(f"{p.name}: no runs for {', '.join(missing)} (every other problem has them)")
         if not p.references:
             gaps.append(f"{p.name}: no reference solutions")
     return gaps

@@ -1,19 +1,24 @@
-"""The numbers behind the report's tables, computed from the study file alone."""
+"""The report's tables, formatted from what the study file holds. Nothing here ranks,
+fits or selects: the cheapest methods come from `equal_error`, the fronts from
+`front_*`, the orders and their verdicts from each method's attributes (all computed
+in C++, core/work_precision.hpp and core/convergence_fit.hpp)."""
 import math
 
 import numpy as np
 
-THRESHOLDS = (1e-2, 1e-4, 1e-6)  # the issue's "final errors of 1e-2, 1e-4 and 1e-6"
-SUMMARY_METRIC = "err_pos_final"
+from .study import SUMMARY_TARGETS
+
+SUMMARY_METRICS = (("err_pos_final", "by final error"), ("err_pos_max", "by max error over the run"))
 
 
 def fmt_num(x, digits=3):
-    if x is None or (isinstance(x, float) and math.isnan(x)):
+    if x is None or (isinstance(x, (float, np.floating)) and math.isnan(x)):
         return "n/a"
     return f"{x:.{digits}g}"
 
 
 def fmt_time_ns(ns):
+    """As C++'s format_time_ns: "12.3 us"."""
     if ns is None or not np.isfinite(ns):
         return "n/a"
     for scale, unit in ((1e9, "s"), (1e6, "ms"), (1e3, "us")):
@@ -23,126 +28,156 @@ def fmt_time_ns(ns):
 
 
 def fmt_param(method, value):
-    return f"rtol = {value:.3g}" if method.adaptive else f"dt = {value:.6g} s"
+    return f"tol = {value:.3g}" if method.adaptive else f"dt = {value:.6g} s"
 
 
-def order_rows(problem, peers=False):
-    """Expected versus observed order, one dict per method (integrators, or fixed-step peers)."""
+def fmt_cost(cost_kind, cost):
+    return fmt_time_ns(cost) if cost_kind == "time_ns" else f"{int(cost)} force evals"
+
+
+def label(method):
+    """The method's name as every table and legend shows it: peers and the baseline marked."""
+    return method.name + {"ours": "", "peer": " (peer)", "baseline": " (baseline, for scale)"}[method.origin]
+
+
+def _fit_range(method):
+    levels = method.fit_levels
+    if not levels:
+        return ""
+    p = method.param
+    return f"{p[max(levels)]:.3g} - {p[min(levels)]:.3g}"
+
+
+def observed_text(method):
+    status = method.attrs["fit_status"]
+    if status == "exact":
+        return "exact for this problem"
+    if status == "fitted":
+        return f"{method.attrs['fit_slope']:.3f}"
+    return f"not fitted: {method.attrs['fit_note']}"
+
+
+def holds_text(method):
+    """`declared_order_holds` as the table says it: 1 yes, 0 no (with the figures), -1
+    cannot be said (exact, not fitted, or no declared order)."""
+    holds = int(method.attrs["declared_order_holds"])
+    if holds == 1:
+        return "yes"
+    if holds == 0:
+        return f"NO: declares {method.declared_order:g}, achieves {method.attrs['observed_order']:.2f}"
+    return "n/a"
+
+
+def order_rows(problem):
+    """Declared versus observed order of every fixed-step method (ours, peers, baseline)."""
     rows = []
-    for m in (problem.peers if peers else problem.integrators):
-        if peers and m.adaptive:
+    for m in problem.methods:
+        if m.adaptive:
             continue
-        a = m.attrs
-        status = a.get("fit_status", "")
-        observed = a.get("observed_order", float("nan"))
-        if int(a.get("exact_for_problem", 0) or 0) == 1 or status == "exact":
-            text = "exact for this problem"
-        elif status == "fitted" and np.isfinite(observed):
-            text = f"{observed:.3f}"
-        else:
-            text = "not fitted" + (f" ({a['fit_note']})" if a.get("fit_note") else "")
-        levels = [int(k) for k in np.atleast_1d(a.get("fit_levels", []))] if a.get("fit_levels") is not None else []
-        dt = m.param
-        dt_range = f"{dt[max(levels)]:.3g} - {dt[min(levels)]:.3g}" if levels and len(dt) > max(levels) else ""
-        expected = m.expected_order
-        rows.append({
-            "method": m.name,
-            "expected": "n/a" if not np.isfinite(expected) else f"{expected:g}",
-            "observed": text,
-            "levels": ",".join(str(k) for k in levels),
-            "dt_range": dt_range,
-            "residual": fmt_num(a.get("fit_residual_log10"), 2) if status == "fitted" else "",
-            "observed_value": observed,
-        })
+        fitted = m.attrs["fit_status"] == "fitted"
+        rows.append([label(m), "n/a" if not np.isfinite(m.declared_order) else f"{m.declared_order:g}",
+                     observed_text(m), ",".join(map(str, m.fit_levels)), _fit_range(m),
+                     fmt_num(m.attrs["fit_residual_log10"], 2) if fitted else "", holds_text(m)])
     return rows
+
+
+ORDER_HEAD = ["method", "declared order", "observed order", "fit levels", "fit dt range [s]", "fit residual (log10)",
+              "declared order holds"]
+
+
+def adaptive_rows(problem):
+    """The adaptive methods' fit of error against tolerance: a slope near 1 means the
+    error follows the tolerance asked for."""
+    rows = []
+    for m in problem.methods:
+        if not m.adaptive:
+            continue
+        fitted = m.attrs["fit_status"] == "fitted"
+        completed = m.completed
+        rows.append([label(m), m.attrs["library"], fmt_num(m.attrs["fit_slope"]) if fitted else observed_text(m),
+                     ",".join(map(str, m.fit_levels)), _fit_range(m), str(int(completed.sum())) + f" of {len(m.runs)}",
+                     str(int(m.runs["rejected_steps"].sum()))])
+    return rows
+
+
+ADAPTIVE_HEAD = ["method", "library", "error-per-tolerance slope", "fit levels", "fit tolerance range",
+                 "runs completed", "rejected steps (all runs)"]
+
+
+def summary_rows(problem, metric):
+    """The answer of `equal_error` for each summary target: the cheapest method that is
+    not the baseline, and (where the baseline reached the target too) the baseline for
+    scale."""
+    rows = []
+    table = problem.equal_error[problem.equal_error["metric"] == metric]
+    has_baseline = bool(problem.by_origin("baseline"))
+    for target in SUMMARY_TARGETS:
+        at = table[np.isclose(table["target"], target, rtol=1e-9, atol=0)]
+        answer = at[at["is_answer"] == 1]
+        if len(answer):
+            a = answer[0]
+            m = problem.method(a["method"])
+            run = m.runs[m.row_at(a["param"])]
+            note = ""
+            if metric == "err_pos_final" and run["err_pos_max"] > 10 * target:
+                note = (f"small at the horizon only: the max error over the run is {fmt_num(run['err_pos_max'])} "
+                        f"{problem.unit}")
+            row = [f"{target:g}", label(m), fmt_param(m, a["param"]), fmt_cost(a["cost_kind"], a["cost"]),
+                   fmt_num(run["err_pos_final"]), fmt_num(run["err_pos_max"]), note]
+        else:
+            row = [f"{target:g}", "none reaches it", "", "", "", "", ""]
+        if has_baseline:
+            base = at[at["origin"] == "baseline"]
+            row.append("; ".join(f"{b['method']} {fmt_param(problem.method(b['method']), b['param'])}: "
+                                 f"{fmt_cost(b['cost_kind'], b['cost'])}" for b in base) or "does not reach it")
+        rows.append(row)
+    head = [f"target {metric} [{problem.unit}]", "cheapest method", "dt or tolerance", "cost",
+            f"err_pos_final [{problem.unit}]", f"err_pos_max [{problem.unit}]", "note"]
+    if has_baseline:
+        head.append("hand-written floor (baseline, for scale)")
+    return head, rows
+
+
+def front_rows(problem, front_key):
+    """A Pareto front from the file, consecutive rows of one method merged into one line."""
+    front = problem.fronts[front_key]
+    groups = []
+    for r in front:
+        if groups and groups[-1][-1]["method"] == r["method"]:
+            groups[-1].append(r)
+        else:
+            groups.append([r])
+    cost = (lambda ns: fmt_time_ns(ns)) if front_key == "time" else (lambda n: str(int(n)))
+
+    def span(a, b, f):
+        return f(a) if a == b else f"{f(a)} .. {f(b)}"
+
+    rows = []
+    for g in groups:
+        m = problem.method(g[0]["method"])
+        param = (lambda v: f"{v:.3g}") if m.adaptive else (lambda v: f"{v:.6g}")
+        rows.append([label(m), str(len(g)),
+                     ("tol " if m.adaptive else "dt ") + span(g[0]["param"], g[-1]["param"], param)
+                     + ("" if m.adaptive else " s"),
+                     span(g[0]["cost"], g[-1]["cost"], cost), span(g[0]["err_pos_max"], g[-1]["err_pos_max"], fmt_num)])
+    head = ["method", "runs", "dt or tolerance", "time per run" if front_key == "time" else "force evals",
+            f"err_pos_max [{problem.unit}]"]
+    return head, rows
+
+
+def front_methods(problem, front_key):
+    return list(dict.fromkeys(problem.fronts[front_key]["method"]))
 
 
 def reference_rows(problem):
     rows = []
     for src, a in sorted(problem.references.items()):
-        rows.append({
-            "source": src,
-            "truth": "yes" if int(a.get("is_truth", 0) or 0) else "",
-            "steps": a.get("steps"), "failed": a.get("failed_steps"),
-            "rhs_evals": a.get("rhs_evals"), "lin_rhs_evals": a.get("lin_rhs_evals"),
-            "rhs_evals_counted": a.get("rhs_evals_counted"),
-            "compared_with": a.get("compared_with", ""),
-            "err_pos_rel": a.get("err_pos_rel"), "err_vel_rel": a.get("err_vel_rel"),
-        })
+        status = a["status"] + (f": {a['reason']}" if a["reason"] else "")
+        rows.append([src, status, "yes" if int(a["is_truth"]) else "", str(a["steps"]), str(a["failed_steps"]),
+                     str(a["rhs_evals"]), str(a["lin_rhs_evals"]), str(a["rhs_evals_counted"]), a["compared_with"],
+                     fmt_num(a["err_pos_rel"], 2), fmt_num(a["err_vel_rel"], 2)])
     return rows
 
 
-def candidates(problem, metric, timings):
-    """Every (method, row) of the problem that could answer "cheapest for an error":
-    integrator rows and peer rows, as flat records."""
-    out = []
-    for m in problem.methods:
-        err = m.col(metric)
-        if not m.has(metric):
-            continue
-        div, cut, t, fe, par = m.diverged, m.cut, m.col("time_ns"), m.col("force_evals"), m.param
-        for i in range(len(m.rows)):
-            out.append({"method": m, "i": i, "param": par[i], "err": err[i], "diverged": bool(div[i]),
-                        "cut": bool(cut[i]) and timings, "time_ns": t[i], "force_evals": fe[i],
-                        "err_pos_max": m.col("err_pos_max")[i], "err_final": m.col("err_pos_final")[i]})
-    return out
-
-
-def cheapest(problem, tol, timings, metric=SUMMARY_METRIC):
-    """The cheapest row meeting `metric <= tol`, by the same rule as `stepbench advise`:
-    a row qualifies when it did not diverge, meets the tolerance and (timed study) was
-    not cut by the time budget; the cost is time_ns when every qualifying row has one,
-    else force_evals. Ties go to the lower error, then the method name. Returns (row or None, cost_name, best)."""
-    rows = candidates(problem, metric, timings)
-    ok = [r for r in rows if not r["diverged"] and np.isfinite(r["err"]) and r["err"] <= tol and not r["cut"]]
-    all_timed = timings and all(np.isfinite(r["time_ns"]) and r["time_ns"] > 0 for r in ok)
-    cost = "time_ns" if all_timed else "force_evals"
-    best_err = min((r for r in rows if not r["diverged"] and np.isfinite(r["err"])), key=lambda r: r["err"],
-                   default=None)
-    if not ok:
-        return None, cost, best_err
-    win = min(ok, key=lambda r: (r[cost], r["err"], r["method"].name))
-    return win, cost, best_err
-
-
-def pareto_mask(cost, err, rel=1e-6):
-    """Points no other point beats in both cost and error. Going up in cost, a point
-    joins the front only if its error is lower than every cheaper point's by more than
-    `rel` (relative): the same method run by two libraries gives errors equal up to
-    round-off, and the slower one does not beat the faster."""
-    cost, err = np.asarray(cost, float), np.asarray(err, float)
-    n = len(cost)
-    mask = np.zeros(n, bool)
-    order = np.lexsort((err, cost))  # by cost, then error
-    best = np.inf
-    for i in order:
-        if err[i] < best * (1 - rel):  # best starts at inf, so the cheapest finite point joins
-            mask[i] = True
-            best = err[i]
-    return mask
-
-
-def work_points(problem, x_field, timings, err_field="err_pos_max"):
-    """Per method: (x, err) arrays of the rows usable on a work-precision plot."""
-    pts = {}
-    for m in problem.methods:
-        if not m.has(err_field):
-            continue
-        # "time_s": the median wall time, converted from the file's nanoseconds.
-        x = m.col("time_ns") * 1e-9 if x_field == "time_s" else m.col(x_field)
-        e = m.col(err_field)
-        ok = ~m.diverged & np.isfinite(x) & (x > 0) & np.isfinite(e)
-        if timings:
-            ok &= ~m.cut
-        if ok.any():
-            pts[m.name] = (x[ok], e[ok], m.param[ok], m)
-    return pts
-
-
-def pareto_front(points):
-    """[(method name, x, err, param, Method)] on the front of all methods' points."""
-    flat = [(name, x, e, p, m) for name, (xs, es, ps, m) in points.items() for x, e, p in zip(xs, es, ps)]
-    if not flat:
-        return []
-    mask = pareto_mask([f[1] for f in flat], [f[2] for f in flat])
-    return sorted((f for f, keep in zip(flat, mask) if keep), key=lambda f: f[1])
+REFERENCE_HEAD = ["source", "status", "is truth", "steps", "failed steps", "rhs_evals", "lin_rhs_evals",
+                  "rhs_evals_counted", "compared with", "position agreement (rel.)", "velocity agreement (rel.)"]

@@ -1,3 +1,10 @@
+"""Shared fixtures: the executables, and two real study files made once per session, a
+plain sweep and a quick timed study (every method, every problem), that the study-file,
+report and benchmark tests all read."""
+import os
+import subprocess
+import time
+
 import pytest
 
 
@@ -8,3 +15,31 @@ def pytest_addoption(parser):
 @pytest.fixture(scope="session")
 def stepbench(request):
     return request.config.getoption("--stepbench")
+
+
+@pytest.fixture(scope="session")
+def bench(stepbench):
+    path = os.path.join(os.path.dirname(stepbench), "stepbench_bench")
+    assert os.access(path, os.X_OK), path
+    return path
+
+
+@pytest.fixture(scope="session")
+def plain_study(stepbench, tmp_path_factory):
+    """`stepbench sweep --quick`: every method on every problem, no timings."""
+    path = tmp_path_factory.mktemp("plain") / "study.h5"
+    subprocess.run([stepbench, "sweep", "--quick", "--quiet", "--out", str(path)], check=True,
+                   stdout=subprocess.DEVNULL)
+    return path
+
+
+@pytest.fixture(scope="session")
+def timed_study(bench, tmp_path_factory):
+    """`stepbench_bench --quick --study_out`: the same sweep with every row timed (a few
+    seconds). Returns the path and the finished process, whose output some tests read."""
+    path = tmp_path_factory.mktemp("timed") / "study.h5"
+    start = time.monotonic()
+    done = subprocess.run([bench, "--quick", f"--study_out={path}"], check=True, capture_output=True, text=True,
+                          timeout=300)
+    print(f"\nquick timed study: {time.monotonic() - start:.1f} s")  # the figure the README quotes
+    return path, done

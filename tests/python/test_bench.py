@@ -1,115 +1,134 @@
-"""The benchmark executable as a user meets it: the cases it registers from the
-registries, one case in quick mode whose counters agree with `stepbench run`, the quick
-timed study file, and its bad-flag handling."""
+"""The benchmark executable as a user meets it: the cases it registers (one per row of
+the sweep that completed), Google Benchmark's own output formats and flags, one case
+whose counters agree with `stepbench run`, the quick timed study file, its bad-flag
+handling and its time budget."""
+import csv
+import io
 import json
 import math
 import os
 import subprocess
-import time
 
 import h5py
+import numpy as np
 import pytest
 
-PEERS_FIXED = ["gsl_rk4", "gsl_rk2", "gsl_rkf45"]
-PEERS_ADAPTIVE = ["gsl_rkf45_adaptive", "gsl_rk8pd_adaptive", "cvode_adams", "cvode_bdf"]
-BASELINE_PROBLEMS = {"damped_spring", "pendulum"}
+ONE_CASE = "^pendulum/rk4/dt:0.0430546/"  # a narrow filter: one case, a few milliseconds
 
 
-@pytest.fixture(scope="module")
-def bench(stepbench):
-    path = os.path.join(os.path.dirname(stepbench), "stepbench_bench")
-    assert os.access(path, os.X_OK), path
-    return path
-
-
-@pytest.fixture(scope="module")
-def listing(stepbench):
-    return json.loads(subprocess.run([stepbench, "list", "--json"], check=True, capture_output=True,
-                                     text=True).stdout)
+def run_bench(bench, *args, check=False):
+    return subprocess.run([bench, "--quick", *args], capture_output=True, text=True, timeout=120, check=check)
 
 
 def listed(bench, *args):
-    out = subprocess.run([bench, "--quick", "--benchmark_list_tests", *args], check=True, capture_output=True,
-                         text=True).stdout
-    return out.split()
+    done = run_bench(bench, "--benchmark_list_tests", *args, check=True)
+    return done.stdout.split()
 
 
-def test_lists_every_case_of_the_registry(bench, listing):
+def test_lists_a_case_for_every_completed_row(bench, plain_study):
+    """Every method (ours, peers, baseline) on every problem it applies to, one case per
+    row of the quick sweep that completed (a diverged or failed row is not timed)."""
     names = set(listed(bench))
-    has_odeint = any("/odeint_rk4/" in n for n in names)
     expected = set()
-    for p in listing["problems"]:
-        dts = [p["horizon"] / (32 * 2 ** k) for k in range(8)]  # the quick ladder
-        methods = [i["name"] for i in listing["integrators"]] + PEERS_FIXED
-        if has_odeint:
-            methods += ["odeint_rk4", "odeint_velocity_verlet"]
-        if p["name"] in BASELINE_PROBLEMS:
-            methods.append("baseline_rk4")
-        expected |= {f"{p['name']}/{m}/dt:{dt:.6g}" for m in methods for dt in dts}
-        tols = [10.0 ** -e for e in range(2, 13, 2)]  # thinned in quick mode
-        expected |= {f"{p['name']}/{m}/tol:{tol:.0e}" for m in PEERS_ADAPTIVE for tol in tols}
+    with h5py.File(plain_study) as f:
+        for pname, g in f["problems"].items():
+            for mname, m in g["methods"].items():
+                what = "dt" if m.attrs["kind"] == "fixed_step" else "tol"
+                runs = m["runs"][()]
+                for r in runs[(runs["diverged"] == 0) & (runs["failed"] == 0)]:
+                    expected.add(f"{pname}/{mname}/{what}:{r['param']:g}/real_time")
     assert names == expected, (sorted(expected - names)[:5], sorted(names - expected)[:5])
 
 
 def test_filter_selects_one_family(bench):
-    names = listed(bench, "--benchmark_filter=pendulum/rk4/")
+    names = listed(bench, "--benchmark_filter=^pendulum/rk4/")
     assert len(names) == 8 and all(n.startswith("pendulum/rk4/dt:") for n in names)
+
+
+def test_json_format_is_clean_json_on_stdout(bench):
+    """--benchmark_format=json: stdout is the JSON document and nothing else; the sweep's
+    progress and the summary go to stderr."""
+    done = run_bench(bench, f"--benchmark_filter={ONE_CASE}", "--benchmark_format=json", check=True)
+    doc = json.loads(done.stdout)
+    assert [b["name"] for b in doc["benchmarks"]] == ["pendulum/rk4/dt:0.0430546/real_time"]
+    assert "swept pendulum" in done.stderr and "stepbench_bench:" in done.stderr
+
+
+def test_csv_format_is_clean_csv_on_stdout(bench):
+    done = run_bench(bench, f"--benchmark_filter={ONE_CASE}", "--benchmark_format=csv", check=True)
+    rows = list(csv.DictReader(io.StringIO(done.stdout)))
+    assert [r["name"] for r in rows] == ["pendulum/rk4/dt:0.0430546/real_time"]
+    assert float(rows[0]["err_pos_max"]) > 0 and int(float(rows[0]["force_evals"])) == 512
+    assert "swept pendulum" in done.stderr
+
+
+def test_counters_tabular_prints_a_header(bench):
+    done = run_bench(bench, "--benchmark_filter=^pendulum/(rk4|cvode_bdf)/", "--benchmark_counters_tabular=true",
+                     check=True)
+    header = next(line for line in done.stdout.splitlines() if line.startswith("Benchmark"))
+    for column in ["Time", "Iterations", "err_pos_final", "err_pos_max", "force_evals", "steps"]:
+        assert column in header.split(), header
 
 
 def test_one_case_agrees_with_stepbench_run(bench, stepbench, tmp_path):
     out = tmp_path / "case.json"
-    subprocess.run([bench, "--quick", "--benchmark_filter=^damped_spring/rk4/dt:0.0390625$",
-                    f"--benchmark_out={out}", "--benchmark_out_format=json"], check=True, capture_output=True)
+    run_bench(bench, "--benchmark_filter=^damped_spring/rk4/dt:0.0390625/", f"--benchmark_out={out}",
+              "--benchmark_out_format=json", check=True)
     runs = [b for b in json.loads(out.read_text())["benchmarks"] if b["run_type"] == "iteration"]
-    assert len(runs) == 1 and runs[0]["name"] == "damped_spring/rk4/dt:0.0390625"
+    assert [r["name"] for r in runs] == ["damped_spring/rk4/dt:0.0390625/real_time"]
     case = runs[0]
-    for counter in ["err_pos_final", "err_pos_max", "steps", "force_evals", "ns_per_step"]:
+    for counter in ["err_pos_final", "err_pos_max", "steps", "force_evals", "time_per_step"]:
         assert counter in case, counter
-    assert case["real_time"] > 0 and case["ns_per_step"] > 0
-    run = json.loads(subprocess.run([stepbench, "run", "--problem", "damped_spring", "--integrator", "rk4",
+    assert case["real_time"] > 0 and case["time_per_step"] > 0
+    run = json.loads(subprocess.run([stepbench, "run", "--problem", "damped_spring", "--method", "rk4",
                                      "--dt", "0.0390625", "--json"], check=True, capture_output=True,
                                     text=True).stdout)
     assert case["steps"] == run["steps"] == 256
     assert case["force_evals"] == run["force_evals"] == 4 * 256
     assert case["err_pos_final"] == pytest.approx(run["err_pos_final"], rel=1e-12)
     assert case["err_pos_max"] == pytest.approx(run["err_pos_max"], rel=1e-12)
-    # ns_per_step is the case's wall time over its steps (measured around the same loop).
-    assert case["ns_per_step"] == pytest.approx(case["real_time"] * 1e3 / 256, rel=0.05)  # real_time in us
+    # time_per_step is the case's wall time over its steps, in seconds (real_time is in us).
+    assert case["time_per_step"] == pytest.approx(case["real_time"] * 1e-6 / 256, rel=0.05)
 
 
-def test_quick_timed_study(bench, tmp_path):
-    path = tmp_path / "study.h5"
-    start = time.monotonic()
-    done = subprocess.run([bench, "--quick", f"--study_out={path}"], check=True, capture_output=True, text=True)
-    elapsed = time.monotonic() - start
-    print(f"\nquick timed study: {elapsed:.1f} s")  # the figure the README quotes
-    assert "Performance ratios" in done.stdout
+def test_quick_timed_study(timed_study, stepbench):
+    path, done = timed_study
+    assert f"wrote {path}" in done.stderr and "stepbench ratios" in done.stderr
     with h5py.File(path, "r") as f:
         assert f.attrs["timing"] == 1 and f.attrs["benchmark_mode"] == "quick"
-        for key in ["benchmark_min_time_s", "benchmark_repetitions", "cpu_scaling_enabled", "num_cpus", "cpu"]:
+        for key in ["benchmark_min_time_s", "benchmark_repetitions", "benchmark_case_budget_s",
+                    "benchmark_wall_seconds", "cpu_scaling_enabled", "num_cpus", "mhz_per_cpu"]:
             assert key in f.attrs, key
-        conv = f["damped_spring/rk4/convergence"][()]
-        assert len(conv) == 8
-        assert (conv["time_ns"] > 0).all() and (conv["repetitions"] >= 1).all() and not conv["cut"].any()
+        p = f["problems/pendulum/methods"]
+        rk4 = f["problems/damped_spring/methods/rk4/runs"][()]
+        assert len(rk4) == 8
+        assert (rk4["time_ns"] > 0).all() and (rk4["repetitions"] >= 1).all() and not rk4["cut"].any()
+        assert (rk4["time_ns_min"] <= rk4["time_ns"]).all() and (rk4["time_ns"] <= rk4["time_ns_max"]).all()
         # A finer dt costs more: time grows with the step count (allow noise, not order).
-        assert conv["time_ns"][-1] > 20 * conv["time_ns"][0]
-        peer = f["pendulum/gsl_rk4"]
-        assert peer.attrs["kind"] == "fixed_step" and peer.attrs["declared_order"] == 4
-        assert abs(peer.attrs["observed_order"] - 4) < 0.3
-        wp = peer["work_precision"][()]
-        assert list(wp.dtype.names) == ["param", "steps", "force_evals", "err_pos_final", "err_pos_max",
-                                        "diverged", "time_ns", "repetitions", "cut"]
+        assert rk4["time_ns"][-1] > 20 * rk4["time_ns"][0]
+        gsl = p["gsl_rk4"]
+        assert gsl.attrs["origin"] == "peer" and gsl.attrs["kind"] == "fixed_step"
+        assert gsl.attrs["declared_order"] == 4 and abs(gsl.attrs["observed_order"] - 4) < 0.3
         # GSL's rk4 estimates its error by step doubling: 11 evaluations a step (3 RK4
         # steps sharing the first stage) after the first.
-        assert wp["force_evals"][0] == 11 * wp["steps"][0] + 1
-        cvode = f["pendulum/cvode_bdf"]["work_precision"][()]
+        runs = gsl["runs"][()]
+        assert runs["force_evals"][0] == 11 * runs["steps"][0] + 1
+        cvode = p["cvode_bdf"]["runs"][()]
         assert cvode["param"][0] == pytest.approx(1e-2) and (cvode["time_ns"] > 0).all()
         # Tighter tolerance, smaller error (over the whole ladder, not step by step).
         assert cvode["err_pos_max"][-1] < 1e-3 * cvode["err_pos_max"][0]
-        if "odeint_velocity_verlet" in f["pendulum"]:
-            vv = f["pendulum/odeint_velocity_verlet"]
+        assert p["baseline_rk4"].attrs["origin"] == "baseline"
+        if "odeint_velocity_verlet" in p:
+            vv = p["odeint_velocity_verlet"].attrs
             # Boost declares order 1 for a second-order method: reported, not hidden.
-            assert vv.attrs["declared_order"] == 1 and abs(vv.attrs["observed_order"] - 2) < 0.15
+            assert vv["declared_order"] == 1 and abs(vv["observed_order"] - 2) < 0.15
+            assert vv["declared_order_holds"] == 0
+    ratios = subprocess.run([stepbench, "ratios", "--study", str(path)], capture_output=True, text=True)
+    assert ratios.returncode == 0, ratios.stderr
+    assert "Performance ratios" in ratios.stdout and "rk4 / baseline_rk4" in ratios.stdout
+    doc = json.loads(subprocess.run([stepbench, "ratios", "--study", str(path), "--json"], check=True,
+                                    capture_output=True, text=True).stdout)
+    assert doc["step_cost"]["problem"] == "damped_spring" and doc["step_cost"]["ns_per_step"]["rk4"] > 0
 
 
 @pytest.mark.parametrize("args, message", [
@@ -119,7 +138,7 @@ def test_quick_timed_study(bench, tmp_path):
     (["--no_such_flag"], "unrecognized command-line flag"),
 ])
 def test_bad_flags(bench, args, message):
-    done = subprocess.run([bench, "--quick", *args], capture_output=True, text=True, timeout=60)
+    done = run_bench(bench, *args)
     assert done.returncode != 0
     assert message in done.stderr
     assert done.stdout == ""
@@ -129,17 +148,19 @@ def test_time_budget_cuts_and_marks_the_fine_end(bench, tmp_path):
     """A budget far below one iteration's time: each family's first (coarsest) case runs,
     every finer one is cut, and the study file says so instead of holding a number."""
     path = tmp_path / "cut.h5"
-    subprocess.run([bench, "--quick", "--case_budget=1e-9", "--benchmark_filter=^pendulum/(rk4|cvode_bdf)/",
-                    f"--study_out={path}"], check=True, capture_output=True, text=True)
+    run_bench(bench, "--case_budget=1e-9", "--benchmark_filter=^pendulum/(rk4|cvode_bdf)/", f"--study_out={path}",
+              check=True)
     with h5py.File(path, "r") as f:
         assert f.attrs["benchmark_case_budget_s"] == 1e-9
-        for table in [f["pendulum/rk4/convergence"][()], f["pendulum/cvode_bdf/work_precision"][()]]:
-            assert table["time_ns"][0] > 0 and not table["cut"][0]
-            assert table["cut"][1:].all()
-            assert all(math.isnan(t) for t in table["time_ns"][1:])
+        methods = f["problems/pendulum/methods"]
+        for name in ["rk4", "cvode_bdf"]:
+            runs = methods[name]["runs"][()]
+            assert runs["time_ns"][0] > 0 and not runs["cut"][0]
+            assert runs["cut"][1:].all() and (runs["repetitions"][1:] == 0).all()
+            assert all(math.isnan(t) for t in runs["time_ns"][1:])
         # Cases the filter left out are neither timed nor cut.
-        other = f["pendulum/euler/convergence"][()]
-        assert not other["cut"].any() and all(math.isnan(t) for t in other["time_ns"])
+        other = methods["euler"]["runs"][()]
+        assert not other["cut"].any() and np.isnan(other["time_ns"]).all()
 
 
 def test_two_json_outputs_compare_with_google_benchmarks_compare_py(bench, tmp_path):
@@ -149,8 +170,8 @@ def test_two_json_outputs_compare_with_google_benchmarks_compare_py(bench, tmp_p
     outs = []
     for name in ["a.json", "b.json"]:
         out = tmp_path / name
-        subprocess.run([bench, "--quick", "--benchmark_filter=^damped_spring/(rk4|gsl_rk4)/",
-                        f"--benchmark_out={out}", "--benchmark_out_format=json"], check=True, capture_output=True)
+        run_bench(bench, "--benchmark_filter=^damped_spring/(rk4|gsl_rk4)/", f"--benchmark_out={out}",
+                  "--benchmark_out_format=json", check=True)
         outs.append(str(out))
     done = subprocess.run(["/usr/bin/python3", compare, "benchmarks", *outs], capture_output=True, text=True,
                           timeout=120)
@@ -163,17 +184,15 @@ def test_set_reaches_the_timed_cases_and_the_study(bench, stepbench, tmp_path):
     """--set changes the scene for the sweep and for the timed loop alike: the study
     records the parameter, and a timed case's counters equal `stepbench run --set`."""
     path, out = tmp_path / "set.h5", tmp_path / "set.json"
-    subprocess.run([bench, "--quick", "--set=damped_spring.k_d=3", "--benchmark_filter=^damped_spring/rk4/dt:0.0390625$",
-                    f"--benchmark_out={out}", "--benchmark_out_format=json", f"--study_out={path}"],
-                   check=True, capture_output=True)
+    run_bench(bench, "--set=damped_spring.k_d=3", "--benchmark_filter=^damped_spring/rk4/dt:0.0390625/",
+              f"--benchmark_out={out}", "--benchmark_out_format=json", f"--study_out={path}", check=True)
     with h5py.File(path, "r") as f:
-        assert f["damped_spring"].attrs["k_d"] == 3.0
+        assert f["problems/damped_spring"].attrs["k_d"] == 3.0
     case = [b for b in json.loads(out.read_text())["benchmarks"] if b["run_type"] == "iteration"][0]
-    run = json.loads(subprocess.run([stepbench, "run", "--problem", "damped_spring", "--integrator", "rk4",
-                                     "--dt", "0.0390625", "--set", "k_d=3", "--json"], check=True,
-                                    capture_output=True, text=True).stdout)
-    assert case["err_pos_max"] == pytest.approx(run["err_pos_max"], rel=1e-12)
-    default = json.loads(subprocess.run([stepbench, "run", "--problem", "damped_spring", "--integrator", "rk4",
-                                         "--dt", "0.0390625", "--json"], check=True, capture_output=True,
-                                        text=True).stdout)
-    assert case["err_pos_max"] != pytest.approx(default["err_pos_max"], rel=1e-3)
+
+    def run(*extra):
+        return json.loads(subprocess.run([stepbench, "run", "--problem", "damped_spring", "--method", "rk4",
+                                          "--dt", "0.0390625", "--json", *extra], check=True, capture_output=True,
+                                         text=True).stdout)
+    assert case["err_pos_max"] == pytest.approx(run("--set", "k_d=3")["err_pos_max"], rel=1e-12)
+    assert case["err_pos_max"] != pytest.approx(run()["err_pos_max"], rel=1e-3)

@@ -1,5 +1,8 @@
-"""The study file as its readers meet it: h5py reads the documented layout
-(docs/study-format.md) and the numbers in it are the ones the run computed."""
+"""The study file as its readers meet it (docs/study-format.md, format 2): h5py reads the
+documented layout, the numbers in it are the ones the run computed, and the derived
+tables (`equal_error`, `front_*`) follow the documented rules. Those rules are written
+a second time here, as a cross-check of the C++ (core/work_precision.cpp); the report
+itself only reads the tables."""
 import json
 import math
 import subprocess
@@ -8,68 +11,211 @@ import h5py
 import numpy as np
 import pytest
 
-FIELDS = ["dt", "steps", "force_evals", "err_pos_final", "err_vel_final", "err_pos_max",
-          "err_pos_rms", "energy_drift", "energy_err_max", "diverged"]
+RUN_FIELDS = ["param", "steps", "rejected_steps", "force_evals", "jacobian_evals", "newton_iterations",
+              "linear_solves", "err_pos_final", "err_vel_final", "err_pos_max", "err_pos_rms", "energy_drift",
+              "energy_err_max", "diverged", "failed", "note"]
+TIMED_FIELDS = ["time_ns", "time_ns_min", "time_ns_max", "repetitions", "cut"]
+ROOT_ATTRS = ["format_version", "version", "git_commit", "compiler", "build_type", "dependencies", "created_utc",
+              "cpu", "cores", "levels", "base_steps", "tolerances", "sample_count", "reference_rtol",
+              "reference_atol", "fit_metric", "divergence_factor", "equal_error_targets", "wall_seconds", "timing"]
+METHOD_ATTRS = ["origin", "kind", "param_kind", "declared_order", "description", "library", "symplectic",
+                "reuses_last_force", "needs_jacobian", "error_estimate", "dense_output", "fit_status", "fit_metric",
+                "fit_param", "fit_slope", "observed_order", "fit_levels", "fit_residual_log10", "fit_note",
+                "exact_for_problem", "declared_order_holds"]
 
 
 @pytest.fixture(scope="module")
-def study(stepbench, tmp_path_factory):
-    path = tmp_path_factory.mktemp("study") / "study.h5"
-    subprocess.run([stepbench, "sweep", "--levels", "8", "--quiet", "--out", str(path)], check=True)
-    with h5py.File(path, "r") as f:
+def plain(plain_study):
+    with h5py.File(plain_study, "r") as f:
         yield f
 
 
-def test_root_attributes(study):
-    for key in ["format_version", "version", "git_commit", "compiler", "build_type", "created_utc", "cpu"]:
-        assert key in study.attrs, key
-    assert study.attrs["levels"] == 8
+@pytest.fixture(scope="module")
+def timed(timed_study):
+    with h5py.File(timed_study[0], "r") as f:
+        yield f
 
 
-def test_every_problem_and_integrator(study, stepbench):
-    listing = json.loads(subprocess.run([stepbench, "list", "--json"], check=True,
-                                        capture_output=True, text=True).stdout)
+@pytest.fixture(scope="module")
+def listing(stepbench):
+    return json.loads(subprocess.run([stepbench, "list", "--json"], check=True, capture_output=True,
+                                     text=True).stdout)
+
+
+def text(v):
+    return v.decode() if isinstance(v, bytes) else v
+
+
+def test_root_attributes(plain):
+    for key in ROOT_ATTRS:
+        assert key in plain.attrs, key
+    assert plain.attrs["format_version"] == 2 and plain.attrs["timing"] == 0
+    assert plain.attrs["levels"] == 8  # --quick
+    assert "GSL" in plain.attrs["dependencies"] and "SUNDIALS" in plain.attrs["dependencies"]
+    for target in (1e-2, 1e-4, 1e-6):
+        assert np.isclose(plain.attrs["equal_error_targets"], target, rtol=1e-12).any()
+
+
+def test_every_problem_and_method(plain, listing):
+    tolerances = plain.attrs["tolerances"]
     for p in listing["problems"]:
-        g = study[p["name"]]
+        g = plain["problems"][p["name"]]
         for param in p["parameters"]:
             assert g.attrs[param["name"]] == pytest.approx(param["default"])
         assert g.attrs["horizon"] == pytest.approx(p["horizon"])
+        assert g.attrs["position_unit"] == p["position_unit"]
         assert set(g["reference"]) == {"gsl_rk8pd", "cvode_bdf", "cvode_adams"}
         for ref in g["reference"].values():
-            assert ref["position"].shape == (p["dim"],)
-            assert ref["velocity"].shape == (p["dim"],)
+            assert ref.attrs["status"] == "ok"
+            assert ref["position"].shape == (p["dim"],) and ref["velocity"].shape == (p["dim"],)
             for stat in ["steps", "failed_steps", "rhs_evals", "lin_rhs_evals", "rhs_evals_counted"]:
                 assert stat in ref.attrs
-        for i in listing["integrators"]:
-            ig = g[i["name"]]
-            assert ig.attrs["expected_order"] == i["expected_order"]
-            conv = ig["convergence"][()]
-            assert list(conv.dtype.names) == FIELDS
-            assert len(conv) == 8
-            np.testing.assert_allclose(conv["dt"][:-1], 2 * conv["dt"][1:])
+        assert set(g["methods"]) == set(p["methods"])
+        described = {m["name"]: m for m in listing["methods"]}
+        for name in p["methods"]:
+            m = g["methods"][name]
+            for key in METHOD_ATTRS:
+                assert key in m.attrs, (p["name"], name, key)
+            assert m.attrs["origin"] == described[name]["origin"]
+            assert m.attrs["kind"] == described[name]["kind"]
+            runs = m["runs"][()]
+            assert list(runs.dtype.names) == RUN_FIELDS
+            if m.attrs["kind"] == "fixed_step":
+                assert m.attrs["param_kind"] == "dt" and len(runs) == 8
+                np.testing.assert_allclose(runs["param"][:-1], 2 * runs["param"][1:])
+            else:
+                assert m.attrs["param_kind"] == "tolerance"
+                np.testing.assert_array_equal(runs["param"], tolerances)
+    # The hand-written baseline runs where it applies, and only there.
+    assert [m["origin"] for m in listing["methods"] if m["name"] == "baseline_rk4"] == ["baseline"]
 
 
-def test_rows_match_stepbench_run(study, stepbench):
-    """A row of the study file is what `stepbench run` prints for the same case."""
-    conv = study["pendulum"]["midpoint"]["convergence"][()]
-    row = conv[3]
+def test_timed_rows_carry_timings(timed):
+    assert timed.attrs["timing"] == 1
+    runs = timed["problems/damped_spring/methods/rk4/runs"][()]
+    assert list(runs.dtype.names) == RUN_FIELDS + TIMED_FIELDS
+    assert set(timed["problems/pendulum"]) >= {"equal_error", "front_force_evals", "front_time"}
+
+
+@pytest.mark.parametrize("method, args", [("midpoint", ["--dt"]), ("gsl_rk4", ["--dt"]), ("cvode_bdf", ["--tol"])])
+def test_rows_match_stepbench_run(plain, stepbench, method, args):
+    """A row of the study file is what `stepbench run` prints for the same case, for ours
+    and for peers, fixed-step and adaptive alike: one code measures them all."""
+    row = plain[f"problems/pendulum/methods/{method}/runs"][()][3]
     out = json.loads(subprocess.run(
-        [stepbench, "run", "--problem", "pendulum", "--integrator", "midpoint", "--dt", repr(float(row["dt"])),
-         "--json"], check=True, capture_output=True, text=True).stdout)
-    assert out["steps"] == row["steps"] and out["force_evals"] == row["force_evals"]
+        [stepbench, "run", "--problem", "pendulum", "--method", method, *args, repr(float(row["param"])), "--json"],
+        check=True, capture_output=True, text=True).stdout)
+    for key in ["steps", "force_evals", "rejected_steps", "jacobian_evals"]:
+        assert out[key] == row[key], key
     for key in ["err_pos_final", "err_vel_final", "err_pos_max", "err_pos_rms", "energy_drift"]:
         assert out[key] == pytest.approx(float(row[key]), rel=1e-9), key
 
 
-def test_exact_methods_have_nan_order(study):
-    g = study["constant_acceleration"]["rk4"]
-    assert g.attrs["exact_for_problem"] == 1
+def test_exact_methods_have_nan_order(plain):
+    g = plain["problems/constant_acceleration/methods/rk4"]
+    assert g.attrs["exact_for_problem"] == 1 and g.attrs["fit_status"] == "exact"
     assert math.isnan(g.attrs["observed_order"])
-    assert g.attrs["fit_status"] == "exact"
+    assert g.attrs["declared_order_holds"] == -1
 
 
-def test_fit_levels_recorded(study):
-    g = study["damped_spring"]["rk4"]
-    levels = g.attrs["fit_levels"]
-    assert len(levels) >= 3
+def test_fit_levels_recorded(plain):
+    g = plain["problems/damped_spring/methods/rk4"]
+    assert len(g.attrs["fit_levels"]) >= 3
     assert abs(g.attrs["observed_order"] - 4) < 0.15
+    assert g.attrs["declared_order_holds"] == 1
+
+
+def test_declared_orders_are_checked(plain):
+    """GSL's rk2 declares 2 and advances with the third-order member of its pair; an
+    adaptive method has no observed order to hold a declaration to."""
+    rk2 = plain["problems/pendulum/methods/gsl_rk2"].attrs
+    assert rk2["declared_order"] == 2 and abs(rk2["observed_order"] - 3) < 0.1 and rk2["declared_order_holds"] == 0
+    bdf = plain["problems/pendulum/methods/cvode_bdf"].attrs
+    assert math.isnan(bdf["observed_order"]) and bdf["declared_order_holds"] == -1
+
+
+# --- the derived tables, against the documented rules written again --------------------------
+
+def methods_of(g):
+    return {name: (text(m.attrs["origin"]), m["runs"][()]) for name, m in g["methods"].items()}
+
+
+def cheapest_by_the_rule(methods, target, metric, timed):
+    """docs/study-format.md, `equal_error`: (cost kind, [(cost, error, method, param)] ranked)."""
+    qualifying = {}
+    for name, (_, runs) in methods.items():
+        err = runs[metric]
+        ok = (runs["diverged"] == 0) & (runs["failed"] == 0) & np.isfinite(err) & (err <= target)
+        if timed:
+            ok &= runs["cut"] == 0
+        if ok.any():
+            qualifying[name] = runs[ok]
+    by_time = timed and all((np.isfinite(r["time_ns"]) & (r["time_ns"] > 0)).all() for r in qualifying.values())
+    cost = "time_ns" if by_time else "force_evals"
+    picks = []
+    for name, rows in qualifying.items():
+        i = min(range(len(rows)), key=lambda i: (rows[cost][i], rows[metric][i]))
+        picks.append((float(rows[cost][i]), float(rows[metric][i]), name, float(rows["param"][i])))
+    return cost, sorted(picks)
+
+
+@pytest.mark.parametrize("shape", ["plain", "timed"])
+def test_equal_error_follows_the_rule(plain, timed, shape):
+    f = plain if shape == "plain" else timed
+    is_timed = shape == "timed"
+    for pname, g in f["problems"].items():
+        methods = methods_of(g)
+        table = g["equal_error"][()]
+        for metric in ("err_pos_max", "err_pos_final"):
+            for target in f.attrs["equal_error_targets"]:
+                rows = table[(np.char.equal(table["metric"].astype(str), metric)) & (table["target"] == target)]
+                cost, picks = cheapest_by_the_rule(methods, target, metric, is_timed)
+                where = (pname, metric, target)
+                assert [text(m) for m in rows["method"]] == [p[2] for p in picks], where
+                assert list(rows["rank"]) == list(range(1, len(picks) + 1)), where
+                assert all(text(c) == cost for c in rows["cost_kind"]), where
+                np.testing.assert_array_equal(rows["param"], [p[3] for p in picks])
+                np.testing.assert_array_equal(rows["cost"], [p[0] for p in picks])
+                # The answer: the first ranked method that is not the baseline.
+                answers = [text(m) for m, a in zip(rows["method"], rows["is_answer"]) if a]
+                first = [p[2] for p in picks if methods[p[2]][0] != "baseline"][:1]
+                assert answers == first, where
+
+
+def front_by_the_rule(methods, cost_field, timed):
+    """docs/study-format.md, `front_*`: by cost, a row joins if its error beats every
+    cheaper row's by more than 1e-6 relative; the baseline is left out."""
+    points = []
+    for name, (origin, runs) in methods.items():
+        if origin == "baseline":
+            continue
+        for r in runs:
+            cost, err = float(r[cost_field]), float(r["err_pos_max"])
+            if r["diverged"] or r["failed"] or not np.isfinite(err) or not (np.isfinite(cost) and cost > 0):
+                continue
+            if timed and r["cut"]:
+                continue
+            points.append((cost, err, name, float(r["param"])))
+    front, best = [], math.inf
+    for p in sorted(points, key=lambda p: (p[0], p[1])):
+        if p[1] < best * (1 - 1e-6):
+            front.append(p)
+            best = p[1]
+    return front
+
+
+@pytest.mark.parametrize("shape, front, field", [("plain", "front_force_evals", "force_evals"),
+                                                  ("timed", "front_force_evals", "force_evals"),
+                                                  ("timed", "front_time", "time_ns")])
+def test_fronts_follow_the_rule(plain, timed, shape, front, field):
+    f = plain if shape == "plain" else timed
+    for pname, g in f["problems"].items():
+        want = front_by_the_rule(methods_of(g), field, shape == "timed")
+        got = g[front][()]
+        # (cost, error) pin a point; two methods may share both exactly (exact methods at
+        # equal cost), and the rule does not say which of them is listed.
+        assert [(float(r["cost"]), float(r["err_pos_max"])) for r in got] == [(p[0], p[1]) for p in want], pname
+        for r in got:
+            runs = g["methods"][text(r["method"])]["runs"][()]
+            row = runs[runs["param"] == r["param"]]
+            assert len(row) == 1 and row[field][0] == r["cost"] and row["err_pos_max"][0] == r["err_pos_max"]

@@ -11,53 +11,65 @@
 
 namespace stepbench::bench {
 
+void case_book::add(const problem_study& ps, const method_info& info, method_row& row, std::string name,
+                    std::string family) {
+  if (row.metrics.diverged || row.metrics.failed || row.metrics.skipped) return;
+  auto c = std::make_unique<timed_case>();
+  c->name = std::move(name);
+  c->family = std::move(family);
+  c->row = &row;
+  if (!by_name_.emplace(c->name, c.get()).second) throw std::logic_error("two benchmark cases would share the name " + c->name);
+  const std::function<double()> run = ps.problem->timed_run(info.name, row.param, ps.horizon, ps.truth.times);
+  timed_case* tc = c.get();
+  const auto& m = row.metrics;
+  const long steps = row.steps;
+  const work_counters work = row.work;
+  const long rejected = row.rejected_steps;
+  benchmark::RegisterBenchmark(c->name.c_str(), [this, tc, run, m, steps, work, rejected](benchmark::State& state) {
+    if (over_budget(*tc)) {
+      state.SkipWithError("cut: the previous case of this family used over half the per-case time budget");
+      return;
+    }
+    const auto start = std::chrono::steady_clock::now();
+    for (auto _ : state) benchmark::DoNotOptimize(run());
+    const double ns = std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - start).count() /
+                      static_cast<double>(std::max<benchmark::IterationCount>(1, state.iterations()));
+    record(*tc, ns);
+    state.counters["err_pos_final"] = m.err_pos_final;
+    state.counters["err_pos_max"] = m.err_pos_max;
+    state.counters["steps"] = static_cast<double>(steps);
+    state.counters["force_evals"] = static_cast<double>(work.force_evals);
+    if (rejected) state.counters["rejected_steps"] = static_cast<double>(rejected);
+    if (work.newton_iterations) state.counters["newton_iterations"] = static_cast<double>(work.newton_iterations);
+    if (work.jacobian_evals) state.counters["jacobian_evals"] = static_cast<double>(work.jacobian_evals);
+    // Wall time per step (the case uses real time): Google Benchmark divides the elapsed
+    // time by steps x iterations (an inverted iteration-invariant rate) and prints it in
+    // seconds with an SI prefix (13.8n = 13.8 ns).
+    state.counters["time_per_step"] = benchmark::Counter(
+        static_cast<double>(std::max(1L, steps)), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  })->Unit(benchmark::kMicrosecond)->UseRealTime();
+  cases_.push_back(std::move(c));
+}
+
 void case_book::register_all(study& s) {
   for (auto& ps : s.problems) {
     const std::string pname(ps.problem->name());
     for (auto& ms : ps.methods) {
       const bool fixed = ms.info.kind == method_kind::fixed_step;
-      for (auto& row : ms.rows) {
-        if (row.metrics.diverged || row.metrics.failed) continue;
-        auto c = std::make_unique<timed_case>();
-        c->name = fmt::format("{}/{}/{}:{:.6g}", pname, ms.info.name, fixed ? "dt" : "tol", row.param);
-        c->family = pname + "/" + ms.info.name;
-        c->row = &row;
-        if (!by_name_.emplace(c->name, c.get()).second)
-          throw std::logic_error("two benchmark cases would share the name " + c->name);
-        const std::function<double()> run =
-            ps.problem->timed_run(ms.info.name, row.param, ps.horizon, ps.truth.times);
-        timed_case* tc = c.get();
-        const auto& m = row.metrics;
-        const long steps = row.steps;
-        const work_counters work = row.work;
-        const long rejected = row.rejected_steps;
-        benchmark::RegisterBenchmark(c->name.c_str(), [this, tc, run, m, steps, work, rejected](benchmark::State& state) {
-          if (over_budget(*tc)) {
-            state.SkipWithError("cut: the previous case of this family used over half the per-case time budget");
-            return;
-          }
-          const auto start = std::chrono::steady_clock::now();
-          for (auto _ : state) benchmark::DoNotOptimize(run());
-          const double ns = std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - start).count() /
-                            static_cast<double>(std::max<benchmark::IterationCount>(1, state.iterations()));
-          record(*tc, ns);
-          state.counters["err_pos_final"] = m.err_pos_final;
-          state.counters["err_pos_max"] = m.err_pos_max;
-          state.counters["steps"] = static_cast<double>(steps);
-          state.counters["force_evals"] = static_cast<double>(work.force_evals);
-          if (rejected) state.counters["rejected_steps"] = static_cast<double>(rejected);
-          if (work.newton_iterations) state.counters["newton_iterations"] = static_cast<double>(work.newton_iterations);
-          if (work.jacobian_evals) state.counters["jacobian_evals"] = static_cast<double>(work.jacobian_evals);
-          // Wall time per step (the case uses real time): Google Benchmark divides the
-          // elapsed time by steps x iterations (an inverted iteration-invariant rate) and
-          // prints it in seconds with an SI prefix (13.8n = 13.8 ns).
-          state.counters["time_per_step"] = benchmark::Counter(
-              static_cast<double>(std::max(1L, steps)), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
-        })->Unit(benchmark::kMicrosecond)->UseRealTime();
-        cases_.push_back(std::move(c));
-      }
+      for (auto& row : ms.rows)
+        add(ps, ms.info, row, fmt::format("{}/{}/{}:{:.6g}", pname, ms.info.name, fixed ? "dt" : "tol", row.param),
+            pname + "/" + ms.info.name);
     }
   }
+  // The small-steps comparison (study/substeps.hpp): each of its runs, timed the same way.
+  for (auto& st : s.substeps)
+    for (const auto& ps : s.problems) {
+      if (ps.problem->name() != st.problem) continue;
+      for (auto& m : st.methods)
+        for (auto& r : m.rows)
+          add(ps, m.info, r.row, fmt::format("substeps/{}/{}/n:{}", st.problem, m.info.name, r.substeps),
+              "substeps/" + st.problem + "/" + m.info.name);
+    }
 }
 
 timed_case* case_book::find(const std::string& registered_name) {
@@ -89,6 +101,12 @@ void case_book::merge_into_rows() {
       t.cut = c->skipped.rfind("cut", 0) == 0;
     }
   }
+}
+
+std::size_t case_book::timed_count() const {
+  std::size_t n = 0;
+  for (const auto& c : cases_) n += !c->ns_per_run.empty();
+  return n;
 }
 
 bool case_book::any_timed() const {

@@ -1,8 +1,9 @@
 #pragma once
 // The timed cases: one Google Benchmark case per row of the study that completed (a run
-// that diverged or failed has nothing worth timing), registered at run time from the
-// study's own entries, each one whole integration over the horizon. Names:
-// <problem>/<method>/dt:<dt> or <problem>/<method>/tol:<tol>. The accuracy counters come
+// that diverged, failed or was skipped has nothing worth timing), registered at run time
+// from the study's own entries, each one whole integration over the horizon. Names:
+// <problem>/<method>/dt:<dt> or <problem>/<method>/tol:<tol>, and
+// substeps/<problem>/<method>/n:<substeps> for the small-steps comparison. The accuracy counters come
 // from the row the sweep measured; the case only times. Results are matched back to
 // rows by the name each case was registered under, never re-formatted from a row.
 #include <map>
@@ -31,6 +32,7 @@ class case_book {
   // Copies the timings into the rows: the median, fastest and slowest repetition.
   void merge_into_rows();
   bool any_timed() const;
+  std::size_t timed_count() const;
 
  private:
   // Called before a case runs: true when its family's previous (coarser) case took more
@@ -38,6 +40,9 @@ class case_book {
   // Google Benchmark calls a case several times while it sizes the iteration count;
   // those calls of the same case do not count against it.
   bool over_budget(const timed_case& c) const;
+  // Registers the case of one completed row (a diverged, failed or skipped run has
+  // nothing worth timing).
+  void add(const problem_study& ps, const method_info& info, method_row& row, std::string name, std::string family);
   void record(const timed_case& c, double ns);
 
   double budget_s_;

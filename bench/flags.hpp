@@ -16,7 +16,7 @@ struct options {
   bool quick = false;
   std::string study_out;
   double case_budget_s = 0.5;
-  double min_time_s = 0.025;
+  double min_time_s = 0.01;
   int repetitions = 3;
   bool list_only = false;
   std::map<std::string, std::map<std::string, double>> overrides;  // problem -> parameter -> value

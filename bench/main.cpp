@@ -15,6 +15,7 @@
 
 #include "bench/cases.hpp"
 #include "bench/flags.hpp"
+#include "bench/scaling.hpp"
 #include "bench/timings.hpp"
 #include "study/study_file.hpp"
 #include "study/sweep.hpp"
@@ -45,6 +46,7 @@ int main(int argc, char** argv) {
     study s = run_sweep(sopts);
     bench::case_book book(opts.case_budget_s);
     book.register_all(s);
+    bench::register_scaling();
 
     // The display reporter is made after Initialize, from the flags it parsed.
     bench::collecting_reporter reporter(benchmark::CreateDefaultDisplayReporter(), book);
@@ -68,12 +70,14 @@ int main(int argc, char** argv) {
     s.timed = ts;
     if (!opts.study_out.empty()) {
       write_study(s, opts.study_out);
-      fmt::print(stderr, "stepbench_bench: wrote {} ({} mode, {} cases) in {:.1f} s; `stepbench ratios --study {}` "
-                 "prints the performance ratios\n", opts.study_out, ts.mode, book.size(), ts.wall_seconds, opts.study_out);
+      fmt::print(stderr, "stepbench_bench: wrote {} ({} mode, {} cases timed) in {:.1f} s; `stepbench ratios --study {}` "
+                 "prints the performance ratios\n", opts.study_out, ts.mode, book.timed_count(), ts.wall_seconds,
+                 opts.study_out);
     } else {
-      fmt::print(stderr, "stepbench_bench: timed {} cases in {:.1f} s ({} mode)\n", book.size(), ts.wall_seconds, ts.mode);
+      fmt::print(stderr, "stepbench_bench: timed {} cases in {:.1f} s ({} mode)\n", book.timed_count(), ts.wall_seconds,
+                 ts.mode);
     }
-    return 0;
+    return report_study_outcome(s, "stepbench_bench");
   } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "stepbench_bench: error: %s\n", e.what());
     return 2;

@@ -27,7 +27,8 @@ void collecting_reporter::ReportRuns(const std::vector<Run>& runs) {
       c->ns_per_run.push_back(r.real_accumulated_time * 1e9 / static_cast<double>(r.iterations));
   }
   display_->ReportRuns(runs);
-  if (!runs.empty() && runs.front().run_type == Run::RT_Iteration) ++reported_;
+  if (!runs.empty() && runs.front().run_type == Run::RT_Iteration && book_.find(runs.front().run_name.function_name))
+    ++reported_;
   const auto now = std::chrono::steady_clock::now();
   if (now - last_progress_ > std::chrono::seconds(10)) {
     last_progress_ = now;

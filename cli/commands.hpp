@@ -19,5 +19,7 @@ command add_run(CLI::App& app);
 command add_sweep(CLI::App& app);
 command add_advise(CLI::App& app);
 command add_ratios(CLI::App& app);
+command add_compare(CLI::App& app);
+command add_stability(CLI::App& app);
 
 }  // namespace stepbench::cli

@@ -71,7 +71,8 @@ int run_list(bool as_json) {
     for (const auto& m : all_methods()) {
       if (m.origin != origin) continue;
       std::string caps;
-      for (const auto& [key, on] : capabilities_json(m.traits).items())
+      const json declared = capabilities_json(m.traits);
+      for (const auto& [key, on] : declared.items())
         if (on.get<bool>()) caps += (caps.empty() ? "" : ", ") + key;
       fmt::print("  {:<24} {:<10} order {:<4} {}{}\n", m.name, to_string(m.kind),
                  std::isfinite(m.declared_order) ? fmt::format("{:g}", m.declared_order) : "-", m.description,

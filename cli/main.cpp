@@ -11,7 +11,8 @@ int main(int argc, char** argv) {
   using namespace stepbench::cli;
   CLI::App app{"stepbench: accuracy, stability and speed of time integrators on game-physics problems"};
   app.require_subcommand(1);
-  const std::vector<command> commands{add_list(app), add_run(app), add_sweep(app), add_advise(app), add_ratios(app)};
+  const std::vector<command> commands{add_list(app), add_run(app), add_sweep(app), add_advise(app), add_ratios(app),
+                                     add_compare(app), add_stability(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

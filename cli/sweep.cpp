@@ -54,15 +54,10 @@ int run_sweep_command(sweep_args a) {
                    r.source, ps.problem->name(), r.status, r.compared_with.empty() ? "-" : r.compared_with,
                    r.vs.pos_rel, r.vs.vel_rel, r.solution.stats.steps, r.solution.stats.rhs_evals_counted);
   }
+  std::fflush(stdout);
   fmt::print(stderr, "wrote {} ({} problems, {} levels) in {:.2f} s\n", a.out, s.problems.size(), a.opts.levels,
              s.wall_seconds);
-  // Every other problem has been measured and written; only then is a problem without a
-  // trusted truth an error.
-  if (const auto bad = untrusted_problems(s); !bad.empty()) {
-    fmt::print(stderr, "stepbench: error: no trusted truth for {} (errors recorded as NaN)\n", fmt::join(bad, ", "));
-    return 1;
-  }
-  return 0;
+  return report_study_outcome(s, "stepbench");
 }
 
 }  // namespace
@@ -78,8 +73,9 @@ command add_sweep(CLI::App& app) {
   sub->add_option("--out", a->out, "study file to write")->capture_default_str();
   sub->add_flag("--quick", a->quick, "8 levels and every other tolerance (the CI study)");
   sub->add_flag("--quiet", a->quiet, "print only the summary line");
-  sub->footer("exit codes: 0 written; 1 a file error, or a problem without a trusted truth (the file is still "
-              "written); 2 bad usage\n");
+  sub->footer("exit codes: 0 written, every case completed (or diverged, or skipped over the work budget); 1 a file "
+              "error, or a problem without a trusted truth (the file is still written); 2 bad usage; 3 written, but some "
+              "case failed (each named on stderr)\n");
   return {sub, [a] { return run_sweep_command(*a); }};
 }
 

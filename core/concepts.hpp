@@ -109,43 +109,52 @@ namespace detail {
 // A stand-in system, only to check in the concepts below that a step compiles.
 struct probe_system {
   using vec = Eigen::Matrix<double, 1, 1>;
+  using jacobian_matrix = Eigen::Matrix<double, 1, 1>;
   static constexpr bool force_depends_on_velocity = true;
+  mutable work_counters work;
   int dim() const;
   double mass() const;
   double inverse_mass() const;
   void force(double, const vec&, const vec&, vec&) const;
+  jacobian_matrix make_jacobian() const;
+  void jacobian(double, const vec&, const vec&, jacobian_matrix&, jacobian_matrix&) const;
 };
 }  // namespace detail
 
-// Sizes workspace vectors like the state, once per run (a no-op for fixed-size
-// vectors), so that no step allocates.
+// Sizes workspace vectors like the state and zeroes them, once per run, so that no
+// step allocates (for fixed-size vectors it only initialises them).
 template <class Vec, class... More>
 inline void size_like(const Vec& like, Vec& first, More&... more) {
-  if constexpr (Vec::RowsAtCompileTime == Eigen::Dynamic) {
-    first.resize(like.size());
-    (more.resize(like.size()), ...);
-  }
+  first.setZero(like.size());
+  (more.setZero(like.size()), ...);
 }
 
 // A method that needs scratch space (stage vectors, a Jacobian, a controller's memory)
-// declares `template <class Vec> struct stepper`, constructed from the method and sized
-// once per run by `resize(like)`; it holds the space as members and has the step, as
+// declares `template <class Sys> struct stepper` (Sys the system it steps, with its
+// `vec` and `jacobian_matrix` types), constructed from the method and sized once per
+// run by `resize(sys, like)`; it holds the space as members and has the step, as
 // Odeint's steppers keep theirs, sized once by their resizer. A method without scratch
 // space has the step itself.
-template <class I, class Vec>
-concept has_stepper = requires { typename I::template stepper<Vec>; };
+template <class I, class Sys>
+concept has_stepper = requires { typename I::template stepper<Sys>; };
 
-// The object that steps states of type Vec for `method`, sized like `like`.
-template <class Vec, class I>
-inline auto make_stepper(const I& method, const Vec& like) {
-  if constexpr (has_stepper<I, Vec>) {
-    typename I::template stepper<Vec> s(method);
-    s.resize(like);
-    return s;
-  } else {
-    (void)like;
-    return method;
-  }
+template <class I, class Sys>
+struct stepper_of {
+  using type = I;
+};
+template <class I, class Sys>
+  requires has_stepper<I, Sys>
+struct stepper_of<I, Sys> {
+  using type = typename I::template stepper<Sys>;
+};
+// The object that steps `Sys`'s states for method I: constructed from the method, then
+// sized once with prepare_stepper.
+template <class I, class Sys>
+using stepper_t = typename stepper_of<I, Sys>::type;
+
+template <class S, class Sys>
+inline void prepare_stepper(S& stepper, const Sys& sys, const typename Sys::vec& like) {
+  if constexpr (requires { stepper.resize(sys, like); }) stepper.resize(sys, like);
 }
 
 // A fixed-step integrator (Odeint's "stepper"): a small value type with its name, its
@@ -156,7 +165,7 @@ concept integrator = requires(const I& i, const detail::probe_system& sys, step_
   { I::order } -> std::convertible_to<int>;
   { I::description } -> std::convertible_to<std::string_view>;
   { I::traits } -> std::convertible_to<capabilities>;
-  { make_stepper(i, s.x).step(sys, 0.0, s, 0.1) };
+  { stepper_t<I, detail::probe_system>(i).step(sys, 0.0, s, 0.1) };
 };
 
 // The outcome of one attempt of an adaptive step.
@@ -178,8 +187,9 @@ concept adaptive_integrator =
       { I::description } -> std::convertible_to<std::string_view>;
       { I::traits } -> std::convertible_to<capabilities>;
       { I(1e-6) };
-      { make_stepper(i, s.x).initial_dt(sys, 0.0, s, 1.0) } -> std::convertible_to<double>;
-      { make_stepper(i, s.x).try_step(sys, 0.0, s, 0.1) } -> std::same_as<step_attempt>;
+      { I::force_evals_per_step } -> std::convertible_to<int>;  // for the step budget
+      { stepper_t<I, detail::probe_system>(i).initial_dt(sys, 0.0, s, 1.0) } -> std::convertible_to<double>;
+      { stepper_t<I, detail::probe_system>(i).try_step(sys, 0.0, s, 0.1) } -> std::same_as<step_attempt>;
     };
 
 // An adaptive integrator that interpolates inside its last accepted step (Odeint's
@@ -188,7 +198,7 @@ concept adaptive_integrator =
 template <class I>
 concept dense_output_integrator =
     adaptive_integrator<I> && requires(const I& i, detail::probe_system::vec& x) {
-      { make_stepper(i, x).interpolate(0.5, x, x) };
+      { stepper_t<I, detail::probe_system>(i).interpolate(0.5, x, x) };
     };
 
 // 1 / m. The integrators work with the force and fold 1 / m into their step

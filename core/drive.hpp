@@ -11,6 +11,7 @@
 //               shortening a step to land on it, or from the method's dense output
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <span>
 #include <string>
 #include <vector>
@@ -64,7 +65,8 @@ struct drive_result {
   long rejected_steps = 0;  // adaptive methods: attempts the error test rejected
   work_counters work{};
   bool non_finite = false;  // a NaN or Inf appeared: the run stopped there
-  std::string failure;      // why the run stopped early (step budget, step size underflow, ...), else empty
+  std::string failure;      // why the run stopped early (step size underflow, ...), else empty
+  bool over_budget = false;  // stopped by the step budget (with the reason in `failure`): skipped, not failed
   std::vector<double> sample_t;
   Eigen::MatrixXd samples;  // column j: [x; v] at sample_t[j]
   double t_final = 0.0;
@@ -83,6 +85,12 @@ struct drive_result {
     sample_t.push_back(t);
   }
 };
+
+inline std::string fmt_g(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
 
 template <class Vec>
 inline bool all_finite(const Vec& x, const Vec& v) {
@@ -167,7 +175,8 @@ template <problem P, integrator I>
   using Vec = typename P::vec;
   counted_system<P> sys{problem};
   step_state<Vec> s = start_state(problem);
-  auto stepper = make_stepper(method, s.x);
+  stepper_t<I, counted_system<P>> stepper(method);
+  prepare_stepper(stepper, sys, s.x);
   drive_result<Vec> out;
   out.start(problem.dim(), plan.size());
   const loop_end end = fixed_step_loop(
@@ -189,15 +198,20 @@ template <problem P, integrator I>
 // The adaptive loop. Steps are the method's own, shortened only to land on the horizon
 // and, for a method without dense output, on each record time (a method with dense
 // output interpolates the record times inside its steps instead). A run stops with a
-// recorded failure when the step size falls below round-off of t or when it would take
-// more than `max_steps` accepted steps.
+// recorded failure when the step size falls below round-off of t, and is stopped as over
+// budget (skipped, not failed) when it has taken `max_steps` accepted steps or when, at
+// its present step size, the rest of the horizon would take more than ten times the
+// steps left (a first-order method at a tight tolerance: its steps would have to be so
+// small that the run could not finish, and often its error estimate would sink into
+// round-off first).
 template <problem P, adaptive_integrator I>
 [[gnu::flatten]] drive_result<typename P::vec> drive_adaptive(const P& problem, const I& method, double horizon,
                                                               std::span<const double> times, long max_steps) {
   using Vec = typename P::vec;
   counted_system<P> sys{problem};
   step_state<Vec> s = start_state(problem);
-  auto stepper = make_stepper(method, s.x);
+  stepper_t<I, counted_system<P>> stepper(method);
+  prepare_stepper(stepper, sys, s.x);
   constexpr bool dense = dense_output_integrator<I>;
 
   drive_result<Vec> out;
@@ -219,6 +233,12 @@ template <problem P, adaptive_integrator I>
     // advance: attempts until one is accepted
     const step_attempt a = stepper.try_step(sys, t, s, h_try);
     h = a.dt_next;
+    if ((horizon - t) / h > 10.0 * static_cast<double>(max_steps - out.steps)) {
+      out.over_budget = true;
+      out.failure = "over the step budget of " + std::to_string(max_steps) + " steps: at t = " + std::to_string(t) +
+                    " the step size " + fmt_g(h) + " would need about " + fmt_g((horizon - t) / h) + " more";
+      break;
+    }
     if (!a.accepted) {
       ++out.rejected_steps;
       if (!std::isfinite(h)) {
@@ -253,7 +273,8 @@ template <problem P, adaptive_integrator I>
       }
     }
     if (out.steps >= max_steps && t < horizon) {
-      out.failure = "step budget of " + std::to_string(max_steps) + " steps exhausted at t = " + std::to_string(t);
+      out.over_budget = true;
+      out.failure = "over the step budget of " + std::to_string(max_steps) + " steps at t = " + std::to_string(t);
       break;
     }
   }

@@ -158,6 +158,11 @@ run_metrics measure(const problem_instance& problem, const run_result& run, cons
     m.err_pos_final = m.err_vel_final = m.err_pos_max = m.err_pos_rms = m.energy_drift = m.energy_err_max = nan;
     return m;
   };
+  if (run.skipped) {
+    m.skipped = true;
+    m.note = run.failure;
+    return all_nan();
+  }
   if (!run.failure.empty()) {
     m.failed = true;
     m.note = run.failure;

@@ -73,7 +73,8 @@ struct run_metrics {
   double energy_err_max = 0.0; // max over samples of |E(y_j) - E(y(t_j))| / energy_scale
   bool diverged = false;       // blew up: non-finite, or beyond blowup_factor x the amplitude
   bool failed = false;         // the method could not complete the run, or there is no trusted truth
-  std::string note;            // why diverged or failed
+  bool skipped = false;        // not run to the end: over the work budget
+  std::string note;            // why diverged, failed or skipped
 };
 
 // Measures a run against the truth. The run's sample times must be the truth's

@@ -2,6 +2,7 @@
 // What the registry says of a method, and one run of it in plain vectors: the shape
 // every method (ours, a library peer, the hand-written baseline) is measured in, by the
 // same code.
+#include <algorithm>
 #include <limits>
 #include <string>
 #include <string_view>
@@ -27,6 +28,19 @@ inline std::string_view to_string(method_origin o) {
 inline std::string_view to_string(method_kind k) { return k == method_kind::fixed_step ? "fixed_step" : "adaptive"; }
 inline std::string_view param_name(method_kind k) { return k == method_kind::fixed_step ? "dt" : "tolerance"; }
 
+// Limits on one run. The work budget is counted in force evaluations times coordinates,
+// so a large scene gets proportionally fewer steps; a run that would exceed it is
+// recorded as skipped (with the reason), not as failed.
+struct run_limits {
+  double work_budget = 1L << 25;  // coordinate force evaluations per run (about 0.1 s of force work)
+  long max_steps = 1L << 21;      // accepted steps of an adaptive method per run
+  // The steps an adaptive method with `evals_per_step` force evaluations may take on a
+  // problem of `dim` coordinates.
+  long adaptive_steps(int dim, double evals_per_step) const {
+    return std::max(1L, std::min(max_steps, static_cast<long>(work_budget / (dim * evals_per_step))));
+  }
+};
+
 struct method_info {
   std::string name;
   std::string description;
@@ -46,7 +60,8 @@ struct run_result {
   long rejected_steps = 0;  // attempts rejected by an error test or a failed solve
   work_counters work{};     // force (right-hand-side) evaluations and an implicit method's work
   bool non_finite = false;  // a NaN or Inf appeared; the run stopped there
-  std::string failure;      // the method could not complete the run (solver error, step budget); empty if it did
+  std::string failure;      // the method could not complete the run (solver error); empty if it did
+  bool skipped = false;     // not run to the end because it would exceed the work budget (reason in `failure`)
   std::vector<double> sample_t;
   std::vector<std::vector<double>> sample_y;  // [x; v] at sample_t
   std::vector<double> final_y;                // [x; v] where the run stopped

@@ -50,11 +50,12 @@ class problem_instance {
   // Runs `method` at `param` (dt or tolerance) to `horizon`, recording [x; v] at
   // `times` (increasing, in (0, horizon]). A method that cannot complete the run
   // returns with `failure` set; an unknown method throws std::invalid_argument.
-  virtual run_result run(std::string_view method, double param, double horizon, std::span<const double> times) const = 0;
+  virtual run_result run(std::string_view method, double param, double horizon, std::span<const double> times,
+                         const run_limits& limits = {}) const = 0;
   // The same run, prepared once (the record plan) and performed whole by each call of
   // the returned function, for timing. Returns a value of the final state to keep.
   virtual std::function<double()> timed_run(std::string_view method, double param, double horizon,
-                                            std::span<const double> times) const = 0;
+                                            std::span<const double> times, const run_limits& limits = {}) const = 0;
   virtual std::unique_ptr<problem_instance> clone() const = 0;
 };
 

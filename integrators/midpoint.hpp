@@ -14,13 +14,13 @@ struct midpoint {
   static constexpr int order = 2;
   static constexpr capabilities traits{};
 
-  template <class Vec>
+  template <class Sys>
   struct stepper {
+    using Vec = typename Sys::vec;
     Vec x_mid, v_mid, f_mid;
     explicit stepper(const midpoint&) {}
-    void resize(const Vec& like) { size_like(like, x_mid, v_mid, f_mid); }
+    void resize(const Sys&, const Vec& like) { size_like(like, x_mid, v_mid, f_mid); }
 
-    template <class Sys>
     void step(const Sys& sys, double t, step_state<Vec>& s, double dt) {
       const double h = 0.5 * dt, im = inverse_mass(sys);
       x_mid = s.x + h * s.v;

@@ -15,13 +15,13 @@ struct momentum {
   static constexpr int order = 1;
   static constexpr capabilities traits{.symplectic = true};
 
-  template <class Vec>
+  template <class Sys>
   struct stepper {
+    using Vec = typename Sys::vec;
     Vec p;
     explicit stepper(const momentum&) {}
-    void resize(const Vec& like) { size_like(like, p); }
+    void resize(const Sys&, const Vec& like) { size_like(like, p); }
 
-    template <class Sys>
     void step(const Sys& sys, double t, step_state<Vec>& s, double dt) {
       const double m = sys.mass();
       p = m * s.v + dt * current_force(sys, t, s);

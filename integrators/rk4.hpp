@@ -16,13 +16,13 @@ struct rk4 {
   static constexpr int order = 4;
   static constexpr capabilities traits{};
 
-  template <class Vec>
+  template <class Sys>
   struct stepper {
+    using Vec = typename Sys::vec;
     Vec x2, v2, f2, x3, v3, f3, x4, v4, f4, x_123, v_123;
     explicit stepper(const rk4&) {}
-    void resize(const Vec& like) { size_like(like, x2, v2, f2, x3, v3, f3, x4, v4, f4, x_123, v_123); }
+    void resize(const Sys&, const Vec& like) { size_like(like, x2, v2, f2, x3, v3, f3, x4, v4, f4, x_123, v_123); }
 
-    template <class Sys>
     void step(const Sys& sys, double t, step_state<Vec>& s, double dt) {
       const double h = 0.5 * dt, im = inverse_mass(sys), h_im = h * im, dt_im = dt * im;
       // The dx of each sample is the velocity of the previous sub-step.

@@ -20,13 +20,13 @@ struct velocity_verlet {
   static constexpr int order = 2;
   static constexpr capabilities traits{.symplectic = true, .reuses_last_force = true};
 
-  template <class Vec>
+  template <class Sys>
   struct stepper {
+    using Vec = typename Sys::vec;
     Vec f_n, v_half, v_pred, f_new;
     explicit stepper(const velocity_verlet&) {}
-    void resize(const Vec& like) { size_like(like, f_n, v_half, v_pred, f_new); }
+    void resize(const Sys&, const Vec& like) { size_like(like, f_n, v_half, v_pred, f_new); }
 
-    template <class Sys>
     void step(const Sys& sys, double t, step_state<Vec>& s, double dt) {
       const double h_im = 0.5 * dt * inverse_mass(sys);
       f_n = current_force(sys, t, s);

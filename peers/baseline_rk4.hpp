@@ -36,7 +36,7 @@ struct baseline_rk4 {
   static constexpr bool applies = requires(const P& p) { baseline_acceleration(p)(0.0, 0.0); };
 
   template <problem P>
-  static auto prepare(const P& p, double dt, double horizon, std::span<const double> times) {
+  static auto prepare(const P& p, double dt, double horizon, std::span<const double> times, const run_limits&) {
     return [p, dt, horizon, plan = plan_records(horizon, dt, times)] { return run(p, dt, horizon, plan); };
   }
 

@@ -67,7 +67,7 @@ struct gsl_fixed {
   static constexpr bool applies = true;
 
   template <problem P>
-  static auto prepare(const P& p, double dt, double horizon, std::span<const double> times) {
+  static auto prepare(const P& p, double dt, double horizon, std::span<const double> times, const run_limits&) {
     return [p, dt, horizon, plan = plan_records(horizon, dt, times)] { return run(p, dt, horizon, plan); };
   }
 

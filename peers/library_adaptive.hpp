@@ -21,6 +21,8 @@ drive_result<Vec> as_run(const reference_solution& sol, int dim) {
   out.rejected_steps = sol.stats.failed_steps;
   out.work.force_evals = sol.stats.rhs_evals_counted;
   out.work.jacobian_evals = sol.stats.jac_evals;
+  out.work.newton_iterations = sol.stats.newton_iterations;
+  out.work.linear_solves = sol.stats.linear_solves;
   out.start(dim, sol.y.size());
   for (std::size_t j = 0; j < sol.y.size(); ++j) {
     const Eigen::Map<const Eigen::VectorXd> y(sol.y[j].data(), 2 * dim);
@@ -58,7 +60,8 @@ struct cvode_adams_solver {
 };
 struct cvode_bdf_solver {
   static constexpr const char* name = "cvode_bdf";
-  static constexpr const char* description = "CVODE BDF, Newton with dense difference-quotient Jacobian";
+  static constexpr const char* description =
+      "CVODE BDF, Newton (band solver with the analytic Jacobian for a chain, else dense difference quotients)";
   static constexpr const char* library = "SUNDIALS CVODE";
   static reference_solution solve(const ode_system& s, std::span<const double> t, double tol) {
     return solve_cvode(s, t, cvode_method::bdf, {tol, tol});
@@ -77,7 +80,7 @@ struct library_adaptive {
   // The right-hand side is wrapped once; each run is the solver's whole run (set-up,
   // integration, output at the sample times), as a user would call it.
   template <problem P>
-  static auto prepare(const P& p, double tol, double /*horizon*/, std::span<const double> times) {
+  static auto prepare(const P& p, double tol, double /*horizon*/, std::span<const double> times, const run_limits&) {
     return [sys = make_ode_system(p), dim = p.dim(), tol, t = std::vector<double>(times.begin(), times.end())] {
       return as_run<typename P::vec>(Solver::solve(sys, t, tol), dim);
     };

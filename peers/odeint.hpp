@@ -41,7 +41,7 @@ struct odeint_rk4 {
   static constexpr bool applies = fixed_size_state<P>;
 
   template <problem P>
-  static auto prepare(const P& p, double dt, double horizon, std::span<const double> times) {
+  static auto prepare(const P& p, double dt, double horizon, std::span<const double> times, const run_limits&) {
     return [p, dt, horizon, plan = plan_records(horizon, dt, times)] { return run(p, dt, horizon, plan); };
   }
 
@@ -89,7 +89,7 @@ struct odeint_velocity_verlet {
   static constexpr bool applies = fixed_size_state<P>;
 
   template <problem P>
-  static auto prepare(const P& p, double dt, double horizon, std::span<const double> times) {
+  static auto prepare(const P& p, double dt, double horizon, std::span<const double> times, const run_limits&) {
     return [p, dt, horizon, plan = plan_records(horizon, dt, times)] { return run(p, dt, horizon, plan); };
   }
 

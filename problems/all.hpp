@@ -5,9 +5,11 @@
 #include "problems/damped_spring.hpp"
 #include "problems/pendulum.hpp"
 #include "problems/projectile.hpp"
+#include "problems/spring_chain.hpp"
+#include "problems/stiff_spring.hpp"
 
 namespace stepbench {
 
-using all_problems = type_list<constant_acceleration, projectile, damped_spring, pendulum>;
+using all_problems = type_list<constant_acceleration, projectile, damped_spring, pendulum, stiff_spring, spring_chain>;
 
 }  // namespace stepbench

@@ -1,6 +1,8 @@
 #pragma once
-// The lecture's RK4 example (digest sections 4 and 6): a unit mass on a spring and
-// damper, F = -k_s x - k_d v, i.e. m x'' + k_d x' + k_s x = 0.
+// A mass on a spring and damper, F = -k_s x - k_d v, i.e. m x'' + k_d x' + k_s x = 0
+// (digest section 4): the physics of two scenes, `damped_spring` (the lecture's RK4
+// example, below) and `stiff_spring` (problems/stiff_spring.hpp), which differ only in
+// their defaults: a scene is a struct of defaults, the physics is written once here.
 //
 // Closed form for every damping regime in one expression. With gamma = k_d / (2m),
 // w0^2 = k_s / m, D = gamma^2 - w0^2 and s = sqrt|D|:
@@ -21,30 +23,32 @@
 
 namespace stepbench {
 
-struct damped_spring {
-  static constexpr std::string_view name = "damped_spring";
-  static constexpr std::string_view description = "mass on a spring and damper (lecture's RK4 example)";
+template <class Scene>
+struct spring_damper {
+  static constexpr std::string_view name = Scene::name;
+  static constexpr std::string_view description = Scene::description;
   static constexpr int dim() { return 1; }
   static constexpr std::string_view position_unit = "m";
   static constexpr bool force_depends_on_velocity = true;
   using vec = Eigen::Matrix<double, 1, 1>;
+  using jacobian_matrix = Eigen::Matrix<double, 1, 1>;
 
-  double k_s = 10.0;
-  double k_d = 1.0;
-  double mass_kg = 1.0;
-  double x0 = 1.0;
-  double v0 = 0.0;
-  double duration = 10.0;
+  double k_s = Scene::k_s;
+  double k_d = Scene::k_d;
+  double mass_kg = Scene::mass_kg;
+  double x0 = Scene::x0;
+  double v0 = Scene::v0;
+  double duration = Scene::duration;
 
   static constexpr auto parameters() {
-    using p = param<damped_spring>;
+    using p = param<spring_damper>;
     return std::array{
-        p{"k_s", &damped_spring::k_s, "N/m", "spring stiffness"},
-        p{"k_d", &damped_spring::k_d, "N s/m", "damping coefficient"},
-        p{"mass_kg", &damped_spring::mass_kg, "kg", "mass"},
-        p{"x0", &damped_spring::x0, "m", "initial displacement"},
-        p{"v0", &damped_spring::v0, "m/s", "initial velocity"},
-        p{"duration", &damped_spring::duration, "s", "default horizon"},
+        p{"k_s", &spring_damper::k_s, "N/m", "spring stiffness"},
+        p{"k_d", &spring_damper::k_d, "N s/m", "damping coefficient"},
+        p{"mass_kg", &spring_damper::mass_kg, "kg", "mass"},
+        p{"x0", &spring_damper::x0, "m", "initial displacement"},
+        p{"v0", &spring_damper::v0, "m/s", "initial velocity"},
+        p{"duration", &spring_damper::duration, "s", "default horizon"},
     };
   }
   std::string validate() const {
@@ -57,6 +61,12 @@ struct damped_spring {
 
   double mass() const { return mass_kg; }
   void force(double, const vec& x, const vec& v, vec& f) const { f = -k_s * x - k_d * v; }
+  // dF/dx = -k_s, dF/dv = -k_d.
+  jacobian_matrix make_jacobian() const { return jacobian_matrix::Zero(); }
+  void jacobian(double, const vec&, const vec&, jacobian_matrix& dfdx, jacobian_matrix& dfdv) const {
+    dfdx(0, 0) = -k_s;
+    dfdv(0, 0) = -k_d;
+  }
   phase<vec> initial() const { return {vec(x0), vec(v0)}; }
   double horizon() const { return duration; }
 
@@ -106,5 +116,13 @@ struct damped_spring {
   // solution's energy, not with E(0).
   double energy(const vec& x, const vec& v) const { return 0.5 * mass_kg * v.squaredNorm() + 0.5 * k_s * x.squaredNorm(); }
 };
+
+// The lecture's RK4 example (digest sections 4 and 6): a unit mass, k = 10, b = 1.
+struct damped_spring_scene {
+  static constexpr std::string_view name = "damped_spring";
+  static constexpr std::string_view description = "mass on a spring and damper (lecture's RK4 example)";
+  static constexpr double k_s = 10.0, k_d = 1.0, mass_kg = 1.0, x0 = 1.0, v0 = 0.0, duration = 10.0;
+};
+using damped_spring = spring_damper<damped_spring_scene>;
 
 }  // namespace stepbench

@@ -1,9 +1,16 @@
-// Reference solutions from SUNDIALS CVODE 6.x: BDF with Newton iteration on a dense
-// difference-quotient Jacobian, or Adams with fixed-point (functional) iteration.
+// Reference solutions from SUNDIALS CVODE 6.x: BDF with Newton iteration, or Adams with
+// fixed-point (functional) iteration. BDF's linear solver: when the system gives a
+// banded force Jacobian (a chain), CVODE gets the analytic Jacobian and a band solver,
+// with the state interleaved per coordinate ([x_0, v_0, x_1, v_1, ...]) so that the
+// first-order Jacobian [[0, I], [dF/dx, dF/dv] / m] is banded too (half-bandwidth
+// 2 b + 1 for a force coupling b neighbouring coordinates); otherwise a dense
+// difference-quotient Jacobian, as good for a few coordinates.
 #include <cvode/cvode.h>
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
+#include <sunlinsol/sunlinsol_band.h>
 #include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_band.h>
 #include <sunmatrix/sunmatrix_dense.h>
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
@@ -24,7 +31,30 @@ namespace {
 
 struct cvode_callback_state : detail::callback_state {
   std::string last_message;  // from the error handler, instead of CVODE printing to stderr
+  // Interleaved layout (band solver): CVODE's y[2c] = x_c, y[2c+1] = v_c; the system's
+  // own layout is [x; v]. These hold the system's view.
+  bool interleaved = false;
+  std::vector<double> y_plain, dydt_plain;
+
+  // CVODE's vector to the system's [x; v] layout (identity when not interleaved).
+  std::span<const double> plain(const double* y) {
+    const auto n = static_cast<std::size_t>(sys->n);
+    if (!interleaved) return {y, n};
+    const std::size_t dim = n / 2;
+    for (std::size_t c = 0; c < dim; ++c) y_plain[c] = y[2 * c], y_plain[dim + c] = y[2 * c + 1];
+    return y_plain;
+  }
 };
+
+// The system's [x; v] layout to CVODE's.
+void to_solver_layout(const cvode_callback_state& st, std::span<const double> plain, double* out) {
+  const std::size_t n = plain.size(), dim = n / 2;
+  if (!st.interleaved) {
+    std::copy(plain.begin(), plain.end(), out);
+    return;
+  }
+  for (std::size_t c = 0; c < dim; ++c) out[2 * c] = plain[c], out[2 * c + 1] = plain[dim + c];
+}
 
 // Every call of f, including those of the difference-quotient Jacobian, goes through here.
 int cvode_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) noexcept {
@@ -38,7 +68,12 @@ int cvode_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) noexcep
   const auto n = static_cast<std::size_t>(st.sys->n);
   double* dydt = N_VGetArrayPointer(ydot);
   try {
-    st.sys->rhs(t, std::span<const double>(N_VGetArrayPointer(y), n), std::span<double>(dydt, n));
+    if (st.interleaved) {
+      st.sys->rhs(t, st.plain(N_VGetArrayPointer(y)), st.dydt_plain);
+      to_solver_layout(st, st.dydt_plain, dydt);
+    } else {
+      st.sys->rhs(t, std::span<const double>(N_VGetArrayPointer(y), n), std::span<double>(dydt, n));
+    }
   } catch (...) {
     st.error = std::current_exception();
     return -1;  // negative: unrecoverable, CVODE stops (user guide 6.x, CVRhsFn)
@@ -51,6 +86,27 @@ int cvode_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) noexcep
       st.non_finite_t = t;
       return -1;
     }
+  }
+  return 0;
+}
+
+// The first-order Jacobian in the interleaved layout: d(x_c)'/d(v_c) = 1,
+// d(v_i)'/d(x_j) = dF_i/dx_j / m, d(v_i)'/d(v_j) = dF_i/dv_j / m (CVLsJacFn, user guide 6.x).
+int cvode_band_jacobian(sunrealtype t, N_Vector y, N_Vector, SUNMatrix jac, void* user_data, N_Vector, N_Vector,
+                        N_Vector) noexcept {
+  auto& st = *static_cast<cvode_callback_state*>(user_data);
+  if (st.error) return -1;
+  try {
+    SUNMatZero(jac);
+    const std::size_t dim = static_cast<std::size_t>(st.sys->n) / 2;
+    for (std::size_t c = 0; c < dim; ++c) SM_ELEMENT_B(jac, 2 * c, 2 * c + 1) = 1.0;
+    st.sys->force_jacobian(t, st.plain(N_VGetArrayPointer(y)), [&](int i, int j, double kx, double kv) {
+      SM_ELEMENT_B(jac, 2 * i + 1, 2 * j) = kx;
+      SM_ELEMENT_B(jac, 2 * i + 1, 2 * j + 1) = kv;
+    });
+  } catch (...) {
+    st.error = std::current_exception();
+    return -1;
   }
   return 0;
 }
@@ -125,10 +181,15 @@ reference_solution solve_cvode(const ode_system& sys, std::span<const double> ti
     if (!p) throw std::runtime_error(std::string(source) + ": " + call + " returned null");
   };
 
+  const bool band = method == cvode_method::bdf && sys.force_jacobian && sys.coupling_bandwidth >= 0 &&
+                    2 * (2 * sys.coupling_bandwidth + 1) + 1 < sys.n;
+  st.interleaved = band;
+  if (band) st.y_plain.resize(static_cast<std::size_t>(sys.n)), st.dydt_plain.resize(static_cast<std::size_t>(sys.n));
+
   check("SUNContext_Create", SUNContext_Create(nullptr, &h.ctx), flag_kind::other);
   h.y = N_VNew_Serial(sys.n, h.ctx);
   check_ptr("N_VNew_Serial", h.y);
-  std::copy(sys.y0.begin(), sys.y0.end(), N_VGetArrayPointer(h.y));
+  to_solver_layout(st, sys.y0, N_VGetArrayPointer(h.y));
 
   h.mem = CVodeCreate(method == cvode_method::bdf ? CV_BDF : CV_ADAMS, h.ctx);
   check_ptr("CVodeCreate", h.mem);
@@ -136,9 +197,17 @@ reference_solution solve_cvode(const ode_system& sys, std::span<const double> ti
   check("CVodeInit", CVodeInit(h.mem, &cvode_rhs, 0.0, h.y));
   check("CVodeSStolerances", CVodeSStolerances(h.mem, tol.rtol, tol.atol));
   check("CVodeSetUserData", CVodeSetUserData(h.mem, &st));
-  check("CVodeSetMaxNumSteps", CVodeSetMaxNumSteps(h.mem, detail::max_steps_per_output));
+  check("CVodeSetMaxNumSteps", CVodeSetMaxNumSteps(h.mem, sys.max_steps_per_output));
 
-  if (method == cvode_method::bdf) {
+  if (band) {
+    const sunindextype half = 2 * sys.coupling_bandwidth + 1;
+    h.a = SUNBandMatrix(sys.n, half, half, h.ctx);
+    check_ptr("SUNBandMatrix", h.a);
+    h.ls = SUNLinSol_Band(h.y, h.a, h.ctx);
+    check_ptr("SUNLinSol_Band", h.ls);
+    check("CVodeSetLinearSolver", CVodeSetLinearSolver(h.mem, h.ls, h.a), flag_kind::cvls);
+    check("CVodeSetJacFn", CVodeSetJacFn(h.mem, &cvode_band_jacobian), flag_kind::cvls);
+  } else if (method == cvode_method::bdf) {
     // No Jacobian function is set, so CVLS uses its dense difference-quotient Jacobian,
     // whose n calls of f per evaluation count in CVodeGetNumLinRhsEvals, not in nfe.
     h.a = SUNDenseMatrix(sys.n, sys.n, h.ctx);
@@ -167,11 +236,11 @@ reference_solution solve_cvode(const ode_system& sys, std::span<const double> ti
     const int flag = CVode(h.mem, tout, h.y, &t, CV_NORMAL);
     if (st.error) std::rethrow_exception(st.error);
     if (flag < 0) fail("CVode at t=" + detail::num(t) + " towards t=" + detail::num(tout), flag);
-    const double* y = N_VGetArrayPointer(h.y);
+    const auto y = st.plain(N_VGetArrayPointer(h.y));
     for (std::size_t i = 0; i < n; ++i)
       if (!std::isfinite(y[i])) throw std::runtime_error(std::string(source) + ": non-finite state at t=" +
                                                          detail::num(tout));
-    out.y.emplace_back(y, y + n);
+    out.y.emplace_back(y.begin(), y.end());
   }
 
   auto& s = out.stats;
@@ -185,8 +254,11 @@ reference_solution solve_cvode(const ode_system& sys, std::span<const double> ti
   s.failed_steps = err_fails + solve_fails;
   check("CVodeGetNumRhsEvals", CVodeGetNumRhsEvals(h.mem, &s.rhs_evals));
   if (method == cvode_method::bdf) {
+    check("CVodeGetNumNonlinSolvIters", CVodeGetNumNonlinSolvIters(h.mem, &s.newton_iterations));
     check("CVodeGetNumLinRhsEvals", CVodeGetNumLinRhsEvals(h.mem, &s.lin_rhs_evals), flag_kind::cvls);
     check("CVodeGetNumJacEvals", CVodeGetNumJacEvals(h.mem, &s.jac_evals), flag_kind::cvls);
+    // A direct linear solver does one solve per Newton iteration.
+    s.linear_solves = s.newton_iterations;
   }
   s.rhs_evals_counted = st.calls;
   s.rtol = tol.rtol;

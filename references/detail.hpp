@@ -10,11 +10,6 @@
 
 namespace stepbench::detail {
 
-// Step budget between two output times, for both solvers: far above what the references
-// need on the scenes here (hundreds of steps in all), low enough that a problem too stiff
-// for the solver fails in seconds with its message instead of running for minutes.
-inline constexpr long max_steps_per_output = 200'000;
-
 // A time or value for an error message: %g, not std::to_string's fixed notation.
 inline std::string num(double v) {
   char buf[32];

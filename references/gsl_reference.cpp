@@ -70,7 +70,7 @@ reference_solution solve_gsl(const ode_system& sys, std::span<const double> time
   if (!driver) throw std::runtime_error(source + ": gsl_odeiv2_driver_alloc_y_new returned null");
   // nmax bounds the steps of one driver_apply call (0 would mean unbounded): a problem too
   // stiff for an explicit solver fails in seconds with a message instead of running on.
-  if (int s = gsl_odeiv2_driver_set_nmax(driver.get(), detail::max_steps_per_output); s != GSL_SUCCESS)
+  if (int s = gsl_odeiv2_driver_set_nmax(driver.get(), static_cast<unsigned long>(sys.max_steps_per_output)); s != GSL_SUCCESS)
     throw std::runtime_error(source + ": gsl_odeiv2_driver_set_nmax failed, status " + std::to_string(s));
 
   reference_solution out;

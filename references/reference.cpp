@@ -21,6 +21,7 @@ void validate_reference_input(std::string_view source, const ode_system& sys, st
   for (double v : sys.y0)
     if (!std::isfinite(v)) fail("y0 has a non-finite entry");
   if (!sys.rhs) fail("rhs is not set");
+  if (sys.max_steps_per_output < 1) fail("the step budget must be positive");
   if (times.empty()) fail("no output times");
   for (std::size_t i = 0; i < times.size(); ++i) {
     if (!std::isfinite(times[i]) || times[i] <= 0.0)
@@ -44,8 +45,9 @@ reference_solution solve_reference(std::string_view source, const ode_system& sy
   if (source == "gsl_rk8pd") return solve_gsl_rk8pd(sys, times, tol);
   if (source == "cvode_bdf") return solve_cvode(sys, times, cvode_method::bdf, tol);
   if (source == "cvode_adams") return solve_cvode(sys, times, cvode_method::adams, tol);
+  if (source == "arkode_erk8") return solve_arkode_erk(sys, times, 8, tol);
   throw std::invalid_argument("unknown reference source '" + std::string(source) +
-                              "' (expected gsl_rk8pd, cvode_bdf or cvode_adams)");
+                              "' (expected gsl_rk8pd, cvode_bdf, cvode_adams or arkode_erk8)");
 }
 
 }  // namespace stepbench

@@ -17,6 +17,17 @@ struct ode_system {
   std::vector<double> y0;
   // dydt = f(t, y); both spans have length n.
   std::function<void(double t, std::span<const double> y, std::span<double> dydt)> rhs;
+  // Step budget between two output times: a problem too stiff or too large for a
+  // solver fails in bounded time with the solver's message (the caller scales it with
+  // the problem's size and stiffness: study/registry.cpp, reference_step_budget).
+  long max_steps_per_output = 200'000;
+  // Optional, for the stiff solver (CVODE BDF): the force Jacobians of a second-order
+  // system y = [x; v], f = [v; F(t, x, v) / m] with n / 2 coordinates. force_jacobian(t,
+  // y, emit) calls emit(i, j, dF_i/dx_j / m, dF_i/dv_j / m) for every pair of coordinates
+  // with |i - j| <= coupling_bandwidth (the rest are zero). -1: not given.
+  int coupling_bandwidth = -1;
+  using jacobian_entry = std::function<void(int i, int j, double dfdx_over_m, double dfdv_over_m)>;
+  std::function<void(double t, std::span<const double> y, const jacobian_entry& emit)> force_jacobian;
 };
 
 // What a reference solver did to produce its solution. Every count is the solver's
@@ -28,6 +39,8 @@ struct reference_stats {
   long rhs_evals = 0;      // calls of f made by the integrator proper (CVodeGetNumRhsEvals for CVODE)
   long lin_rhs_evals = 0;  // CVODE only: calls of f for the difference-quotient Jacobian (CVodeGetNumLinRhsEvals)
   long jac_evals = 0;      // CVODE only: Jacobian evaluations (CVodeGetNumJacEvals)
+  long newton_iterations = 0;  // CVODE BDF: Newton iterations (CVodeGetNumNonlinSolvIters)
+  long linear_solves = 0;      // CVODE BDF: linear solves, one per Newton iteration with a direct solver
   long rhs_evals_counted = 0;  // our own count of every call of f, from a wrapped callback
   double rtol = 0.0;
   double atol = 0.0;
@@ -60,12 +73,20 @@ enum class gsl_method { rk8pd, rkf45 };
 reference_solution solve_gsl(const ode_system& sys, std::span<const double> times, gsl_method method,
                              reference_tolerances tol = {});
 
+// CVODE: BDF with Newton iterations (a band linear solver with the problem's analytic
+// Jacobian when the system gives a banded one, else a dense difference-quotient
+// Jacobian), or Adams with fixed-point iterations.
 enum class cvode_method { bdf, adams };
 reference_solution solve_cvode(const ode_system& sys, std::span<const double> times, cvode_method method,
                                reference_tolerances tol = {});
 
+// ARKODE's explicit Runge-Kutta stepper (ERKStep) with its default table of the given
+// order (8: ARKODE_FEHLBERG_13_7_8; 5: ARKODE_DORMAND_PRINCE_7_4_5).
+reference_solution solve_arkode_erk(const ode_system& sys, std::span<const double> times, int order,
+                                    reference_tolerances tol = {});
+
 // The reference sources by name, in the order they are reported.
-inline constexpr const char* reference_sources[] = {"gsl_rk8pd", "cvode_bdf", "cvode_adams"};
+inline constexpr const char* reference_sources[] = {"gsl_rk8pd", "cvode_bdf", "cvode_adams", "arkode_erk8"};
 reference_solution solve_reference(std::string_view source, const ode_system& sys, std::span<const double> times,
                                    reference_tolerances tol = {});
 

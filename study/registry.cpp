@@ -27,7 +27,7 @@ struct ours_fixed {
   template <problem P>
   static constexpr bool applies = true;
   template <problem P>
-  static auto prepare(const P& p, double dt, double horizon, std::span<const double> times) {
+  static auto prepare(const P& p, double dt, double horizon, std::span<const double> times, const run_limits&) {
     return [p, dt, horizon, plan = plan_records(horizon, dt, times)] { return drive(p, I{}, dt, horizon, plan); };
   }
 };
@@ -41,9 +41,13 @@ struct ours_adaptive {
   template <problem P>
   static constexpr bool applies = true;
   template <problem P>
-  static auto prepare(const P& p, double tol, double horizon, std::span<const double> times) {
-    return [p, tol, horizon, t = std::vector<double>(times.begin(), times.end())] {
-      return drive_adaptive(p, I(tol), horizon, t, adaptive_step_budget);
+  static auto prepare(const P& p, double tol, double horizon, std::span<const double> times,
+                      const run_limits& limits) {
+    // The budget in steps: the work budget over the coordinates and the method's force
+    // evaluations a step.
+    const long max_steps = limits.adaptive_steps(p.dim(), I::force_evals_per_step);
+    return [p, tol, horizon, max_steps, t = std::vector<double>(times.begin(), times.end())] {
+      return drive_adaptive(p, I(tol), horizon, t, max_steps);
     };
   }
 };
@@ -91,6 +95,7 @@ run_result to_run_result(const drive_result<Vec>& r, double param, double horizo
   out.work = r.work;
   out.non_finite = r.non_finite;
   out.failure = r.failure;
+  out.skipped = r.over_budget;
   out.sample_t = r.sample_t;
   for (std::size_t j = 0; j < r.sample_t.size(); ++j) {
     const auto col = r.samples.col(static_cast<Eigen::Index>(j));
@@ -187,11 +192,11 @@ class problem_model final : public problem_instance {
     return out;
   }
 
-  run_result run(std::string_view method, double param, double horizon,
-                 std::span<const double> times) const override {
+  run_result run(std::string_view method, double param, double horizon, std::span<const double> times,
+                 const run_limits& limits) const override {
     run_result out;
     with_method(method, [&]<class M>() {
-      auto run_once = M::prepare(p_, param, horizon, times);  // throws std::invalid_argument for bad times
+      auto run_once = M::prepare(p_, param, horizon, times, limits);  // throws std::invalid_argument for bad times
       try {
         out = to_run_result(run_once(), param, horizon);
       } catch (const std::invalid_argument&) {
@@ -208,10 +213,10 @@ class problem_model final : public problem_instance {
   }
 
   std::function<double()> timed_run(std::string_view method, double param, double horizon,
-                                    std::span<const double> times) const override {
+                                    std::span<const double> times, const run_limits& limits) const override {
     std::function<double()> out;
     with_method(method, [&]<class M>() {
-      out = [run_once = M::prepare(p_, param, horizon, times)] { return run_once().final_state.x[0]; };
+      out = [run_once = M::prepare(p_, param, horizon, times, limits)] { return run_once().final_state.x[0]; };
     });
     return out;
   }

@@ -23,9 +23,5 @@ std::vector<method_info> integrators();
 // Throws std::invalid_argument naming the unknown method and the known ones.
 const method_info& find_method(std::string_view name);
 
-// Accepted steps an adaptive method of ours may take in one run before the run is
-// recorded as failed (a first-order method at a tight tolerance would otherwise take
-// billions).
-inline constexpr long adaptive_step_budget = 1L << 21;
 
 }  // namespace stepbench

@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <csignal>
+
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -15,6 +17,8 @@
 
 #include "build_info.hpp"
 #include "study/h5.hpp"
+#include "study/stability.hpp"
+#include "study/substeps.hpp"
 
 namespace stepbench {
 namespace {
@@ -83,44 +87,13 @@ void write_method(H5::Group& parent, const method_study& ms, bool timed) {
   attr(g, "observed_order",
        info.kind == method_kind::fixed_step ? ms.fit.order : std::numeric_limits<double>::quiet_NaN());
   attr(g, "fit_levels", ms.fit.levels);
-  attr(g, "fit_residual_log10", ms.fit.residual);
+  attr(g, "fit_residual_log10",
+       ms.fit.state == fit_result::status::fitted ? ms.fit.residual : std::numeric_limits<double>::quiet_NaN());
   attr(g, "fit_note", ms.fit.note);
   attr(g, "exact_for_problem", static_cast<int>(ms.fit.state == fit_result::status::exact));
   attr(g, "declared_order_holds", ms.declared_order_holds);
 
-  h5::table t;
-  auto col = [&](auto get) {
-    using T = decltype(get(ms.rows.front()));
-    std::vector<T> v;
-    for (const auto& r : ms.rows) v.push_back(get(r));
-    return v;
-  };
-  t.add("param", col([](const method_row& r) { return r.param; }));
-  t.add("steps", col([](const method_row& r) { return std::int64_t{r.steps}; }));
-  t.add("rejected_steps", col([](const method_row& r) { return std::int64_t{r.rejected_steps}; }));
-  t.add("force_evals", col([](const method_row& r) { return std::int64_t{r.work.force_evals}; }));
-  t.add("jacobian_evals", col([](const method_row& r) { return std::int64_t{r.work.jacobian_evals}; }));
-  t.add("newton_iterations", col([](const method_row& r) { return std::int64_t{r.work.newton_iterations}; }));
-  t.add("linear_solves", col([](const method_row& r) { return std::int64_t{r.work.linear_solves}; }));
-  t.add("err_pos_final", col([](const method_row& r) { return r.metrics.err_pos_final; }));
-  t.add("err_vel_final", col([](const method_row& r) { return r.metrics.err_vel_final; }));
-  t.add("err_pos_max", col([](const method_row& r) { return r.metrics.err_pos_max; }));
-  t.add("err_pos_rms", col([](const method_row& r) { return r.metrics.err_pos_rms; }));
-  t.add("energy_drift", col([](const method_row& r) { return r.metrics.energy_drift; }));
-  t.add("energy_err_max", col([](const method_row& r) { return r.metrics.energy_err_max; }));
-  t.add("diverged", col([](const method_row& r) { return static_cast<std::int8_t>(r.metrics.diverged); }));
-  t.add("failed", col([](const method_row& r) { return static_cast<std::int8_t>(r.metrics.failed); }));
-  t.add("note", col([](const method_row& r) { return r.metrics.note; }));
-  // Timing fields only in a timed study, so an untimed file does not carry columns of
-  // NaN that a reader could mistake for measurements.
-  if (timed) {
-    t.add("time_ns", col([](const method_row& r) { return r.time.time_ns; }));
-    t.add("time_ns_min", col([](const method_row& r) { return r.time.time_ns_min; }));
-    t.add("time_ns_max", col([](const method_row& r) { return r.time.time_ns_max; }));
-    t.add("repetitions", col([](const method_row& r) { return std::int64_t{r.time.repetitions}; }));
-    t.add("cut", col([](const method_row& r) { return static_cast<std::int8_t>(r.time.cut); }));
-  }
-  t.write(g, "runs");
+  runs_table(ms.rows, timed).write(g, "runs");
 }
 
 // The equal-error table: for each metric and target, every method that reaches it with
@@ -201,6 +174,11 @@ void write_problem(H5::Group& parent, const problem_study& ps, bool timed) {
   attr(g, "has_closed_form", static_cast<int>(p.has_closed_form()));
   attr(g, "has_energy", static_cast<int>(p.has_energy()));
   attr(g, "has_jacobian", static_cast<int>(p.has_jacobian()));
+  // Every method that runs on the problem, so a reader can tell a method that does not
+  // apply (the baseline off its two problems) from one missing from a damaged file.
+  std::string applies;
+  for (const auto& m : p.methods()) applies += (applies.empty() ? "" : ",") + m.name;
+  attr(g, "methods", applies);
   attr(g, "truth_source", ps.truth.source);
   attr(g, "truth_trusted", static_cast<int>(ps.truth.trusted));
   attr(g, "truth_note", ps.truth.note);
@@ -221,7 +199,79 @@ void write_problem(H5::Group& parent, const problem_study& ps, bool timed) {
 
 std::string temp_path_for(const std::string& path) { return fmt::format("{}.tmp.{}", path, ::getpid()); }
 
+// The temporary file being written, for the signal handler below (a fixed buffer: a
+// handler may only call async-signal-safe functions, such as unlink and raise).
+char temp_being_written[4096] = {0};
+
+extern "C" void remove_temp_and_reraise(int sig) {
+  if (temp_being_written[0]) ::unlink(temp_being_written);
+  ::signal(sig, SIG_DFL);
+  ::raise(sig);
+}
+
+// While a study file is written, SIGINT, SIGTERM and SIGHUP remove the temporary file
+// before ending the process as they would have: an interrupted run leaves the previous
+// results file byte-identical and nothing else behind. (Before the write there is
+// nothing to clean up: the previous file is only ever replaced by a rename.)
+class temp_file_guard {
+ public:
+  explicit temp_file_guard(const std::string& path) {
+    std::snprintf(temp_being_written, sizeof temp_being_written, "%s", path.c_str());
+    struct sigaction action {};
+    action.sa_handler = remove_temp_and_reraise;
+    sigemptyset(&action.sa_mask);
+    for (std::size_t i = 0; i < std::size(signals_); ++i) sigaction(signals_[i], &action, &previous_[i]);
+  }
+  ~temp_file_guard() {
+    for (std::size_t i = 0; i < std::size(signals_); ++i) sigaction(signals_[i], &previous_[i], nullptr);
+    temp_being_written[0] = 0;
+  }
+  temp_file_guard(const temp_file_guard&) = delete;
+  temp_file_guard& operator=(const temp_file_guard&) = delete;
+
+ private:
+  static constexpr int signals_[] = {SIGINT, SIGTERM, SIGHUP};
+  struct sigaction previous_[3];
+};
+
 }  // namespace
+
+h5::table runs_table(const std::vector<method_row>& rows, bool timed) {
+  h5::table t;
+  auto col = [&](auto get) {
+    using T = decltype(get(rows.front()));
+    std::vector<T> v;
+    for (const auto& r : rows) v.push_back(get(r));
+    return v;
+  };
+  t.add("param", col([](const method_row& r) { return r.param; }));
+  t.add("steps", col([](const method_row& r) { return std::int64_t{r.steps}; }));
+  t.add("rejected_steps", col([](const method_row& r) { return std::int64_t{r.rejected_steps}; }));
+  t.add("force_evals", col([](const method_row& r) { return std::int64_t{r.work.force_evals}; }));
+  t.add("jacobian_evals", col([](const method_row& r) { return std::int64_t{r.work.jacobian_evals}; }));
+  t.add("newton_iterations", col([](const method_row& r) { return std::int64_t{r.work.newton_iterations}; }));
+  t.add("linear_solves", col([](const method_row& r) { return std::int64_t{r.work.linear_solves}; }));
+  t.add("err_pos_final", col([](const method_row& r) { return r.metrics.err_pos_final; }));
+  t.add("err_vel_final", col([](const method_row& r) { return r.metrics.err_vel_final; }));
+  t.add("err_pos_max", col([](const method_row& r) { return r.metrics.err_pos_max; }));
+  t.add("err_pos_rms", col([](const method_row& r) { return r.metrics.err_pos_rms; }));
+  t.add("energy_drift", col([](const method_row& r) { return r.metrics.energy_drift; }));
+  t.add("energy_err_max", col([](const method_row& r) { return r.metrics.energy_err_max; }));
+  t.add("diverged", col([](const method_row& r) { return static_cast<std::int8_t>(r.metrics.diverged); }));
+  t.add("failed", col([](const method_row& r) { return static_cast<std::int8_t>(r.metrics.failed); }));
+  t.add("skipped", col([](const method_row& r) { return static_cast<std::int8_t>(r.metrics.skipped); }));
+  t.add("note", col([](const method_row& r) { return r.metrics.note; }));
+  // Timing fields only in a timed study, so an untimed file does not carry columns of
+  // NaN that a reader could mistake for measurements.
+  if (timed) {
+    t.add("time_ns", col([](const method_row& r) { return r.time.time_ns; }));
+    t.add("time_ns_min", col([](const method_row& r) { return r.time.time_ns_min; }));
+    t.add("time_ns_max", col([](const method_row& r) { return r.time.time_ns_max; }));
+    t.add("repetitions", col([](const method_row& r) { return std::int64_t{r.time.repetitions}; }));
+    t.add("cut", col([](const method_row& r) { return static_cast<std::int8_t>(r.time.cut); }));
+  }
+  return t;
+}
 
 std::vector<double> equal_error_targets() {
   std::vector<double> out;
@@ -235,7 +285,8 @@ std::vector<wp_method> work_precision_input(const problem_study& ps, const std::
     wp_method m{ms.info.name, ms.info.origin, ms.info.kind, {}};
     for (const auto& r : ms.rows)
       m.rows.push_back({r.param, metric_value(r.metrics, metric), r.time.time_ns,
-                        static_cast<double>(r.work.force_evals), !r.metrics.diverged && !r.metrics.failed,
+                        static_cast<double>(r.work.force_evals),
+                        !r.metrics.diverged && !r.metrics.failed && !r.metrics.skipped,
                         r.metrics.diverged, r.time.cut});
     out.push_back(std::move(m));
   }
@@ -275,6 +326,7 @@ void check_writable(const std::string& path) {
 void write_study(const study& s, const std::string& path) {
   check_writable(path);
   const std::string tmp = temp_path_for(path);
+  const temp_file_guard guard(tmp);
   H5::Exception::dontPrint();
   try {
     H5::H5File file(tmp, H5F_ACC_TRUNC);
@@ -309,8 +361,10 @@ void write_study(const study& s, const std::string& path) {
       attr(file, "num_cpus", t.num_cpus);
       attr(file, "mhz_per_cpu", t.mhz_per_cpu);
     }
+    write_stability(file);  // /stability: computed from our compiled steps (study/stability.hpp)
     H5::Group problems = file.createGroup("problems");
     for (const auto& ps : s.problems) write_problem(problems, ps, s.timed.has_value());
+    write_substeps(file, s.substeps, s.timed.has_value());
     file.close();
   } catch (const H5::Exception& e) {
     std::remove(tmp.c_str());

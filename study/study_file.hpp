@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/work_precision.hpp"
+#include "study/h5.hpp"
 #include "study/sweep.hpp"
 
 namespace stepbench {
@@ -21,6 +22,9 @@ void check_writable(const std::string& path);
 // Writes the study to a temporary file beside `path` and renames it into place, so an
 // existing file is replaced whole or not at all.
 void write_study(const study& s, const std::string& path);
+
+// The `runs` table of a method's rows (docs/study-format.md); timing fields when timed.
+h5::table runs_table(const std::vector<method_row>& rows, bool timed);
 
 // The rows of a problem's methods in the shape the work-precision rule takes, for one
 // error metric (core/work_precision.hpp).

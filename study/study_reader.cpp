@@ -56,7 +56,7 @@ study_method read_method(const H5::Group& g, const std::string& name) {
     }
   }
   for (const char* required : {"param", "steps", "force_evals", "err_pos_final", "err_vel_final", "err_pos_max",
-                               "err_pos_rms", "diverged", "failed"})
+                               "err_pos_rms", "diverged", "failed", "skipped"})
     if (!m.columns.count(required))
       throw std::runtime_error(fmt::format("missing field '{}' in {}/runs", required, g.getObjName()));
   return m;
@@ -70,6 +70,7 @@ study_problem read_problem(const H5::Group& g, const std::string& name) {
   p.truth_trusted = h5::long_attr(g, "truth_trusted") != 0;
   p.horizon = h5::double_attr(g, "horizon");
   p.pos_scale = h5::double_attr(g, "pos_scale");
+  p.vel_scale = h5::double_attr(g, "vel_scale");
   for (unsigned i = 0; i < static_cast<unsigned>(g.getNumAttrs()); ++i) {
     const H5::Attribute a = g.openAttribute(i);
     if (a.getTypeClass() == H5T_FLOAT && a.getSpace().getSimpleExtentNpoints() == 1) {
@@ -140,6 +141,11 @@ study_data read_study(const std::string& path) {
         std::string v;
         a.read(a.getStrType(), v);
         out.meta[a.getName()] = v;
+      } else if ((a.getTypeClass() == H5T_FLOAT || a.getTypeClass() == H5T_INTEGER) &&
+                 a.getSpace().getSimpleExtentNpoints() == 1) {
+        double v = 0;
+        a.read(H5::PredType::NATIVE_DOUBLE, &v);
+        out.settings[a.getName()] = v;
       }
     }
     out.timed = h5::long_attr(file, "timing") != 0;
@@ -165,12 +171,13 @@ std::vector<wp_method> work_precision_input(const study_problem& p, const std::s
     const auto& evals = m.col("force_evals");
     const auto& diverged = m.col("diverged");
     const auto& failed = m.col("failed");
+    const auto& skipped = m.col("skipped");
     const std::vector<double> none(param.size(), std::numeric_limits<double>::quiet_NaN()), zeros(param.size(), 0.0);
     const auto& time = timed ? m.col("time_ns") : none;
     const auto& cut = timed ? m.col("cut") : zeros;
     for (std::size_t i = 0; i < param.size(); ++i)
-      w.rows.push_back({param[i], err[i], time[i], evals[i], diverged[i] == 0 && failed[i] == 0, diverged[i] != 0,
-                        cut[i] != 0});
+      w.rows.push_back({param[i], err[i], time[i], evals[i], diverged[i] == 0 && failed[i] == 0 && skipped[i] == 0,
+                        diverged[i] != 0, cut[i] != 0});
     out.push_back(std::move(w));
   }
   return out;

@@ -38,7 +38,7 @@ struct study_reference {
 struct study_problem {
   std::string name, unit, truth_source;
   bool truth_trusted = true;
-  double horizon = 0.0, pos_scale = 1.0;
+  double horizon = 0.0, pos_scale = 1.0, vel_scale = 1.0;
   std::map<std::string, double> params;  // every numeric attribute of the problem group
   std::vector<study_reference> references;
   std::vector<study_method> methods;
@@ -49,6 +49,7 @@ struct study_data {
   std::string path;
   long format_version = 0;
   std::map<std::string, std::string> meta;  // string root attributes (version, compiler, cpu, ...)
+  std::map<std::string, double> settings;   // numeric scalar root attributes (cores, levels, base_steps, ...)
   bool timed = false;
   std::vector<study_problem> problems;
   const study_problem* find(const std::string& problem) const;

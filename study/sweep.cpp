@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "core/drive.hpp"
+#include "study/substeps.hpp"
 
 namespace stepbench {
 namespace {
@@ -84,7 +85,7 @@ void fit_rows(method_study& ms, double pos_scale) {
     fit.dt.push_back(row.param);
     fit.error.push_back(row.metrics.err_pos_max);
     fit.steps.push_back(row.steps);
-    fit.diverged.push_back(row.metrics.diverged || row.metrics.failed);
+    fit.diverged.push_back(row.metrics.diverged || row.metrics.failed || row.metrics.skipped);
   }
   ms.fit = fit_order(fit);
   ms.declared_order_holds =
@@ -94,8 +95,23 @@ void fit_rows(method_study& ms, double pos_scale) {
 method_study run_method(const problem_study& ps, const method_info& m, const sweep_options& opts) {
   method_study ms;
   ms.info = m;
+  const double dim = ps.problem->dim();
   for (double param : param_ladder(m, ps.horizon, opts)) {
-    const run_result run = ps.problem->run(m.name, param, ps.horizon, ps.truth.times);
+    // A fixed-step run whose work (twice the previous level's force evaluations, times
+    // the coordinates) would exceed the budget is skipped, with the reason.
+    if (m.kind == method_kind::fixed_step && !ms.rows.empty() && ms.rows.back().work.force_evals > 0 &&
+        2.0 * static_cast<double>(ms.rows.back().work.force_evals) * dim > opts.limits.work_budget) {
+      method_row row{param, 0, 0, {}, {}, {}};
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      auto& mt = row.metrics;
+      mt.err_pos_final = mt.err_vel_final = mt.err_pos_max = mt.err_pos_rms = mt.energy_drift = mt.energy_err_max = nan;
+      mt.skipped = true;
+      mt.note = fmt::format("skipped: about {:.3g} force evaluations x {:g} coordinates exceed the work budget of {:.3g}",
+                            2.0 * static_cast<double>(ms.rows.back().work.force_evals), dim, opts.limits.work_budget);
+      ms.rows.push_back(std::move(row));
+      continue;
+    }
+    const run_result run = ps.problem->run(m.name, param, ps.horizon, ps.truth.times, opts.limits);
     method_row row{param, run.steps, run.rejected_steps, run.work, measure(*ps.problem, run, ps.truth), {}};
     ms.rows.push_back(std::move(row));
   }
@@ -128,8 +144,46 @@ study run_sweep(const sweep_options& opts) {
                    std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     out.problems.push_back(std::move(ps));
   }
+  out.substeps = run_substeps(out, opts.substeps);
   out.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
+}
+
+std::vector<std::string> failed_cases(const study& s) {
+  std::vector<std::string> out;
+  for (const auto& ps : s.problems) {
+    if (!ps.truth.trusted) continue;
+    for (const auto& ms : ps.methods)
+      for (const auto& r : ms.rows)
+        if (r.metrics.failed)
+          out.push_back(fmt::format("{}/{} at {} {:g}: {}", ps.problem->name(), ms.info.name,
+                                    param_name(ms.info.kind), r.param, r.metrics.note));
+  }
+  for (const auto& st : s.substeps)
+    for (const auto& m : st.methods)
+      for (const auto& r : m.rows)
+        if (r.row.metrics.failed)
+          out.push_back(fmt::format("substeps/{}/{} at n = {}: {}", st.problem, m.info.name, r.substeps, r.row.metrics.note));
+  return out;
+}
+
+int report_study_outcome(const study& s, const char* program) {
+  const auto failed = failed_cases(s);
+  for (const auto& f : failed) std::fprintf(stderr, "%s: failed: %s\n", program, f.c_str());
+  // Every other problem has been measured and written; only then is a problem without a
+  // trusted truth an error.
+  if (const auto bad = untrusted_problems(s); !bad.empty()) {
+    std::string names;
+    for (const auto& b : bad) names += (names.empty() ? "" : ", ") + b;
+    std::fprintf(stderr, "%s: error: no trusted truth for %s (errors recorded as NaN)\n", program, names.c_str());
+    return 1;
+  }
+  if (!failed.empty()) {
+    std::fprintf(stderr, "%s: %zu case%s failed (recorded with the reason in the study file)\n", program, failed.size(),
+                 failed.size() == 1 ? "" : "s");
+    return exit_failed_cases;
+  }
+  return 0;
 }
 
 std::vector<std::string> untrusted_problems(const study& s) {

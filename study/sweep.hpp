@@ -21,6 +21,15 @@ namespace stepbench {
 // `thinned`).
 std::vector<double> tolerance_ladder(bool thinned = false);
 
+struct substep_options {
+  bool enabled = true;
+  std::vector<std::string> problems{"stiff_spring", "spring_chain"};
+  std::vector<std::string> explicit_methods{"semi_implicit_euler", "velocity_verlet"};
+  std::vector<std::string> implicit_methods{"implicit_euler", "implicit_midpoint"};
+  std::vector<int> counts{1, 2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 64};
+  int frames = 32;  // the frame is horizon / frames; the truth's sample times are its ends
+};
+
 struct sweep_options {
   std::vector<std::string> problems;  // empty: all
   std::vector<std::string> methods;   // empty: all that run on each problem
@@ -31,6 +40,8 @@ struct sweep_options {
   int sample_count = 32; // fixed sample times j T / sample_count; must divide base_steps
   std::vector<double> tolerances = tolerance_ladder();
   reference_tolerances tol{};
+  run_limits limits{};    // the work budget of one run (core/method.hpp)
+  substep_options substeps{};  // the small-steps comparison (study/substeps.hpp)
   bool progress = false;  // one line per problem on stderr
 };
 
@@ -79,9 +90,27 @@ struct timing_settings {
   double wall_seconds = 0.0;
 };
 
+struct substep_row {
+  int substeps = 1;
+  method_row row;          // param = dt = frame / substeps
+  double extra_damping = 0.0;  // max_j (E_true - E) / energy_scale; NaN without energy or when not completed
+};
+
+struct substep_method {
+  method_info info;
+  std::vector<substep_row> rows;
+};
+
+struct substep_study {
+  std::string problem;
+  double frame_dt = 0.0;
+  std::vector<substep_method> methods;
+};
+
 struct study {
   sweep_options options;
   std::vector<problem_study> problems;
+  std::vector<substep_study> substeps;
   double wall_seconds = 0.0;
   std::optional<timing_settings> timed;
 };
@@ -110,5 +139,17 @@ study run_sweep(const sweep_options& opts);
 
 // Problems whose truth is not trusted (no closed form, no two references agreeing).
 std::vector<std::string> untrusted_problems(const study& s);
+
+// The runs that failed (a solver error, a non-converging Newton iteration), one line
+// each: "<problem>/<method> at <dt or tol>: <reason>". Diverged and skipped runs are
+// outcomes the study records, not failures; a problem without a trusted truth is
+// reported by untrusted_problems instead.
+std::vector<std::string> failed_cases(const study& s);
+
+// The exit status of a command that ran the study and wrote it: 0 every case completed
+// (or diverged, or was skipped over the work budget); 1 a problem has no trusted truth;
+// 3 some case failed. Each is explained on stderr.
+inline constexpr int exit_failed_cases = 3;
+int report_study_outcome(const study& s, const char* program);
 
 }  // namespace stepbench

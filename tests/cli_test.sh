@@ -37,14 +37,19 @@ PY
 import json, sys
 d = json.load(sys.stdin)
 names = {p["name"] for p in d["problems"]}
-assert names == {"constant_acceleration", "projectile", "damped_spring", "pendulum"}, names
+assert names == {"constant_acceleration", "projectile", "damped_spring", "pendulum", "stiff_spring", "spring_chain"}, names
 orders = {m["name"]: m["declared_order"] for m in d["methods"] if m["origin"] == "ours" and m["kind"] == "fixed_step"}
-assert orders == {"euler": 1, "semi_implicit_euler": 1, "midpoint": 2, "rk4": 4, "momentum": 1, "velocity_verlet": 2}, orders
+assert orders == {"euler": 1, "semi_implicit_euler": 1, "midpoint": 2, "rk4": 4, "momentum": 1, "velocity_verlet": 2,
+                  "implicit_euler": 1, "implicit_midpoint": 2}, orders
+adaptive = {m["name"]: m["declared_order"] for m in d["methods"] if m["origin"] == "ours" and m["kind"] == "adaptive"}
+assert adaptive == {"adaptive_euler": 1, "rk45": 5}, adaptive
 origins = {m["name"]: m["origin"] for m in d["methods"]}
 assert origins["baseline_rk4"] == "baseline" and origins["gsl_rk4"] == "peer" and origins["cvode_bdf"] == "peer", origins
 caps = {m["name"]: m["capabilities"] for m in d["methods"]}
 assert caps["velocity_verlet"]["symplectic"] and caps["velocity_verlet"]["reuses_last_force"], caps
 assert not caps["rk4"]["symplectic"] and caps["cvode_bdf"]["error_estimate"], caps
+assert caps["implicit_midpoint"]["symplectic"] and caps["implicit_midpoint"]["needs_jacobian"], caps
+assert caps["rk45"]["dense_output"] and caps["rk45"]["reuses_last_force"], caps
 ' && ok || bad "list --json"
 
 # A parameter override changes the answer as the closed form says: 20 N gives 1000 m.

@@ -4,6 +4,8 @@
 
 #include "core/drive.hpp"
 #include "integrators/all.hpp"
+#include "integrators/explicit_rk.hpp"
+#include "integrators/tableaus.hpp"
 #include "problems/all.hpp"
 
 using namespace stepbench;
@@ -106,4 +108,38 @@ TEST(drive, non_finite_state_stops_the_run) {
   const auto r = drive(p, euler{}, 1.0, 10.0, plan_records(10.0, 1.0, times));
   EXPECT_TRUE(r.non_finite);
   EXPECT_LT(r.steps, 10);
+}
+
+// The hand-scheduled steps of midpoint and rk4 (written for latency: 1/m folded into the
+// coefficients, partial sums formed early) are the methods their Butcher tableaux define:
+// one step of each equals the generic tableau step (integrators/explicit_rk.hpp on
+// integrators/tableaus.hpp) to rounding, on a nonlinear and a damped problem.
+TEST(integrators, hand_scheduled_steps_equal_their_tableaux) {
+  auto check = [](const auto& problem, auto method, const auto& tableau, const char* name) {
+    using P = std::decay_t<decltype(problem)>;
+    using Sys = counted_system<P>;
+    constexpr int S = std::decay_t<decltype(tableau)>::stages;
+    Sys sys(problem);
+    for (double dt : {0.3, 0.01}) {
+      auto s = start_state(problem);
+      stepper_t<decltype(method), Sys> stepper(method);
+      prepare_stepper(stepper, sys, s.x);
+      const auto s0 = s;
+      stepper.step(sys, 0.0, s, dt);
+      rk_stages<S, Sys> k;
+      k.resize(s0.x);
+      typename P::vec f0 = s0.x, x1 = s0.x, v1 = s0.x;
+      sys.force(0.0, s0.x, s0.v, f0);
+      k.compute(tableau, sys, 0.0, s0.x, s0.v, f0, dt);
+      k.combine(tableau.b, dt, dt * inverse_mass(sys), s0.x, s0.v, x1, v1);
+      const double scale = s0.x.norm() + dt * s0.v.norm() + dt * dt * f0.norm() / sys.mass();
+      EXPECT_LE((s.x - x1).norm(), 8 * std::numeric_limits<double>::epsilon() * scale) << name << " dt " << dt;
+      EXPECT_LE((s.v - v1).norm(), 8 * std::numeric_limits<double>::epsilon() * (s0.v.norm() + dt * f0.norm() / sys.mass()))
+          << name << " dt " << dt;
+    }
+  };
+  check(pendulum{}, rk4{}, rk4_tableau, "rk4 on pendulum");
+  check(damped_spring{}, rk4{}, rk4_tableau, "rk4 on damped_spring");
+  check(pendulum{}, midpoint{}, midpoint_tableau, "midpoint on pendulum");
+  check(damped_spring{}, midpoint{}, midpoint_tableau, "midpoint on damped_spring");
 }

@@ -2,6 +2,7 @@
 import argparse
 import os
 import shutil
+import signal
 import sys
 import tempfile
 import time
@@ -49,6 +50,12 @@ def main(argv=None, start=None):
     except OSError as e:
         print(f"report: error: cannot write report folder '{args.out}': {e.strerror}", file=sys.stderr)
         return 1
+    # SIGTERM as well as SIGINT ends the run through the cleanup below, so an interrupted
+    # report leaves the previous one in place and no temporary folder behind.
+    def interrupted(signum, frame):
+        raise KeyboardInterrupt(f"signal {signum}")
+    signal.signal(signal.SIGTERM, interrupted)
+    old = moved_aside = None
     try:
         # matplotlib is imported only now: a file the report refuses is refused at once.
         from . import report
@@ -58,17 +65,25 @@ def main(argv=None, start=None):
         os.chmod(tmp, 0o755)  # mkdtemp makes it 0700
         # Swap into place: the old folder moves aside first, so a failure above leaves it
         # untouched and a reader never sees a half-written REPORT.md.
-        old = None
         if os.path.lexists(out):
             if not os.path.isdir(out) or os.path.islink(out):
                 raise OSError(f"'{args.out}' exists and is not a directory")
             old = tempfile.mkdtemp(prefix=f".{os.path.basename(out)}.old-", dir=parent)
-            os.rename(out, os.path.join(old, "report"))
+            moved_aside = os.path.join(old, "report")
+            os.rename(out, moved_aside)
         os.rename(tmp, out)
+        moved_aside = None
         if old:
             shutil.rmtree(old, ignore_errors=True)
-    except Exception as e:  # one line, and no half-written folder left behind
+    except BaseException as e:  # one line, and nothing half-written left behind or lost
+        if moved_aside and not os.path.lexists(out):
+            os.rename(moved_aside, out)  # interrupted between the two renames: the old report goes back
         shutil.rmtree(tmp, ignore_errors=True)
+        if old:
+            shutil.rmtree(old, ignore_errors=True)
+        if isinstance(e, KeyboardInterrupt):
+            print("report: error: interrupted; the previous report is unchanged", file=sys.stderr)
+            return 130
         if os.environ.get("STEPBENCH_REPORT_DEBUG"):
             raise
         msg = str(e).splitlines()[0] if str(e) else type(e).__name__

@@ -9,7 +9,7 @@ import numpy as np  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.transforms import blended_transform_factory  # noqa: E402
 
-from . import tables, theory  # noqa: E402
+from . import tables  # noqa: E402
 
 DPI = 100
 plt.rcParams.update({
@@ -381,65 +381,89 @@ def energy(study, styles, path):
     return True
 
 
-def stability(osc_rows, path):
-    """Left: absolute-stability regions |R(z)| <= 1 of the Runge-Kutta methods in the
-    plane of z = h lambda, with their intervals on the axes. Right: the undamped
-    oscillator's limit w dt for every method."""
-    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 6.2), gridspec_kw={"width_ratios": [1, 1]})
-    re = np.linspace(-3.5, 1.0, 451)
-    im = np.linspace(-3.3, 3.3, 661)
-    zr, zi = np.meshgrid(re, im)
-    z = zr + 1j * zi
-    colors = {"euler": "tab:blue", "midpoint": "tab:green", "rk4": "tab:red"}
-    box = dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.85)
-    handles = []
-    for name in ("rk4", "midpoint", "euler"):
-        r = np.polynomial.Polynomial(theory.stability_function(name))
-        mag = np.abs(r(z))
-        ax.contourf(zr, zi, mag, levels=[0, 1], colors=[colors[name]], alpha=0.18)
-        ax.contour(zr, zi, mag, levels=[1], colors=[colors[name]], linewidths=1.6)
-        xr = theory.real_axis_limit(name)
-        yi, _ = theory.imaginary_axis_limit(name)
-        ax.plot([xr], [0], marker="o", color=colors[name], markersize=7, zorder=5, markeredgecolor="black")
-        text = f"{name}: real axis to {xr:.3f}"
-        text += f", imag. axis |y| <= {yi:.3f}" if yi > 0 else ", imag. axis: only 0"
-        handles.append((Line2D([], [], color=colors[name], linewidth=6, alpha=0.5), text))
-        if yi > 0:
-            ax.plot([0, 0], [-yi, yi], color=colors[name], linewidth=4, solid_capstyle="butt", zorder=4)
-            for s in (-1, 1):
-                ax.annotate(f"{s * yi:+.3f}i", (0, s * yi), xytext=(6, 0), textcoords="offset points",
-                            va="center", fontsize=8.5, color=colors[name], bbox=box)
-    box = dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.85)
-    xr1 = theory.real_axis_limit("euler")
-    ax.annotate(f"{xr1:.3f}\n(euler, midpoint)", (xr1, 0), xytext=(xr1, -0.75), fontsize=8.5, ha="center",
-                va="top", bbox=box, arrowprops=dict(arrowstyle="-", color="0.4", linewidth=0.8))
-    xr4 = theory.real_axis_limit("rk4")
-    ax.annotate(f"{xr4:.3f} (rk4)", (xr4, 0), xytext=(xr4 + 0.1, 0.6), fontsize=8.5, ha="center", bbox=box,
-                arrowprops=dict(arrowstyle="-", color="0.4", linewidth=0.8))
+def _same_regions(stab):
+    """The integrators grouped by identical |R| grids (to 1e-12): on the damper several
+    methods share a stability function (semi-implicit Euler's velocity update is explicit
+    Euler's), and their curves would hide under each other."""
+    groups = []
+    for name in stab.regions:
+        grid = stab.regions[name]
+        for g in groups:
+            if np.allclose(stab.regions[g[0]], grid, rtol=1e-12, atol=0, equal_nan=True):
+                g.append(name)
+                break
+        else:
+            groups.append([name])
+    return groups
+
+
+def _limit_text(row):
+    if row is None:
+        return "not in the file"
+    if row["unstable_for_all_dt"]:
+        return "unstable for every dt"
+    if row["unconditionally_stable"]:
+        return "stable for every dt"
+    if not np.isfinite(row["theory"]):
+        return "no verdict"
+    return f"< {row['theory']:.4f}"
+
+
+def stability(stab, styles, path):
+    """Left: the stability regions |R(z)| <= 1 in the plane of z = dt lambda, as stored in
+    /stability (|R| from the compiled steps on the complex damper), the contour |R| = 1 of
+    each group of methods with the same R. Right: the limits on the oscillator and on
+    decay from /stability/limits: bars from the amplification matrix, crosses from the
+    long runs."""
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(12, 6.4), gridspec_kw={"width_ratios": [1.1, 1]})
+    zr, zi = np.meshgrid(stab.re, stab.im)
+    handles, labels = [], []
+    dashes = ["-", "--", "-.", ":"]
+    for k, group in enumerate(_same_regions(stab)):
+        color = styles(group[0])["color"] if group[0] in styles.style else f"C{k}"
+        mag = np.ma.masked_invalid(stab.regions[group[0]])
+        ls = dashes[k % len(dashes)]
+        ax.contour(zr, zi, mag, levels=[1.0], colors=[color], linewidths=1.8, linestyles=[ls])
+        handles.append(Line2D([], [], color=color, linewidth=1.8, linestyle=ls))
+        labels.append(" = ".join(group))
     ax.axhline(0, color="black", linewidth=0.7)
     ax.axvline(0, color="black", linewidth=0.7)
-    ax.set_aspect("equal", adjustable="datalim")  # fill the panel: show more of the plane, not blank space
-    ax.set_xlim(re[0], re[-1])
-    ax.set_ylim(im[0], im[-1])
+    ax.set_aspect("equal", adjustable="box")
+    ax.set_xlim(stab.re[0], stab.re[-1])
+    ax.set_ylim(stab.im[0], stab.im[-1])
     ax.set_xlabel("Re(z),  z = dt * lambda  [-]")
     ax.set_ylabel("Im(z)  [-]")
-    ax.set_title("Absolute stability regions |R(z)| <= 1")
-    ax.legend([h for h, _ in handles], [t for _, t in handles], loc="upper center", bbox_to_anchor=(0.5, -0.11),
-              fontsize=8.5, frameon=False)
+    ax.set_title("Stability regions: the curves |R(z)| = 1")
+    ax.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, -0.12), fontsize=8.5, frameon=False,
+              ncol=2)
 
-    names = [r["method"] for r in osc_rows]
-    ys = [r["y_limit"] for r in osc_rows]
-    bars = bx.barh(range(len(names)), ys, color=["tab:gray" if y == 0 else "tab:blue" for y in ys])
-    for i, y in enumerate(ys):
-        bx.text(max(y, 0) + 0.05, i, "unstable for every dt" if y == 0 else f"w dt < {y:.4f}", va="center",
-                fontsize=9)
-    del bars
+    names = list(dict.fromkeys(stab.limits["integrator"]))
+    tests = (("oscillator", "tab:blue", "oscillator: omega * dt"), ("decay", "tab:orange", "decay: lambda * dt"))
+    finite = [r["theory"] for r in stab.limits if np.isfinite(r["theory"])]
+    right = 1.5 * max(finite + [1.0])
+    height = 0.38
+    for j, (test, color, text) in enumerate(tests):
+        for i, name in enumerate(names):
+            row = stab.limit(name, test)
+            yc = i + (j - 0.5) * height
+            value = row["theory"] if row is not None else np.nan
+            if row is not None and row["unconditionally_stable"]:
+                bx.barh(yc, right, height=height, color=color, alpha=0.25, hatch="//", edgecolor=color)
+            elif np.isfinite(value):
+                bx.barh(yc, value, height=height, color=color)
+                if np.isfinite(row["measured"]):
+                    bx.plot([row["measured"]], [yc], marker="x", color="black", markersize=6, zorder=4)
+            bx.text((value if np.isfinite(value) else 0.0) + 0.04 * right / 1.5, yc, _limit_text(row), va="center",
+                    fontsize=8)
+        bx.barh([np.nan], [np.nan], color=color, label=text)
+    bx.plot([], [], marker="x", color="black", linestyle="none", label="long runs")
     bx.set_yticks(range(len(names)))
     bx.set_yticklabels(names)
     bx.invert_yaxis()
-    bx.set_xlim(0, max(ys + [1]) * 1.45)
-    bx.set_xlabel("stability limit w * dt on x'' = -w^2 x  [-]")
-    bx.set_title("Undamped oscillator: largest stable w * dt")
+    bx.set_xlim(0, right * 1.35)
+    bx.set_xlabel("largest stable y  [-]")
+    bx.set_title("Limits: x'' = -omega^2 x and v' = -lambda v")
     bx.grid(axis="y", visible=False)
-    fig.subplots_adjust(left=0.07, right=0.98, top=0.93, bottom=0.24, wspace=0.45)
+    bx.legend(loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=3, fontsize=8.5, frameon=False)
+    fig.subplots_adjust(left=0.06, right=0.98, top=0.93, bottom=0.22, wspace=0.3)
     _save(fig, path)

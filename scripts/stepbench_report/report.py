@@ -1,11 +1,10 @@
 """The report: figures into <dir>/fig, the same document as REPORT.md and index.html."""
-import math
 import os
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-from . import figures, render, tables, theory
+from . import figures, render, tables
 from .tables import fmt_num
 
 TITLE = "stepbench report: accuracy, stability and cost of time integrators"
@@ -29,18 +28,6 @@ def _value(v):
     return str(v)
 
 
-def _oscillator_problems(study):
-    """Problems with a linear spring (k_s, mass_kg, k_d): the oscillator theory applies
-    with w0 = sqrt(k_s / m) and damping ratio zeta = k_d / (2 sqrt(k_s m))."""
-    out = []
-    for p in study.problems:
-        a = p.attrs
-        if {"k_s", "mass_kg", "k_d"} <= set(a):
-            ks, m, kd = float(a["k_s"]), float(a["mass_kg"]), float(a["k_d"])
-            out.append((p, math.sqrt(ks / m), kd / (2 * math.sqrt(ks * m))))
-    return out
-
-
 def _figure_jobs(study, figdir):
     """(kind, argument, path) for every figure; they are independent, so they can be
     drawn in parallel processes. The panel figures take longest and go first, so that
@@ -50,7 +37,8 @@ def _figure_jobs(study, figdir):
         jobs.append(("wp", "time", os.path.join(figdir, "work_precision_time.png")))
     jobs.append(("energy", None, os.path.join(figdir, "energy_drift.png")))
     jobs += [("convergence", p.name, os.path.join(figdir, f"convergence_{p.name}.png")) for p in study.problems]
-    jobs.append(("stability", None, os.path.join(figdir, "stability_regions.png")))
+    if study.stability is not None:
+        jobs.append(("stability", None, os.path.join(figdir, "stability_regions.png")))
     return jobs
 
 
@@ -74,7 +62,7 @@ def _draw(job):
         if not figures.energy(study, styles, path):
             return None
     elif kind == "stability":
-        figures.stability(theory.oscillator_table(list(theory.STEPS)), path)
+        figures.stability(study.stability, styles, path)
     return path
 
 
@@ -109,7 +97,7 @@ def document(study, figs):
     _summary(doc, study)
     _convergence(doc, study, figs)
     _work_precision(doc, study)
-    _stability(doc, study)
+    _stability(doc, study, figs)
     _energy(doc, study, figs)
     doc.h(2, "Game loop")
     gl = study.optional.get("game_loop")
@@ -215,61 +203,63 @@ def _work_precision(doc, study):
             doc.table(tables.ADAPTIVE_HEAD, rows)
 
 
-def _stability(doc, study):
+def _limit_cell(row, column):
+    """A limit as the table shows it: the number, or what the flags say instead."""
+    if row["unstable_for_all_dt"]:
+        return "unstable for every dt"
+    if row["unconditionally_stable"]:
+        return "stable for every dt"
+    v = row[column]
+    if np.isfinite(v):
+        return f"{v:.6f}"
+    return "no verdict: the step fails" if np.isfinite(row["step_failed_at"]) else "none found"
+
+
+def _stability(doc, study, figs):
     doc.h(2, "Stability")
-    stab = study.optional.get("stability")
-    if stab:
-        doc.h(3, stab["title"])
-        _generic_section(doc, stab)
-    else:
-        doc.note("Measured stability limits: absent (this study has no stability data). Below is the theory, "
-                 "computed by this script, and how the study's timestep ladder sits against it.")
-    osc = _oscillator_problems(study)
-    theory_rows = theory.oscillator_table(list(theory.STEPS), *(osc[0][1:] if osc else (None, None)))
-    op = osc[0][0] if osc else None
-    head = ["method", "det M(y) - 1", "trace M(y)", "stable for w dt <"]
-    if op is not None:
-        head += [f"{op.name}: dt limit, undamped w0 = {osc[0][1]:.4g} rad/s [s]",
-                 f"{op.name}: dt limit with its damping (zeta = {osc[0][2]:.3g}) [s]"]
+    st = study.stability
+    if st is None:
+        doc.note("Stability limits and regions: absent (this study file has no /stability group).")
+        return
+    a = st.attrs
+    doc.p("Computed by stepbench from the compiled steps of our integrators when it wrote the file "
+          f"({float(a['limits_seconds']) + float(a['regions_seconds']):.2f} s), on two linear test problems: "
+          f"the undamped oscillator ({a['oscillator']}) and pure decay ({a['decay']}). "
+          "The adaptive methods are measured by the step they take when every attempt is accepted "
+          f"(tolerance {float(a['adaptive_tolerance']):g}): rk45's Dormand-Prince step, adaptive_euler's two "
+          "half steps of explicit Euler.")
+    doc.p("Each limit is found twice. From the amplification matrix M(y) of one step (its columns: one step from "
+          "[x; v] = [1; 0] and [0; 1]): the root of rho(M(y)) - 1 - "
+          f"{float(a['rho_tol']):g} (rho the spectral radius, the constant a round-off allowance), bracketed on a "
+          f"log grid of y from {float(a['y_min']):g} to {float(a['y_max']):g} and bisected to "
+          f"{float(a['root_rtol']):g}; a method already unstable at y = {float(a['y_min']):g} is unstable for "
+          f"every dt, one stable on the whole grid and at y = {float(a['y_unconditional']):g} for every dt. From "
+          f"long runs of {int(a['run_steps'])} steps: unstable when the largest |state| over the second half of "
+          f"the run exceeds {float(a['envelope_growth']):g} x the largest over the first half, bisected to "
+          f"{float(a['run_rtol']):g}. The last column is stepbench's verdict on their agreement (within "
+          f"{100 * float(a['agreement']):g} %, or the runs confirm the flag).")
     rows = []
-    for r in theory_rows:
-        lim = "unstable for every dt" if r["y_limit"] == 0 else f"{r['y_limit']:.6g}"
-        row = [r["method"], str(r["det_minus_1"]), str(r["trace"]), lim]
-        if op is not None:
-            row += ["none (unstable)" if r["dt_limit"] == 0 else f"{r['dt_limit']:.4g}",
-                    "none (unstable)" if r["dt_limit_damped"] == 0 else f"{r['dt_limit_damped']:.4g}"]
-        rows.append(row)
-    doc.h(3, "Theoretical limits on the oscillator")
-    doc.p("One step of each method on x'' = -w^2 x is a 2x2 matrix M(y) with y = w dt, built symbolically from "
-          "the step code (exact rational coefficients). The motion stays bounded while both eigenvalues of M lie in "
-          "the unit disk; the limits below are the first roots of det M - 1, 1 - trace M + det M and "
-          "1 + trace M + det M (numpy roots, polished with scipy brentq) where the eigenvalues leave it. "
-          "det M - 1 > 0 for every y > 0 means growth at every dt (explicit Euler: y^2; midpoint: y^4/4, i.e. "
-          "|R(iy)| > 1 for all y != 0). The symplectic methods have det M = 1 exactly and are stable while "
-          "|trace M| < 2. With damping the same matrices give the problem's own limit.")
-    doc.table(head, rows)
-    doc.img("fig/stability_regions.png", "stability regions")
-    factor = float(study.attrs["divergence_factor"])
-    for p, w0, zeta in osc:
-        lim = {r["method"]: r for r in theory.oscillator_table(list(theory.STEPS), w0, zeta)}
-        rows = []
-        for m in p.by_origin("ours", adaptive=False):
-            if m.name not in lim:
-                continue
-            dl = lim[m.name]["dt_limit_damped"]
-            dt, err, div = m.param, m.col("err_pos_max"), m.diverged
-            above = dt >= dl
-            big = err[above & m.completed & np.isfinite(err)]
-            rows.append([m.name, f"{dl:.4g}", f"{dt.max():.4g}", str(int(above.sum())), str(int((above & div).sum())),
-                         fmt_num(big.max()) + f" {p.unit}" if len(big) else "", str(int((~above & div).sum()))])
-        doc.h(3, f"{p.name}: ladder against the limits")
-        doc.p(f"Each ladder row against the theoretical limit (with the damping) on {p.name}. A run counts as "
-              f"diverged when its position error exceeds {factor:g} x the motion's scale (`divergence_factor`), "
-              "so a row just above the limit may grow without being flagged within the horizon; a diverged row "
-              "below the limit would contradict the theory.")
-        doc.table(["integrator", "theoretical dt limit [s]", "coarsest dt in the study [s]",
-                   "rows at or above the limit", "of those, diverged", "largest error of the others",
-                   "diverged rows below the limit"], rows)
+    for r in st.limits:
+        diff = r["rel_difference"]
+        rows.append([r["integrator"], r["test"], _limit_cell(r, "theory"), _limit_cell(r, "measured"),
+                     f"{diff:+.1e}" if np.isfinite(diff) else "", "yes" if r["run_confirms"] else "NO",
+                     r["note"]])
+    doc.h(3, "Stability limits")
+    doc.table(["integrator", "test", "largest stable y, from M(y)", "from long runs", "runs / M(y) - 1",
+               "agree", "long runs"], rows)
+    failed = [r for r in st.limits if np.isfinite(r["step_failed_at"])]
+    for r in failed:
+        doc.note(f"{r['integrator']} on {r['test']}: the compiled step fails from y = {r['step_failed_at']:.4g}; "
+                 "no flag is set where the step does not exist.")
+    if "stability_regions.png" in figs:
+        doc.img("fig/stability_regions.png", "stability regions and limits")
+    doc.p("Regions: |R(z)| from one step of dt = 1 on a damper with the complex rate z (two velocity coordinates, "
+          "F = m L v, L = [[a, -b], [b, a]] for z = a + ib), on the grid stored in the file; each curve is "
+          "|R| = 1, stable on the side that contains small negative z (outside the circle for implicit Euler, "
+          "the left half-plane for implicit midpoint). Methods with the same R share a curve. For "
+          "semi-implicit Euler, momentum and velocity Verlet this is the region for a velocity-dependent force; "
+          "for springs, where the force depends on position and they are symplectic, their oscillator limit "
+          "(omega dt < 2) is the figure that matters.")
 
 
 def _energy(doc, study, figs):

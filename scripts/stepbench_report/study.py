@@ -23,7 +23,7 @@ TIMED_ROOT_ATTRS = ("benchmark_mode", "benchmark_min_time_s", "benchmark_repetit
                     "benchmark_wall_seconds", "cpu_scaling_enabled", "num_cpus", "mhz_per_cpu")
 PROBLEM_ATTRS = ("horizon", "dim", "position_unit", "description", "has_closed_form", "has_energy", "has_jacobian",
                  "truth_source", "truth_trusted", "truth_note", "agreement_limit", "pos_scale", "vel_scale",
-                 "energy_scale")
+                 "energy_scale", "methods")
 REFERENCE_ATTRS = ("status", "reason", "is_truth", "steps", "failed_steps", "rhs_evals", "lin_rhs_evals",
                    "jac_evals", "rhs_evals_counted", "rtol", "atol", "wall_seconds", "compared_with", "err_pos_rel",
                    "err_vel_rel")
@@ -33,7 +33,7 @@ METHOD_ATTRS = ("origin", "kind", "param_kind", "declared_order", "description",
                 "exact_for_problem", "declared_order_holds")
 RUN_FIELDS = ("param", "steps", "rejected_steps", "force_evals", "jacobian_evals", "newton_iterations",
               "linear_solves", "err_pos_final", "err_vel_final", "err_pos_max", "err_pos_rms", "energy_drift",
-              "energy_err_max", "diverged", "failed", "note")
+              "energy_err_max", "diverged", "failed", "skipped", "note")
 TIMED_RUN_FIELDS = ("time_ns", "time_ns_min", "time_ns_max", "repetitions", "cut")
 EQUAL_ERROR_FIELDS = ("metric", "target", "rank", "method", "origin", "kind", "param", "error", "cost_kind", "cost",
                       "time_ns", "force_evals", "is_answer")
@@ -48,11 +48,20 @@ ORIGINS = ("ours", "peer", "baseline")
 PARAM_KIND = {"fixed_step": "dt", "adaptive": "tolerance"}  # kind -> what `param` is
 FIT_STATUSES = ("fitted", "exact", "insufficient")
 
-# Root groups that later issues will add (stability limits, long energy runs, game-loop
-# figures). Their layout is not defined yet; when a root group of one of these names
-# exists the report shows a generic section for it.
+# /stability: the stability limits and regions of our integrators, computed in C++ from
+# their compiled steps (study/stability.cpp).
+STABILITY_ATTRS = ("oscillator", "decay", "adaptive_tolerance", "y_min", "y_max", "y_unconditional", "per_decade",
+                   "rho_tol", "clear_factor", "root_rtol", "run_steps", "envelope_growth", "blowup_factor",
+                   "decay_floor", "run_y_start", "run_per_decade", "run_rtol", "confirm_y", "agreement", "region_dt",
+                   "limits_seconds", "regions_seconds")
+LIMIT_FIELDS = ("integrator", "test", "measured", "theory", "rel_difference", "unstable_for_all_dt",
+                "unconditionally_stable", "run_confirms", "step_failed_at", "note")
+STABILITY_TESTS = ("oscillator", "decay")
+
+# Root groups that later issues will add (long energy runs, game-loop figures). Their
+# layout is not defined yet; when a root group of one of these names exists the report
+# shows a generic section for it.
 OPTIONAL_SECTIONS = {
-    "stability": "Measured stability limits",
     "energy_runs": "Energy drift over time (long runs)",
     "game_loop": "Game-loop figures",
 }
@@ -109,8 +118,8 @@ class Method:
 
     @property
     def completed(self):
-        """Rows that ran to the horizon: neither diverged nor failed (their errors mean something)."""
-        return (self.runs["diverged"] == 0) & (self.runs["failed"] == 0)
+        """Rows that ran to the horizon: not diverged, failed or skipped (their errors mean something)."""
+        return (self.runs["diverged"] == 0) & (self.runs["failed"] == 0) & (self.runs["skipped"] == 0)
 
     @property
     def diverged(self):
@@ -158,12 +167,28 @@ class Problem:
 
 
 @dataclass
+class Stability:
+    """/stability as stored: `limits` one row per (integrator, test), strings decoded;
+    `regions` integrator -> |R| on the grid (rows: `im`, columns: `re`)."""
+    attrs: dict
+    limits: np.ndarray
+    re: np.ndarray
+    im: np.ndarray
+    regions: dict
+
+    def limit(self, integrator, test):
+        rows = self.limits[(self.limits["integrator"] == integrator) & (self.limits["test"] == test)]
+        return rows[0] if len(rows) else None
+
+
+@dataclass
 class Study:
     path: str
     attrs: dict
     problems: list
     optional: dict  # hook name -> {"title", "attrs", "datasets"}; see OPTIONAL_SECTIONS
     gaps: list = field(default_factory=list)  # what a complete study would have and this one lacks
+    stability: Stability = None  # None only in a file that lacks /stability (a gap)
 
     @property
     def timed(self):
@@ -256,6 +281,33 @@ class _Reader:
                     raise self.error(f"{g.name}/{table} names a run that {g.name}/methods lacks "
                                      f"({r['method']} at {r['param']:g})")
 
+    def need_array(self, parent, name, ndim):
+        ds = parent.get(name)
+        if not isinstance(ds, h5py.Dataset) or ds.dtype.names is not None or ds.ndim != ndim:
+            raise self.error(f"{parent.name.rstrip('/')}/{name} is missing (a {ndim}-D dataset of numbers)")
+        return np.asarray(ds[()], dtype=float)
+
+    def stability(self):
+        g = self.f.get("stability")
+        if g is None:
+            return None
+        if not isinstance(g, h5py.Group):
+            raise self.error("/stability is not a group")
+        attrs = self.need_attrs(g, STABILITY_ATTRS)
+        limits = self.need_table(g, "limits", LIMIT_FIELDS)
+        for t in limits["test"]:
+            self.need_value(g["limits"], "test", t, STABILITY_TESTS)
+        re, im = self.need_array(g, "region_re", 1), self.need_array(g, "region_im", 1)
+        regions_group = self.need_group(g, "regions")
+        regions = {}
+        for name in dict.fromkeys(limits["integrator"]):
+            grid = self.need_array(regions_group, name, 2)
+            if grid.shape != (len(im), len(re)):
+                raise self.error(f"/stability/regions/{name} has shape {grid.shape}, not (len(region_im), "
+                                 f"len(region_re)) = ({len(im)}, {len(re)})")
+            regions[name] = grid
+        return Stability(attrs, limits, re, im, regions)
+
     def study(self):
         f = self.f
         if "format_version" not in f.attrs:
@@ -284,7 +336,12 @@ class _Reader:
         optional = {name: {"title": title, "attrs": {k: _text(v) for k, v in f[name].attrs.items()},
                            "datasets": {k: v.shape for k, v in f[name].items() if isinstance(v, h5py.Dataset)}}
                     for name, title in OPTIONAL_SECTIONS.items() if isinstance(f.get(name), h5py.Group)}
-        return Study(path=str(self.path), attrs=attrs, problems=problems, optional=optional, gaps=_gaps(problems))
+        stability = self.stability()
+        gaps = _gaps(problems)
+        if stability is None:
+            gaps.append("no /stability group (the stability limits and regions)")
+        return Study(path=str(self.path), attrs=attrs, problems=problems, optional=optional, gaps=gaps,
+                     stability=stability)
 
 
 def load(path):
@@ -318,18 +375,16 @@ def _first_line(e):
 
 def _gaps(problems):
     """A study written by stepbench has, on every problem, each method that applies to it
-    and the references; a file with less was cut down or damaged, and the report says so
-    rather than ranking what is left as if it were everything. A method that every other
-    problem has and this one lacks is such a gap; one that applies to only some of the
-    problems (the baseline) is not."""
+    (the problem's `methods` attribute lists them) and the references; a file with less
+    was cut down or damaged, and the report says so rather than ranking what is left as
+    if it were everything. A method that does not apply to a problem (Odeint's on the
+    chain, whose state size is not known at compile time) is not a gap."""
     gaps = []
     for p in problems:
-        others = [q for q in problems if q is not p]
-        if others:
-            everywhere_else = set.intersection(*({m.name for m in q.methods} for q in others))
-            missing = sorted(everywhere_else - {m.name for m in p.methods})
-            if missing:
-                gaps.append(f"{p.name}: no runs for {', '.join(missing)} (every other problem has them)")
+        applies = [n for n in str(p.attrs["methods"]).split(",") if n]
+        missing = [n for n in applies if n not in {m.name for m in p.methods}]
+        if missing:
+            gaps.append(f"{p.name}: no runs for {', '.join(missing)} (it applies)")
         if not p.references:
             gaps.append(f"{p.name}: no reference solutions")
     return gaps

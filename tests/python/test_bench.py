@@ -27,16 +27,28 @@ def listed(bench, *args):
 
 def test_lists_a_case_for_every_completed_row(bench, plain_study):
     """Every method (ours, peers, baseline) on every problem it applies to, one case per
-    row of the quick sweep that completed (a diverged or failed row is not timed)."""
+    row of the quick sweep that completed (a diverged, failed or skipped row is not timed),
+    one per run of the small-steps comparison, and the scaling family and the triad."""
     names = set(listed(bench))
     expected = set()
+    done = lambda runs: runs[(runs["diverged"] == 0) & (runs["failed"] == 0) & (runs["skipped"] == 0)]  # noqa: E731
     with h5py.File(plain_study) as f:
         for pname, g in f["problems"].items():
             for mname, m in g["methods"].items():
                 what = "dt" if m.attrs["kind"] == "fixed_step" else "tol"
-                runs = m["runs"][()]
-                for r in runs[(runs["diverged"] == 0) & (runs["failed"] == 0)]:
+                for r in done(m["runs"][()]):
                     expected.add(f"{pname}/{mname}/{what}:{r['param']:g}/real_time")
+        for pname, g in f["substeps"].items():
+            for mname, m in g["methods"].items():
+                for r in done(m["runs"][()]):
+                    expected.add(f"substeps/{pname}/{mname}/n:{r['substeps']}/real_time")
+    with h5py.File(plain_study) as f:
+        fixed = [m for m, g in f["problems/spring_chain/methods"].items()
+                 if g.attrs["origin"] == "ours" and g.attrs["kind"] == "fixed_step"]
+    for m in fixed:
+        for n in (8, 64, 512, 4096, 32768, 65536):
+            expected.add(f"spring_chain/{m}/masses:{n}/real_time")
+    expected |= {"stream/triad/doubles:33554432/real_time", "stream/triad/doubles:196608/real_time"}
     assert names == expected, (sorted(expected - names)[:5], sorted(names - expected)[:5])
 
 

@@ -104,7 +104,8 @@ def test_outputs_exist_and_images_resolve(reports, shape):
     assert html.count("<table>") == md.count("\n|---")
     assert '<a href="#summary-cheapest-method-per-error-target">' in html
     expected = {"convergence_constant_acceleration.png", "convergence_damped_spring.png", "convergence_pendulum.png",
-                "convergence_projectile.png", "work_precision_force_evals.png", "stability_regions.png",
+                "convergence_projectile.png", "convergence_stiff_spring.png", "convergence_spring_chain.png",
+                "work_precision_force_evals.png", "stability_regions.png",
                 "energy_drift.png"}
     if shape == "timed":
         expected.add("work_precision_time.png")
@@ -249,33 +250,55 @@ def test_references_table_matches_the_file(reports):
                 assert row["is truth"] == ("yes" if ref.attrs["is_truth"] else "")
 
 
-def test_stability_theory_numbers(reports):
-    _, folder = reports["plain"]
+@pytest.mark.parametrize("shape", ["plain", "timed"])
+def test_stability_table_is_the_files(reports, shape):
+    """The limits table is /stability/limits as stepbench wrote it (both columns, their
+    difference and the verdict); the published limits are there."""
+    study, folder = reports[shape]
     md = report_text(folder)
-    head, rows = md_table(md, "### Theoretical limits on the oscillator")
-    t = {r[0]: dict(zip(head, r)) for r in rows}
-    assert t["euler"]["stable for w dt <"] == "unstable for every dt"
-    assert t["midpoint"]["stable for w dt <"] == "unstable for every dt"
-    assert t["midpoint"]["det M(y) - 1"] == "y^4/4"  # |R(iy)|^2 - 1 = y^4 / 4 > 0
-    for name in ("semi_implicit_euler", "momentum", "velocity_verlet"):
-        assert float(t[name]["stable for w dt <"]) == pytest.approx(2.0, abs=1e-5)
-    assert float(t["rk4"]["stable for w dt <"]) == pytest.approx(2 * np.sqrt(2), abs=1e-5)
-    # damped_spring: w0 = sqrt(k_s / m) = sqrt(10); dt < 2 / w0 for the symplectic methods.
-    col = [h for h in head if h.startswith("damped_spring: dt limit, undamped")][0]
-    assert float(t["velocity_verlet"][col]) == pytest.approx(2 / np.sqrt(10), rel=1e-3)
-    assert float(t["rk4"][col]) == pytest.approx(2 * np.sqrt(2) / np.sqrt(10), rel=1e-3)
-    # With its damping, explicit Euler is stable for dt < 2 zeta / w0 = k_d / k_s = 0.1 s:
-    # |1 + dt lambda| < 1 for lambda = -gamma +- i w_d, i.e. dt < 2 gamma / |lambda|^2.
-    col = [h for h in head if h.startswith("damped_spring: dt limit with its damping")][0]
-    assert float(t["euler"][col]) == pytest.approx(0.1, rel=1e-3)
-    # The ladder table names the file's divergence factor.
-    assert "exceeds 100 x the motion's scale" in md
+    head, rows = md_table(md, "### Stability limits")
+    table = {(r[0], r[1]): dict(zip(head, r)) for r in rows}
+    with h5py.File(study) as f:
+        limits = f["stability/limits"][()]
+    assert len(table) == len(limits) == 20
+    for r in limits:
+        row = table[(text(r["integrator"]), text(r["test"]))]
+        for col, field in (("largest stable y, from M(y)", "theory"), ("from long runs", "measured")):
+            if r["unstable_for_all_dt"]:
+                assert row[col] == "unstable for every dt"
+            elif r["unconditionally_stable"]:
+                assert row[col] == "stable for every dt"
+            elif np.isfinite(r[field]):
+                assert float(row[col]) == pytest.approx(r[field], rel=1e-6)
+        if np.isfinite(r["rel_difference"]):
+            assert float(row["runs / M(y) - 1"]) == pytest.approx(r["rel_difference"], rel=0.05)
+        assert row["agree"] == ("yes" if r["run_confirms"] else "NO")
+        assert row["long runs"] == text(r["note"])
+    assert float(table[("rk4", "oscillator")]["largest stable y, from M(y)"]) == pytest.approx(2 * np.sqrt(2),
+                                                                                                abs=1e-6)
+    assert float(table[("rk4", "decay")]["largest stable y, from M(y)"]) == pytest.approx(2.785294, abs=1e-6)
+    for name in ("euler", "midpoint"):
+        assert table[(name, "oscillator")]["largest stable y, from M(y)"] == "unstable for every dt"
+    assert "fig/stability_regions.png" in md
+    # The report draws and formats; it no longer carries a copy of the step code.
+    assert not os.path.exists(os.path.join(ROOT, "scripts", "stepbench_report", "theory.py"))
+
+
+def test_a_study_without_stability_is_incomplete(plain_study, tmp_path):
+    cut = tmp_path / "cut.h5"
+    edit(plain_study, cut, lambda f: f.__delitem__("stability"))
+    out = tmp_path / "report"
+    p = run_report(cut, out)
+    assert p.returncode == 0, p.stderr
+    assert "warning: incomplete study file: no /stability group" in p.stderr
+    md = report_text(out)
+    assert "Stability limits and regions: absent" in md
+    assert not (out / "fig" / "stability_regions.png").exists()
 
 
 def test_absent_sections_are_named(reports):
     _, folder = reports["plain"]
     md = report_text(folder)
-    assert "Measured stability limits: absent" in md
     assert "Energy drift over time on long runs: absent" in md
     assert "Game-loop figures: absent" in md
 
@@ -335,6 +358,10 @@ def make_bad_file(kind, good, path):
         edit(good, path, drop_field("problems/pendulum/methods/gsl_rk4/runs", "err_pos_max"))
     elif kind == "no equal_error":
         edit(good, path, lambda f: f.__delitem__("problems/damped_spring/equal_error"))
+    elif kind == "no stability field":
+        edit(good, path, drop_field("stability/limits", "theory"))
+    elif kind == "no stability region":
+        edit(good, path, lambda f: f.__delitem__("stability/regions/rk4"))
 
 
 BAD_FILES = [
@@ -349,6 +376,8 @@ BAD_FILES = [
     ("no root attribute", "the root group lacks attribute divergence_factor"),
     ("no field", "/problems/pendulum/methods/gsl_rk4/runs lacks field err_pos_max"),
     ("no equal_error", "/problems/damped_spring/equal_error is missing"),
+    ("no stability field", "/stability/limits lacks field theory"),
+    ("no stability region", "/stability/regions/rk4 is missing"),
 ]
 
 

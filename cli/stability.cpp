@@ -1,0 +1,86 @@
+// `stepbench stability [--json]`: the stability limits of our integrators on the
+// undamped oscillator and on pure decay, from their compiled steps (study/stability.hpp):
+// (a) from the amplification matrix of one step, (b) from long runs, and whether a method
+// is unstable for every dt or unconditionally stable. The study file carries the same
+// figures and the stability regions under /stability.
+#include <cmath>
+#include <iostream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "cli/commands.hpp"
+#include "study/stability.hpp"
+
+namespace stepbench::cli {
+namespace {
+
+using json = nlohmann::json;
+
+json number_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+int run_stability(bool as_json) {
+  const stability_data d = compute_stability();
+  if (as_json) {
+    json out = json::array();
+    for (const auto& l : d.limits)
+      out.push_back({{"integrator", l.integrator},
+                     {"test", to_string(l.test)},
+                     {"measured", number_or_null(l.measured)},
+                     {"theory", number_or_null(l.theory)},
+                     {"unstable_for_all_dt", l.unstable_for_all_dt},
+                     {"unconditionally_stable", l.unconditionally_stable},
+                     {"run_confirms", l.run_confirms},
+                     {"step_failed_at", number_or_null(l.step_failed_at)},
+                     {"note", l.note}});
+    std::cout << out.dump(2) << "\n";
+    return 0;
+  }
+  const auto& s = d.settings;
+  fmt::print("Stability limits of our integrators, from their compiled steps\n");
+  fmt::print("  oscillator: x'' = -omega^2 x (F = -m omega^2 x), y = omega dt\n");
+  fmt::print("  decay:      pure damper F = -m lambda v (v' = -lambda v; x integrates v), y = lambda dt\n");
+  fmt::print("  theory (a):   root of rho(M(y)) - 1 - {:g}, M the amplification matrix of one step\n", s.rho_tol);
+  fmt::print("  measured (b): bisection on runs of {} steps, unstable when the largest |state| of the second half\n"
+             "                exceeds {:g} x that of the first half (or passes {:g} x the start)\n",
+             s.run_steps, s.envelope_growth, s.blowup_factor);
+  fmt::print("  adaptive methods: the step they take when every attempt is accepted (tolerance {:g})\n\n",
+             always_accept_tolerance);
+  fmt::print("{:<20} {:<10} {:>12} {:>12} {:>10}  {}\n", "integrator", "test", "theory (a)", "measured (b)",
+             "(b)/(a)-1", "long runs");
+  for (const auto& l : d.limits) {
+    std::string theory, measured, diff;
+    if (l.unstable_for_all_dt) {
+      theory = "unstable";
+      measured = "-";
+      diff = "-";
+    } else if (l.unconditionally_stable) {
+      theory = "uncond.";
+      measured = "-";
+      diff = "-";
+    } else {
+      theory = std::isfinite(l.theory) ? fmt::format("{:.6f}", l.theory) : "no verdict";
+      measured = std::isfinite(l.measured) ? fmt::format("{:.6f}", l.measured) : "-";
+      diff = std::isfinite(l.rel_difference()) ? fmt::format("{:+.1e}", l.rel_difference()) : "-";
+    }
+    fmt::print("{:<20} {:<10} {:>12} {:>12} {:>10}  {}{}\n", l.integrator, to_string(l.test), theory, measured, diff,
+               l.run_confirms ? "" : "NOT CONFIRMED: ", l.note);
+  }
+  fmt::print("\n\"unstable\": unstable for every dt; \"uncond.\": stable for every dt (up to y = {:g}).\n",
+             s.y_unconditional);
+  fmt::print("Computed in {:.3f} s (limits {:.3f} s, stability regions on a {} x {} grid {:.3f} s).\n",
+             d.limits_seconds + d.regions_seconds, d.limits_seconds, s.re_count, s.im_count, d.regions_seconds);
+  return 0;
+}
+
+}  // namespace
+
+command add_stability(CLI::App& app) {
+  auto* sub = app.add_subcommand(
+      "stability", "stability limits of our integrators on the oscillator and on decay, from their steps");
+  auto as_json = std::make_shared<bool>(false);
+  sub->add_flag("--json", *as_json, "print JSON: one record per integrator and test");
+  return {sub, [as_json] { return run_stability(*as_json); }};
+}
+
+}  // namespace stepbench::cli

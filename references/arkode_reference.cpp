@@ -1,0 +1,132 @@
+// Solutions from SUNDIALS ARKODE 5.x's explicit Runge-Kutta stepper (ERKStep): with its
+// default table of order 8 (ARKODE_FEHLBERG_13_7_8) an independent high-order reference
+// beside GSL's rk8pd; as a peer (order 5: ARKODE_DORMAND_PRINCE_7_4_5, or 8) what a
+// SUNDIALS user gets. ERKStepSetStopTime lands exactly on each output time instead of
+// interpolating past it.
+#include <arkode/arkode_erkstep.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_context.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <exception>
+#include <stdexcept>
+#include <string>
+
+#include "references/detail.hpp"
+#include "references/reference.hpp"
+
+namespace stepbench {
+namespace {
+
+struct arkode_callback_state : detail::callback_state {
+  std::string last_message;
+};
+
+int arkode_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) noexcept {
+  auto& st = *static_cast<arkode_callback_state*>(user_data);
+  ++st.calls;
+  if (st.error || st.non_finite) return -1;
+  const auto n = static_cast<std::size_t>(st.sys->n);
+  double* dydt = N_VGetArrayPointer(ydot);
+  try {
+    st.sys->rhs(t, std::span<const double>(N_VGetArrayPointer(y), n), std::span<double>(dydt, n));
+  } catch (...) {
+    st.error = std::current_exception();
+    return -1;  // unrecoverable (ARKRhsFn, user guide 5.x)
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    if (!std::isfinite(dydt[i])) {
+      st.non_finite = true;
+      st.non_finite_t = t;
+      return -1;
+    }
+  return 0;
+}
+
+void arkode_error_handler(int error_code, const char* module, const char* function, char* msg, void* user_data) noexcept {
+  if (error_code == ARK_WARNING) return;
+  auto& st = *static_cast<arkode_callback_state*>(user_data);
+  st.last_message = std::string(module) + "/" + function + ": " + msg;
+}
+
+struct arkode_handles {
+  SUNContext ctx = nullptr;
+  N_Vector y = nullptr;
+  void* mem = nullptr;
+  arkode_handles() = default;
+  arkode_handles(const arkode_handles&) = delete;
+  arkode_handles& operator=(const arkode_handles&) = delete;
+  ~arkode_handles() {
+    if (mem) ERKStepFree(&mem);
+    if (y) N_VDestroy(y);
+    if (ctx) SUNContext_Free(&ctx);
+  }
+};
+
+}  // namespace
+
+reference_solution solve_arkode_erk(const ode_system& sys, std::span<const double> times, int order,
+                                    reference_tolerances tol) {
+  const std::string source = "arkode_erk" + std::to_string(order);
+  detail::validate_reference_input(source, sys, times, tol);
+  const auto start = std::chrono::steady_clock::now();
+  arkode_callback_state st;
+  st.sys = &sys;
+  arkode_handles h;
+  const auto fail = [&](const std::string& call, int flag) {
+    // ERKStepGetReturnFlagName returns a malloc'd string the caller frees (arkode_io.c).
+    char* name = ERKStepGetReturnFlagName(flag);
+    std::string what = source + ": " + call + " failed, flag " + std::to_string(flag) + " (" + (name ? name : "?") + ")";
+    std::free(name);
+    if (st.non_finite) what += "; right-hand side returned a non-finite value at t=" + detail::num(st.non_finite_t);
+    if (!st.last_message.empty()) what += "; " + st.last_message;
+    throw std::runtime_error(what);
+  };
+  const auto check = [&](const char* call, int flag) {
+    if (flag != 0) fail(call, flag);
+  };
+  check("SUNContext_Create", SUNContext_Create(nullptr, &h.ctx));
+  h.y = N_VNew_Serial(sys.n, h.ctx);
+  if (!h.y) throw std::runtime_error(source + ": N_VNew_Serial returned null");
+  std::copy(sys.y0.begin(), sys.y0.end(), N_VGetArrayPointer(h.y));
+  h.mem = ERKStepCreate(&arkode_rhs, 0.0, h.y, h.ctx);
+  if (!h.mem) throw std::runtime_error(source + ": ERKStepCreate returned null");
+  check("ERKStepSetErrHandlerFn", ERKStepSetErrHandlerFn(h.mem, &arkode_error_handler, &st));
+  check("ERKStepSetUserData", ERKStepSetUserData(h.mem, &st));
+  check("ERKStepSetOrder", ERKStepSetOrder(h.mem, order));
+  check("ERKStepSStolerances", ERKStepSStolerances(h.mem, tol.rtol, tol.atol));
+  check("ERKStepSetMaxNumSteps", ERKStepSetMaxNumSteps(h.mem, sys.max_steps_per_output));
+  // At a discontinuity an order-8 method at a tight tolerance needs many rejections in a
+  // row to shrink its step; ARKODE's default of 7 gives up where GSL and CVODE do not.
+  check("ERKStepSetMaxErrTestFails", ERKStepSetMaxErrTestFails(h.mem, 100));
+
+  reference_solution out;
+  out.source = source;
+  out.times.assign(times.begin(), times.end());
+  out.y.reserve(times.size());
+  const auto n = static_cast<std::size_t>(sys.n);
+  for (double tout : times) {
+    check("ERKStepSetStopTime", ERKStepSetStopTime(h.mem, tout));
+    sunrealtype t = 0.0;
+    const int flag = ERKStepEvolve(h.mem, tout, h.y, &t, ARK_NORMAL);
+    if (st.error) std::rethrow_exception(st.error);
+    if (flag < 0) fail("ERKStepEvolve at t=" + detail::num(t) + " towards t=" + detail::num(tout), flag);
+    const double* y = N_VGetArrayPointer(h.y);
+    for (std::size_t i = 0; i < n; ++i)
+      if (!std::isfinite(y[i])) throw std::runtime_error(source + ": non-finite state at t=" + detail::num(tout));
+    out.y.emplace_back(y, y + n);
+  }
+  auto& s = out.stats;
+  check("ERKStepGetNumSteps", ERKStepGetNumSteps(h.mem, &s.steps));
+  check("ERKStepGetNumErrTestFails", ERKStepGetNumErrTestFails(h.mem, &s.failed_steps));
+  check("ERKStepGetNumRhsEvals", ERKStepGetNumRhsEvals(h.mem, &s.rhs_evals));
+  s.rhs_evals_counted = st.calls;
+  s.rtol = tol.rtol;
+  s.atol = tol.atol;
+  s.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+}  // namespace stepbench

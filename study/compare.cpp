@@ -1,0 +1,729 @@
+#include "study/compare.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+#include <set>
+#include <stdexcept>
+#include <string_view>
+#include <tuple>
+
+#include <fmt/format.h>
+
+#include "core/work_precision.hpp"
+
+namespace stepbench {
+namespace {
+
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+
+// ---------------------------------------------------------------------------------------
+// The checks. Each takes a pair (the same problem, or the same method, in both files)
+// and appends what it finds to the comparison. A new group of the study file is one more
+// function in one of the two lists below.
+
+struct problem_pair {
+  const study_problem& base;
+  const study_problem& next;
+  const compare_options& opts;
+};
+
+struct method_pair {
+  const study_problem& base_problem;
+  const study_problem& next_problem;
+  const study_method& base;
+  const study_method& next;
+  const compare_options& opts;
+  std::vector<std::pair<std::size_t, std::size_t>> rows;  // (base row, new row) with equal param
+};
+
+change problem_change(change_kind k, const study_problem& p, std::string what, compare_value old_value,
+                      compare_value new_value) {
+  change c;
+  c.kind = k;
+  c.problem = p.name;
+  c.what = std::move(what);
+  c.old_value = std::move(old_value);
+  c.new_value = std::move(new_value);
+  return c;
+}
+
+change row_change(change_kind k, const method_pair& mp, std::size_t new_row, std::string what, double old_value,
+                  double new_value) {
+  change c;
+  c.kind = k;
+  c.problem = mp.next_problem.name;
+  c.method = mp.next.name;
+  c.param_name = std::string(param_name(mp.next.kind));
+  c.param = mp.next.col("param")[new_row];
+  c.what = std::move(what);
+  c.old_value = old_value;
+  c.new_value = new_value;
+  c.ratio = new_value / old_value;
+  if (new_row < mp.next.notes.size()) c.note = mp.next.notes[new_row];
+  return c;
+}
+
+// The truth a problem's errors are measured against: its source and whether it is trusted.
+void check_truth(const problem_pair& pp, comparison& out) {
+  if (pp.base.truth_source != pp.next.truth_source)
+    out.changes.push_back(
+        problem_change(change_kind::regression, pp.next, "truth_source", pp.base.truth_source, pp.next.truth_source));
+  if (pp.base.truth_trusted != pp.next.truth_trusted)
+    out.changes.push_back(problem_change(pp.next.truth_trusted ? change_kind::improvement : change_kind::regression,
+                                         pp.next, "truth_trusted", pp.base.truth_trusted ? 1.0 : 0.0,
+                                         pp.next.truth_trusted ? 1.0 : 0.0));
+}
+
+// The references: status (ok, failed, disagrees) and agreement with what they are compared with.
+void check_references(const problem_pair& pp, comparison& out) {
+  for (const auto& r : pp.base.references) {
+    const auto it = std::find_if(pp.next.references.begin(), pp.next.references.end(),
+                                 [&](const study_reference& n) { return n.source == r.source; });
+    if (it == pp.next.references.end()) {
+      out.removed.push_back({pp.base.name, "", "reference " + r.source, "status " + r.status + " in BASE"});
+      continue;
+    }
+    const study_reference& n = *it;
+    const bool was_ok = r.status == "ok", is_ok = n.status == "ok";
+    if (was_ok != is_ok) {
+      auto c = problem_change(is_ok ? change_kind::improvement : change_kind::regression, pp.next,
+                              fmt::format("reference {} status", r.source), r.status, n.status);
+      c.note = n.reason;
+      out.changes.push_back(std::move(c));
+    }
+    if (r.compared_with != n.compared_with) continue;  // agreements with different things do not compare
+    for (const auto& [field, old_rel, new_rel] : {std::tuple{"err_pos_rel", r.err_pos_rel, n.err_pos_rel},
+                                                  std::tuple{"err_vel_rel", r.err_vel_rel, n.err_vel_rel}})
+      if (const auto k = judge_agreement(old_rel, new_rel, pp.opts.error_factor)) {
+        auto c = problem_change(*k, pp.next, fmt::format("reference {} {}", r.source, field), old_rel, new_rel);
+        c.ratio = new_rel / old_rel;
+        c.note = fmt::format("vs {}", n.compared_with);
+        out.changes.push_back(std::move(c));
+      }
+  }
+  for (const auto& n : pp.next.references)
+    if (std::none_of(pp.base.references.begin(), pp.base.references.end(),
+                     [&](const study_reference& r) { return r.source == n.source; }))
+      out.added.push_back({pp.next.name, "", "reference " + n.source, "status " + n.status + " in NEW"});
+}
+
+std::string param_list(const study_method& m, const std::vector<double>& params) {
+  std::string s;
+  for (double p : params) s += (s.empty() ? "" : ", ") + format_param(m.kind, p);
+  return s;
+}
+
+// The ladder: rows are matched by their param, exactly. Rows only in BASE are removed,
+// rows only in NEW added; a method whose kind changed has no rows in common.
+void match_ladder(method_pair& mp, comparison& out) {
+  const auto& bp = mp.base.col("param");
+  const auto& np = mp.next.col("param");
+  if (mp.base.kind != mp.next.kind) {
+    out.removed.push_back({mp.next_problem.name, mp.next.name, "ladder",
+                           fmt::format("was {} ({} rows), now {} ({} rows): no row compared", to_string(mp.base.kind),
+                                       bp.size(), to_string(mp.next.kind), np.size())});
+    return;
+  }
+  std::vector<double> only_base, only_new;
+  for (std::size_t i = 0; i < bp.size(); ++i) {
+    const auto it = std::find(np.begin(), np.end(), bp[i]);
+    if (it == np.end())
+      only_base.push_back(bp[i]);
+    else
+      mp.rows.emplace_back(i, static_cast<std::size_t>(it - np.begin()));
+  }
+  for (double p : np)
+    if (std::find(bp.begin(), bp.end(), p) == bp.end()) only_new.push_back(p);
+  if (!only_base.empty())
+    out.removed.push_back({mp.next_problem.name, mp.next.name, "ladder",
+                           fmt::format("ladder changed: {} of {} rows only in BASE ({}); {} compared", only_base.size(),
+                                       bp.size(), param_list(mp.base, only_base), mp.rows.size())});
+  if (!only_new.empty())
+    out.added.push_back({mp.next_problem.name, mp.next.name, "ladder",
+                         fmt::format("ladder changed: {} of {} rows only in NEW ({}); {} compared", only_new.size(),
+                                     np.size(), param_list(mp.next, only_new), mp.rows.size())});
+}
+
+// The observed order of a fixed-step method (the fit of err_pos_max against dt).
+void check_order(const method_pair& mp, comparison& out) {
+  if (mp.base.kind != method_kind::fixed_step || mp.next.kind != method_kind::fixed_step) return;
+  const bool was = mp.base.fit_status == "fitted", is = mp.next.fit_status == "fitted";
+  change c;
+  c.problem = mp.next_problem.name;
+  c.method = mp.next.name;
+  if (was && is) {
+    const auto k = judge_order(mp.base.fit_slope, mp.next.fit_slope, mp.opts.order_drop);
+    if (!k) return;
+    c.kind = *k;
+    c.what = "observed order";
+    c.old_value = mp.base.fit_slope;
+    c.new_value = mp.next.fit_slope;
+    c.ratio = mp.next.fit_slope / mp.base.fit_slope;
+  } else if (was || (is && mp.base.fit_status == "insufficient")) {
+    // Fitted and no longer is; or could not be fitted and now is. (From `exact` to fitted
+    // is no improvement: the errors left round-off, which the row checks judge.)
+    c.kind = was ? change_kind::regression : change_kind::improvement;
+    c.what = "order fit";
+    c.old_value = mp.base.fit_status;
+    c.new_value = mp.next.fit_status;
+  } else {
+    return;
+  }
+  out.changes.push_back(std::move(c));
+}
+
+// The flags that say a row has no result: diverged, failed, and (where both files have
+// the field) skipped over the work budget.
+std::vector<std::string> row_flags(const method_pair& mp) {
+  std::vector<std::string> out{"diverged", "failed"};
+  if (mp.base.columns.count("skipped") && mp.next.columns.count("skipped")) out.emplace_back("skipped");
+  return out;
+}
+
+// Every row in both files: newly diverged, failed or skipped (or no longer), and each error.
+void check_rows(const method_pair& mp, comparison& out) {
+  const auto flags = row_flags(mp);
+  const double pos_floor = error_floor_rel * std::max(mp.base_problem.pos_scale, mp.next_problem.pos_scale);
+  const double vel_floor = error_floor_rel * std::max(mp.base_problem.vel_scale, mp.next_problem.vel_scale);
+  for (const auto& [i, j] : mp.rows) {
+    bool completed = true;
+    for (const auto& flag : flags) {
+      const double old_flag = mp.base.col(flag)[i], new_flag = mp.next.col(flag)[j];
+      completed = completed && old_flag == 0 && new_flag == 0;
+      if ((old_flag != 0) != (new_flag != 0)) {
+        auto c = row_change(new_flag != 0 ? change_kind::regression : change_kind::improvement, mp, j, flag, old_flag,
+                            new_flag);
+        c.ratio = nan;  // a flag: 0 -> 1 has no ratio
+        out.changes.push_back(std::move(c));
+      }
+    }
+    if (!completed) continue;  // errors of completed runs only
+    for (const char* metric : error_metrics) {
+      const double old_err = mp.base.col(metric)[i], new_err = mp.next.col(metric)[j];
+      const double floor = std::string_view(metric) == "err_vel_final" ? vel_floor : pos_floor;
+      if (const auto k = judge_error(old_err, new_err, floor, mp.opts.error_factor)) {
+        auto c = row_change(*k, mp, j, metric, old_err, new_err);
+        c.note.clear();
+        out.changes.push_back(std::move(c));
+      }
+    }
+  }
+}
+
+timing_side side(const study_method& m, std::size_t row) {
+  return {m.col("time_ns")[row], m.col("time_ns_min")[row], m.col("time_ns_max")[row],
+          static_cast<long>(m.col("repetitions")[row])};
+}
+
+bool timed_row(const study_method& m, std::size_t row) {
+  return std::isfinite(m.col("time_ns")[row]) && m.col("time_ns")[row] > 0 && m.col("repetitions")[row] >= 1 &&
+         m.col("cut")[row] == 0;
+}
+
+// Rows timed in both files: ratio, noise threshold, flag.
+void collect_timing(const method_pair& mp, comparison& out) {
+  if (!out.timing_compared) return;
+  for (const auto& [i, j] : mp.rows) {
+    if (!timed_row(mp.base, i) || !timed_row(mp.next, j)) continue;
+    timing_row t{mp.next_problem.name,
+                 mp.next.name,
+                 std::string(param_name(mp.next.kind)),
+                 mp.next.col("param")[j],
+                 side(mp.base, i),
+                 side(mp.next, j),
+                 0.0,
+                 0.0,
+                 0};
+    t.ratio = t.new_time.median / t.old_time.median;
+    t.threshold = timing_threshold(t.old_time, t.new_time);
+    t.flag = judge_timing(t.ratio, t.threshold);
+    out.timing.push_back(std::move(t));
+  }
+}
+
+// Per method, over every problem: the geometric mean of its rows' ratios.
+void summarize_timing(comparison& out) {
+  std::map<std::string, timing_summary> by_method;
+  std::map<std::string, std::set<std::string>> problems;
+  std::map<std::string, double> log_sum;
+  for (const auto& t : out.timing) {
+    auto& s = by_method[t.method];
+    s.method = t.method;
+    s.min_ratio = s.rows == 0 ? t.ratio : std::min(s.min_ratio, t.ratio);
+    s.max_ratio = s.rows == 0 ? t.ratio : std::max(s.max_ratio, t.ratio);
+    ++s.rows;
+    s.slower += t.flag > 0;
+    s.faster += t.flag < 0;
+    problems[t.method].insert(t.problem);
+    log_sum[t.method] += std::log(t.ratio);
+  }
+  for (auto& [name, s] : by_method) {
+    s.problems = problems[name].size();
+    s.geomean = std::exp(log_sum[name] / static_cast<double>(s.rows));
+    out.timing_summaries.push_back(s);
+  }
+}
+
+using method_check = void (*)(const method_pair&, comparison&);
+constexpr method_check method_checks[] = {check_order, check_rows, collect_timing};
+
+// The methods of a problem: present in one file only, or compared by every method check.
+void check_methods(const problem_pair& pp, comparison& out) {
+  for (const auto& m : pp.base.methods) {
+    const study_method* n = pp.next.find(m.name);
+    if (!n) {
+      out.removed.push_back({pp.base.name, m.name, "method", fmt::format("{}, {} rows", to_string(m.kind), m.rows())});
+      continue;
+    }
+    method_pair mp{pp.base, pp.next, m, *n, pp.opts, {}};
+    match_ladder(mp, out);
+    for (const auto check : method_checks) check(mp, out);
+  }
+  for (const auto& n : pp.next.methods)
+    if (!pp.base.find(n.name))
+      out.added.push_back({pp.next.name, n.name, "method", fmt::format("{}, {} rows", to_string(n.kind), n.rows())});
+}
+
+using problem_check = void (*)(const problem_pair&, comparison&);
+constexpr problem_check problem_checks[] = {check_truth, check_references, check_methods};
+
+// ---------------------------------------------------------------------------------------
+// What differs between the files besides the results.
+
+std::string number(double v) { return fmt::format("{:.12g}", v); }
+
+void root_differences(const study_data& base, const study_data& next, comparison& out) {
+  // Run-specific figures that always differ are left out.
+  const std::set<std::string> skip{"created_utc", "wall_seconds", "benchmark_wall_seconds"};
+  // Machine, build and mode first: they decide whether the timings compare at all.
+  const std::vector<std::string> first{
+      "cpu",          "cores",   "num_cpus",   "mhz_per_cpu", "cpu_scaling_enabled", "compiler", "build_type",
+      "dependencies", "version", "git_commit", "timing",      "benchmark_mode"};
+  std::map<std::string, std::pair<std::string, std::string>> all;
+  const auto gather = [&](const study_data& s, bool is_new) {
+    for (const auto& [k, v] : s.meta) (is_new ? all[k].second : all[k].first) = v;
+    for (const auto& [k, v] : s.settings) (is_new ? all[k].second : all[k].first) = number(v);
+  };
+  gather(base, false);
+  gather(next, true);
+  std::vector<std::string> order(first);
+  for (const auto& [k, v] : all)
+    if (std::find(first.begin(), first.end(), k) == first.end()) order.push_back(k);
+  for (const auto& k : order) {
+    const auto it = all.find(k);
+    if (it == all.end() || skip.count(k) || it->second.first == it->second.second) continue;
+    const auto shown = [](const std::string& v) { return v.empty() ? std::string("(absent)") : v; };
+    out.differences.push_back({k, shown(it->second.first), shown(it->second.second)});
+  }
+}
+
+// A problem's parameters (and the scales derived from its truth), equal to 1e-9 relative.
+void problem_differences(const study_problem& base, const study_problem& next, comparison& out) {
+  std::set<std::string> keys;
+  for (const auto& [k, v] : base.params) keys.insert(k);
+  for (const auto& [k, v] : next.params) keys.insert(k);
+  for (const auto& k : keys) {
+    const auto b = base.params.find(k), n = next.params.find(k);
+    const bool in_b = b != base.params.end(), in_n = n != next.params.end();
+    if (in_b && in_n) {
+      const double x = b->second, y = n->second;
+      if (x == y || std::abs(x - y) <= 1e-9 * std::max(std::abs(x), std::abs(y)) || (std::isnan(x) && std::isnan(y)))
+        continue;
+    }
+    out.differences.push_back({fmt::format("{}: {}", next.name, k), in_b ? number(b->second) : "(absent)",
+                               in_n ? number(n->second) : "(absent)"});
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// Presentation: every section is one table, drawn as aligned text or as Markdown.
+
+struct table {
+  std::vector<std::string> head;
+  std::vector<std::vector<std::string>> rows;
+};
+
+std::string text_table(const table& t, const std::string& indent = "  ") {
+  std::vector<std::size_t> w(t.head.size());
+  for (std::size_t k = 0; k < t.head.size(); ++k) w[k] = t.head[k].size();
+  for (const auto& r : t.rows)
+    for (std::size_t k = 0; k < r.size(); ++k) w[k] = std::max(w[k], r[k].size());
+  const auto line = [&](const std::vector<std::string>& cells) {
+    std::string s = indent;
+    for (std::size_t k = 0; k < cells.size(); ++k)
+      s += k + 1 < cells.size() ? fmt::format("{:<{}}  ", cells[k], w[k]) : cells[k];
+    s.erase(s.find_last_not_of(' ') + 1);
+    return s + "\n";
+  };
+  std::string out = line(t.head);
+  for (const auto& r : t.rows) out += line(r);
+  return out;
+}
+
+std::string md_cell(const std::string& s) {
+  std::string out;
+  for (char ch : s) out += ch == '|' ? std::string("\\|") : std::string(1, ch);
+  return out.empty() ? " " : out;
+}
+
+std::string md_table(const table& t) {
+  const auto line = [](const std::vector<std::string>& cells) {
+    std::string s = "|";
+    for (const auto& c : cells) s += " " + md_cell(c) + " |";
+    return s + "\n";
+  };
+  std::string out = line(t.head) + "|";
+  for (std::size_t k = 0; k < t.head.size(); ++k) out += "---|";
+  out += "\n";
+  for (const auto& r : t.rows) out += line(r);
+  return out;
+}
+
+std::string value_text(const compare_value& v) {
+  if (const auto* s = std::get_if<std::string>(&v)) return *s;
+  const double d = std::get<double>(v);
+  return std::isnan(d) ? "NaN" : fmt::format("{:.3g}", d);
+}
+
+std::string ratio_text(double r) { return std::isnan(r) ? "-" : std::isinf(r) ? "inf" : fmt::format("{:.3g}", r); }
+
+std::string param_text(const std::string& name, double param) {
+  if (name.empty()) return "-";
+  return format_param(name == "tolerance" ? method_kind::adaptive : method_kind::fixed_step, param);
+}
+
+table changes_table(const comparison& c, change_kind k) {
+  table t{{"problem", "method", "dt or tolerance", "what", "old", "new", "ratio", "note"}, {}};
+  for (const auto& x : c.changes)
+    if (x.kind == k)
+      t.rows.push_back({x.problem, x.method.empty() ? "-" : x.method, param_text(x.param_name, x.param), x.what,
+                        value_text(x.old_value), value_text(x.new_value), ratio_text(x.ratio), x.note});
+  // The note column only when some finding has one.
+  if (std::all_of(t.rows.begin(), t.rows.end(), [](const auto& r) { return r.back().empty(); })) {
+    t.head.pop_back();
+    for (auto& r : t.rows) r.pop_back();
+  }
+  return t;
+}
+
+table presence_table(const std::vector<presence>& items) {
+  table t{{"problem", "method", "what", "detail"}, {}};
+  for (const auto& p : items) t.rows.push_back({p.problem, p.method.empty() ? "-" : p.method, p.what, p.detail});
+  return t;
+}
+
+table differences_table(const comparison& c) {
+  table t{{"what", "BASE", "NEW"}, {}};
+  for (const auto& d : c.differences) t.rows.push_back({d.what, d.old_value, d.new_value});
+  return t;
+}
+
+std::string side_text(const timing_side& s) {
+  return s.repetitions >= 2 ? fmt::format("{} ({}..{}, {} reps)", format_time_ns(s.median), format_time_ns(s.min),
+                                          format_time_ns(s.max), s.repetitions)
+                            : fmt::format("{} (1 rep)", format_time_ns(s.median));
+}
+
+table timing_flagged_table(const comparison& c) {
+  table t{{"problem", "method", "dt or tolerance", "old median", "new median", "new/old", "threshold", "flag"}, {}};
+  for (const auto& r : c.timing)
+    if (r.flag != 0)
+      t.rows.push_back({r.problem, r.method, param_text(r.param_name, r.param), side_text(r.old_time),
+                        side_text(r.new_time), fmt::format("{:.3f}", r.ratio),
+                        fmt::format("+{:.0f} %", 100 * r.threshold), r.flag > 0 ? "slower" : "faster"});
+  return t;
+}
+
+table timing_summary_table(const comparison& c) {
+  table t{{"method", "problems", "rows", "geomean new/old", "min", "max", "slower", "faster"}, {}};
+  for (const auto& s : c.timing_summaries)
+    t.rows.push_back({s.method, std::to_string(s.problems), std::to_string(s.rows), fmt::format("{:.3f}", s.geomean),
+                      fmt::format("{:.3f}", s.min_ratio), fmt::format("{:.3f}", s.max_ratio), std::to_string(s.slower),
+                      std::to_string(s.faster)});
+  return t;
+}
+
+std::string file_line(const std::map<std::string, std::string>& meta, bool timed) {
+  const auto get = [&](const char* k) {
+    const auto it = meta.find(k);
+    return it == meta.end() ? std::string("?") : it->second;
+  };
+  return fmt::format("created {}, stepbench {} ({}), {} {}, {}", get("created_utc"), get("version"), get("git_commit"),
+                     get("compiler"), get("build_type"),
+                     timed ? fmt::format("timed ({})", get("benchmark_mode")) : std::string("untimed"));
+}
+
+// Words filled to `width` columns, the first line after `first`, the rest after `rest`.
+std::string wrap(const std::string& text, const std::string& first, const std::string& rest, std::size_t width = 100) {
+  std::string out = first, word;
+  std::size_t col = first.size();
+  bool line_empty = true;
+  const auto put = [&] {
+    if (word.empty()) return;
+    if (!line_empty && col + 1 + word.size() > width) {
+      out += "\n" + rest;
+      col = rest.size();
+      line_empty = true;
+    }
+    if (!line_empty) {
+      out += ' ';
+      ++col;
+    }
+    out += word;
+    col += word.size();
+    line_empty = false;
+    word.clear();
+  };
+  for (char ch : text)
+    if (ch == ' ')
+      put();
+    else
+      word += ch;
+  put();
+  return out + "\n";
+}
+
+std::string verdict(const comparison& c) { return c.exit_status() == 0 ? "no regression" : "REGRESSION"; }
+
+std::string plural(std::size_t n, const char* one, const char* many) {
+  return fmt::format("{} {}", n, n == 1 ? one : many);
+}
+
+std::string timing_heading(const comparison& c) {
+  const auto single = std::count_if(c.timing.begin(), c.timing.end(), [](const timing_row& r) {
+    return r.old_time.repetitions < 2 || r.new_time.repetitions < 2;
+  });
+  return fmt::format(
+      "new/old of the median time_ns, {} rows timed in both; {} slower, {} faster beyond the noise{}.{}{}",
+      c.timing.size(), c.slower(), c.faster(),
+      c.options.gate_timing ? " (gating: --gate-timing)" : " (informs only; --gate-timing to gate)",
+      c.timing_note.empty() ? "" : fmt::format(" Note: {}.", c.timing_note),
+      single == 0 ? std::string()
+                  : fmt::format(" {} of them have a single repetition on a side: no spread to measure, "
+                                "so their threshold is the {:g} % fallback.",
+                                single, 100 * timing_single_run_floor));
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------
+
+double timing_side::spread() const { return repetitions >= 2 ? (max - min) / median : nan; }
+
+std::optional<change_kind> judge_error(double old_err, double new_err, double floor, double factor) {
+  if (std::isnan(old_err) && std::isnan(new_err)) return std::nullopt;
+  if (!std::isfinite(new_err) && std::isfinite(old_err)) return change_kind::regression;
+  if (std::isfinite(new_err) && !std::isfinite(old_err)) return change_kind::improvement;
+  if (new_err > floor && new_err > factor * old_err) return change_kind::regression;
+  if (old_err > floor && old_err > factor * new_err) return change_kind::improvement;
+  return std::nullopt;
+}
+
+std::optional<change_kind> judge_agreement(double old_rel, double new_rel, double factor) {
+  if (!std::isfinite(old_rel) || !std::isfinite(new_rel)) return std::nullopt;  // not compared
+  return judge_error(old_rel, new_rel, agreement_floor, factor);
+}
+
+std::optional<change_kind> judge_order(double old_order, double new_order, double drop) {
+  if (!std::isfinite(old_order) || !std::isfinite(new_order)) return std::nullopt;
+  if (new_order < old_order - drop) return change_kind::regression;
+  if (new_order > old_order + drop) return change_kind::improvement;
+  return std::nullopt;
+}
+
+double timing_threshold(const timing_side& old_time, const timing_side& new_time) {
+  const bool both_spread = old_time.repetitions >= 2 && new_time.repetitions >= 2;
+  double t = both_spread ? timing_noise_floor : timing_single_run_floor;
+  for (const auto& s : {old_time, new_time})
+    if (std::isfinite(s.spread())) t = std::max(t, timing_spread_multiple * s.spread());
+  return t;
+}
+
+int judge_timing(double ratio, double threshold) {
+  if (ratio > 1.0 + threshold) return 1;
+  if (ratio < 1.0 / (1.0 + threshold)) return -1;
+  return 0;
+}
+
+std::vector<std::string> describe_thresholds(const compare_options& o) {
+  return {
+      fmt::format(
+          "An error (err_pos_max, err_pos_final, err_pos_rms, err_vel_final) of a row that completed in both "
+          "files regresses when it grows by more than {:g}x (--error-factor) while the new error is above the "
+          "round-off floor {:g} x pos_scale for position errors, {:g} x vel_scale for err_vel_final (the larger "
+          "scale of the two files); it improves when it shrinks by as much from above the floor.",
+          o.error_factor, error_floor_rel, error_floor_rel),
+      "A row that newly diverges, fails or is skipped (over the work budget) regresses; one that no longer does "
+      "improves.",
+      fmt::format("An observed order (fit_slope of a fixed-step method fitted in both) regresses when it drops by more "
+                  "than {:g} (--order-drop), or when it was fitted and no longer is; it improves when it rises by as "
+                  "much.",
+                  o.order_drop),
+      fmt::format("A reference regresses when its status leaves ok or its agreement (err_pos_rel, err_vel_rel) grows "
+                  "by more than {:g}x above {:g}; a problem regresses when its truth_source changes or its truth "
+                  "is no longer trusted.",
+                  o.error_factor, agreement_floor),
+      fmt::format("What only BASE has (a problem, a method, a reference, rows of a ladder) {}; what only NEW has is "
+                  "listed as added.",
+                  o.allow_removed ? "is listed (--allow-removed)" : "regresses (unless --allow-removed)"),
+      fmt::format("Timing: a row timed in both is flagged when new/old exceeds 1+t (slower) or falls below "
+                  "1/(1+t) (faster), t = max({:g} %, {:g} x the larger (max - min)/median of the two files' "
+                  "repetitions); with a single repetition on a side there is no spread, and the floor is {:g} % "
+                  "instead of {:g} %. {}",
+                  100 * timing_noise_floor, timing_spread_multiple, 100 * timing_single_run_floor,
+                  100 * timing_noise_floor,
+                  o.gate_timing ? "A flagged slowdown regresses (--gate-timing)."
+                                : "Timing informs; it gates only with --gate-timing."),
+  };
+}
+
+std::size_t comparison::count(change_kind k) const {
+  return static_cast<std::size_t>(
+      std::count_if(changes.begin(), changes.end(), [k](const change& c) { return c.kind == k; }));
+}
+std::size_t comparison::slower() const {
+  return static_cast<std::size_t>(
+      std::count_if(timing.begin(), timing.end(), [](const timing_row& r) { return r.flag > 0; }));
+}
+std::size_t comparison::faster() const {
+  return static_cast<std::size_t>(
+      std::count_if(timing.begin(), timing.end(), [](const timing_row& r) { return r.flag < 0; }));
+}
+std::size_t comparison::gating() const {
+  return count(change_kind::regression) + (options.allow_removed ? 0 : removed.size()) +
+         (options.gate_timing ? slower() : 0);
+}
+
+comparison compare_studies(const study_data& base, const study_data& next, const compare_options& opts) {
+  if (!(opts.error_factor >= 1.0) || !std::isfinite(opts.error_factor))
+    throw std::invalid_argument(
+        fmt::format("--error-factor must be a finite number >= 1, got {:g}", opts.error_factor));
+  if (!(opts.order_drop >= 0.0) || !std::isfinite(opts.order_drop))
+    throw std::invalid_argument(fmt::format("--order-drop must be a finite number >= 0, got {:g}", opts.order_drop));
+  if (base.format_version != next.format_version)
+    throw std::runtime_error(
+        fmt::format("cannot compare '{}' (format_version {}) with '{}' (format_version {}): "
+                    "different study formats",
+                    base.path, base.format_version, next.path, next.format_version));
+  comparison out;
+  out.options = opts;
+  out.base_path = base.path;
+  out.new_path = next.path;
+  out.base_meta = base.meta;
+  out.new_meta = next.meta;
+  out.base_timed = base.timed;
+  out.new_timed = next.timed;
+  out.timing_compared = base.timed && next.timed;
+  if (!out.timing_compared)
+    out.timing_note = !base.timed && !next.timed ? "neither file is timed"
+                      : base.timed               ? "NEW is not timed"
+                                                 : "BASE is not timed";
+  root_differences(base, next, out);
+  if (out.timing_compared) {
+    std::string differ;
+    for (const auto& d : out.differences)
+      for (const char* k : {"cpu", "cores", "compiler", "build_type", "dependencies", "benchmark_mode"})
+        if (d.what == k) differ += (differ.empty() ? "" : ", ") + d.what;
+    if (!differ.empty()) out.timing_note = fmt::format("the files differ in {}: the ratios measure that too", differ);
+  }
+  for (const auto& bp : base.problems) {
+    const study_problem* np = next.find(bp.name);
+    if (!np) {
+      out.removed.push_back({bp.name, "", "problem", plural(bp.methods.size(), "method", "methods")});
+      continue;
+    }
+    problem_differences(bp, *np, out);
+    const problem_pair pp{bp, *np, opts};
+    for (const auto check : problem_checks) check(pp, out);
+  }
+  for (const auto& np : next.problems)
+    if (!base.find(np.name))
+      out.added.push_back({np.name, "", "problem", plural(np.methods.size(), "method", "methods")});
+  summarize_timing(out);
+  return out;
+}
+
+std::string summary_line(const comparison& c) {
+  std::string s = fmt::format(
+      "{}, {}, {} added, {} removed{}", plural(c.count(change_kind::regression), "regression", "regressions"),
+      plural(c.count(change_kind::improvement), "improvement", "improvements"), c.added.size(), c.removed.size(),
+      c.removed.empty()         ? ""
+      : c.options.allow_removed ? " (allowed)"
+                                : " (regressions)");
+  if (c.timing_compared)
+    s += fmt::format("; timing: {} of {} rows slower, {} faster{}", c.slower(), c.timing.size(), c.faster(),
+                     c.options.gate_timing ? " (gating)" : " (informs)");
+  else
+    s += fmt::format("; timing not compared ({})", c.timing_note);
+  return s;
+}
+
+std::string format_text(const comparison& c) {
+  std::string out = fmt::format("stepbench compare\n  BASE {}\n       {}\n  NEW  {}\n       {}\n", c.base_path,
+                                file_line(c.base_meta, c.base_timed), c.new_path, file_line(c.new_meta, c.new_timed));
+  out += fmt::format("\nResult: {} (exit {}): {}\n", verdict(c), c.exit_status(), summary_line(c));
+  out += c.differences.empty()
+             ? "\nThe files agree in machine, build and settings.\n"
+             : "\nThe files differ in (results may differ for these reasons):\n" + text_table(differences_table(c));
+  out += "\nThresholds:\n";
+  for (const auto& line : describe_thresholds(c.options)) out += wrap(line, "  - ", "    ");
+  const auto section = [&](const std::string& title, std::size_t n, const table& t, const std::string& note = "") {
+    out += n == 0 ? fmt::format("\n{}: none\n", title) : fmt::format("\n{} ({}){}:\n", title, n, note);
+    if (n) out += text_table(t);
+  };
+  section("Regressions", c.count(change_kind::regression), changes_table(c, change_kind::regression));
+  section("Improvements", c.count(change_kind::improvement), changes_table(c, change_kind::improvement));
+  section("Added, only in NEW", c.added.size(), presence_table(c.added));
+  section("Removed, only in BASE", c.removed.size(), presence_table(c.removed),
+          c.options.allow_removed ? ", allowed by --allow-removed" : ", regressions: --allow-removed to accept");
+  if (!c.timing_compared) {
+    out += fmt::format("\nTiming: not compared ({})\n", c.timing_note);
+    return out;
+  }
+  out += wrap(timing_heading(c), "\nTiming: ", "  ");
+  if (c.slower() + c.faster() > 0) out += text_table(timing_flagged_table(c));
+  if (!c.timing_summaries.empty()) {
+    out += "\nTiming per method (geometric mean of new/old over its rows timed in both, every problem):\n";
+    out += text_table(timing_summary_table(c));
+  }
+  return out;
+}
+
+std::string format_markdown(const comparison& c) {
+  std::string out = fmt::format("## stepbench compare: {}\n\n", verdict(c));
+  out += fmt::format("**{}** (exit {})\n\n", summary_line(c), c.exit_status());
+  out += md_table({{"", "file", "build"},
+                   {{"BASE", "`" + c.base_path + "`", file_line(c.base_meta, c.base_timed)},
+                    {"NEW", "`" + c.new_path + "`", file_line(c.new_meta, c.new_timed)}}});
+  if (c.differences.empty())
+    out += "\nThe files agree in machine, build and settings.\n";
+  else
+    out += "\n### The files differ in\n\n" + md_table(differences_table(c));
+  const auto section = [&](const std::string& title, std::size_t n, const table& t, const std::string& note = "") {
+    out += n == 0 ? fmt::format("\n### {}: none\n", title) : fmt::format("\n### {} ({}){}\n\n", title, n, note);
+    if (n) out += md_table(t);
+  };
+  section("Regressions", c.count(change_kind::regression), changes_table(c, change_kind::regression));
+  section("Improvements", c.count(change_kind::improvement), changes_table(c, change_kind::improvement));
+  section("Added, only in NEW", c.added.size(), presence_table(c.added));
+  section("Removed, only in BASE", c.removed.size(), presence_table(c.removed),
+          c.options.allow_removed ? ", allowed by `--allow-removed`" : ", regressions: `--allow-removed` to accept");
+  if (!c.timing_compared) {
+    out += fmt::format("\n### Timing\n\nNot compared ({}).\n", c.timing_note);
+  } else {
+    out += fmt::format("\n### Timing\n\n{}\n\n", timing_heading(c));
+    if (c.slower() + c.faster() > 0) out += md_table(timing_flagged_table(c));
+    if (!c.timing_summaries.empty())
+      out +=
+          "\n<details><summary>Timing per method (geometric mean of new/old over its rows timed in both, every "
+          "problem)</summary>\n\n" +
+          md_table(timing_summary_table(c)) + "\n</details>\n";
+  }
+  out += "\n<details><summary>Thresholds</summary>\n\n";
+  for (const auto& line : describe_thresholds(c.options)) out += "- " + line + "\n";
+  out += "\n</details>\n";
+  return out;
+}
+
+}  // namespace stepbench

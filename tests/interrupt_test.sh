@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# Runs that never lose anything: a real run interrupted by SIGINT or SIGTERM leaves the
+# previous results file (and report folder) byte-identical, and no temporary file behind.
+# Each command is first timed whole, then interrupted at fractions of that time, so that
+# some interruptions land during the long work and some near the end: during the write
+# of the study file, or the swap of the report folder into place.
+set -u
+set -m  # job control: background jobs keep SIGINT's default action (bash ignores it otherwise)
+stepbench=${1:?usage: interrupt_test.sh path/to/stepbench path/to/stepbench_bench path/to/scripts/report}
+bench=${2:?}
+report=${3:?}
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fails=0 passes=0
+ok() { passes=$((passes + 1)); }
+bad() { echo "FAIL: $*"; fails=$((fails + 1)); }
+
+snapshot() { (cd "$work" && find . -type f -not -name err -print0 | sort -z | xargs -0 sha256sum); }
+
+# interrupt SIGNAL DELAY_S CMD...: starts CMD, sends SIGNAL after DELAY_S; when the run was
+# interrupted, the folder must be exactly as before (a run that finished first is not a test).
+interrupted=0
+interrupt() {
+  local sig=$1 delay=$2; shift 2
+  local before; before=$(snapshot)
+  "$@" >/dev/null 2>"$work/err" &
+  local pid=$!
+  sleep "$delay"
+  kill -s "$sig" "$pid" 2>/dev/null
+  wait "$pid" 2>/dev/null
+  local rc=$?
+  [ "$rc" -eq 0 ] && return  # finished before the signal
+  interrupted=$((interrupted + 1))
+  [ "$before" = "$(snapshot)" ] && ok ||
+    bad "$* interrupted by SIG$sig at ${delay}s (exit $rc) changed the folder: $(diff <(echo "$before") <(snapshot) | head -4)"
+}
+
+# duration CMD...: the seconds CMD takes, run to completion into a scratch target.
+duration() {
+  local t0 t1; t0=$(date +%s.%N); "$@" >/dev/null 2>&1; t1=$(date +%s.%N)
+  awk -v a="$t0" -v b="$t1" 'BEGIN { print b - a }'
+}
+
+# Interrupts at 10 % .. 99 % of the command's own duration, with both signals.
+interrupt_throughout() {
+  local scratch=$1; shift
+  local total; total=$(duration "${@//__TARGET__/$scratch}")
+  for frac in 0.1 0.5 0.8 0.9 0.95 0.97 0.99; do
+    for sig in INT TERM; do
+      interrupt "$sig" "$(awk -v t="$total" -v f="$frac" 'BEGIN { print t * f }')" "$@"
+    done
+  done
+}
+
+echo "previous results" >"$work/study.h5"
+interrupt_throughout "$work/scratch.h5" "$stepbench" sweep --quick --quiet --out __TARGET__
+interrupt_throughout "$work/scratch.h5" "$bench" --quick --benchmark_filter=pendulum --study_out=__TARGET__
+rm -f "$work/scratch.h5"
+[ "$(cat "$work/study.h5")" = "previous results" ] && ok || bad "the previous study file was touched"
+
+# The report: a previous report folder survives an interrupted run whole.
+"$stepbench" sweep --quick --quiet --out "$work/good.h5" 2>/dev/null || bad "quick sweep for the report failed"
+/usr/bin/python3 "$report" "$work/good.h5" --out "$work/report" >/dev/null 2>&1 || bad "report failed"
+interrupt_throughout "$work/scratch_report" /usr/bin/python3 "$report" "$work/good.h5" --out __TARGET__
+rm -rf "$work/scratch_report"
+[ -f "$work/report/REPORT.md" ] && ok || bad "the previous report folder is gone"
+[ "$interrupted" -ge 20 ] && ok || bad "only $interrupted runs were interrupted before they finished"
+
+echo "interrupt: $passes passed, $fails failed ($interrupted runs interrupted)"
+[ "$fails" -eq 0 ]

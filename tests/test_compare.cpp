@@ -1,0 +1,439 @@
+// `stepbench compare`: the decisions (what regresses, what improves, what is noise) on
+// small studies written to temporary files and changed one figure at a time, either in
+// the file (a field of one `runs` row rewritten with the HDF5 API) or in the study before
+// it is written.
+#include <gtest/gtest.h>
+
+#include <H5Cpp.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <fmt/format.h>
+
+#include "study/compare.hpp"
+#include "study/study_file.hpp"
+#include "study/study_reader.hpp"
+#include "study/sweep.hpp"
+
+using namespace stepbench;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A few methods on one or two problems, 5 levels: milliseconds.
+study small_study(std::vector<std::string> problems = {"damped_spring"},
+                  std::vector<std::string> methods = {"rk4", "euler", "velocity_verlet", "gsl_rk4", "rk45"},
+                  int levels = 5) {
+  sweep_options o;
+  o.problems = std::move(problems);
+  o.methods = std::move(methods);
+  o.levels = levels;
+  o.tolerances = tolerance_ladder(true);
+  return run_sweep(o);
+}
+
+method_study& method(study& s, const std::string& problem, const std::string& name) {
+  for (auto& ps : s.problems)
+    if (ps.problem->name() == problem)
+      for (auto& ms : ps.methods)
+        if (ms.info.name == name) return ms;
+  throw std::runtime_error("no " + problem + "/" + name + " in the test study");
+}
+
+// Made-up timings on every row: median `ns`, spread +-`spread` relative, `reps` repetitions.
+void set_timings(study& s, double ns, double spread, long reps) {
+  s.timed = timing_settings{"full", 0.01, static_cast<int>(reps), 0.5, 2, 1000.0, 0, 1.0};
+  for (auto& ps : s.problems)
+    for (auto& ms : ps.methods)
+      for (auto& r : ms.rows)
+        if (!r.metrics.diverged && !r.metrics.failed) r.time = {ns, ns * (1 - spread), ns * (1 + spread), reps, false};
+}
+
+class compare_test : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / fmt::format("stepbench_compare_{}_{}", ::getpid(),
+                                                   ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  std::string write(const study& s, const std::string& name) const {
+    write_study(s, path(name));
+    return path(name);
+  }
+  // Writes both studies and compares the files as the command does.
+  comparison compare(const study& base, const study& next, const compare_options& o = {}) const {
+    return compare_studies(read_study(write(base, "base.h5")), read_study(write(next, "new.h5")), o);
+  }
+
+ private:
+  fs::path dir_;
+};
+
+// Rewrites one field of one row of /problems/<problem>/methods/<method>/runs in place,
+// through a compound type holding only that field (HDF5 partial I/O).
+void set_run_field(const std::string& file, const std::string& problem, const std::string& method_name,
+                   const std::string& field, std::size_t row, double value) {
+  H5::H5File f(file, H5F_ACC_RDWR);
+  H5::DataSet ds = f.openDataSet("/problems/" + problem + "/methods/" + method_name + "/runs");
+  H5::CompType one(sizeof(double));
+  one.insertMember(field, 0, H5::PredType::NATIVE_DOUBLE);
+  std::vector<double> v(static_cast<std::size_t>(ds.getSpace().getSimpleExtentNpoints()));
+  ds.read(v.data(), one);
+  v.at(row) = value;
+  ds.write(v.data(), one);
+}
+
+void set_root_long(const std::string& file, const std::string& name, long value) {
+  H5::H5File f(file, H5F_ACC_RDWR);
+  f.removeAttr(name);
+  H5::Attribute a = f.createAttribute(name, H5::PredType::NATIVE_LONG, H5::DataSpace());
+  a.write(H5::PredType::NATIVE_LONG, &value);
+}
+
+std::vector<change> found(const comparison& c, change_kind k, const std::string& what) {
+  std::vector<change> out;
+  for (const auto& x : c.changes)
+    if (x.kind == k && x.what == what) out.push_back(x);
+  return out;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------
+// The decision functions.
+
+TEST(compare_decisions, error_growth_beyond_the_factor_above_the_floor) {
+  const double floor = 1e-12;
+  EXPECT_EQ(judge_error(1e-6, 1e-4, floor, 2.0), change_kind::regression);
+  EXPECT_EQ(judge_error(1e-6, 2.1e-6, floor, 2.0), change_kind::regression);
+  EXPECT_EQ(judge_error(1e-6, 1.9e-6, floor, 2.0), std::nullopt);  // within the factor
+  EXPECT_EQ(judge_error(1e-6, 1e-8, floor, 2.0), change_kind::improvement);
+  EXPECT_EQ(judge_error(1e-6, 6e-7, floor, 2.0), std::nullopt);
+  // Round-off: growth (or shrinkage) below the floor is neither.
+  EXPECT_EQ(judge_error(1e-16, 9e-13, floor, 2.0), std::nullopt);
+  EXPECT_EQ(judge_error(9e-13, 1e-16, floor, 2.0), std::nullopt);
+  EXPECT_EQ(judge_error(0.0, 1e-13, floor, 2.0), std::nullopt);
+  EXPECT_EQ(judge_error(0.0, 1e-11, floor, 2.0), change_kind::regression);  // from exact to above the floor
+  // A non-finite error where there was a number.
+  EXPECT_EQ(judge_error(1e-6, std::nan(""), floor, 2.0), change_kind::regression);
+  EXPECT_EQ(judge_error(std::nan(""), std::nan(""), floor, 2.0), std::nullopt);
+}
+
+TEST(compare_decisions, order_and_agreement) {
+  EXPECT_EQ(judge_order(4.0, 3.85, 0.1), change_kind::regression);
+  EXPECT_EQ(judge_order(4.0, 3.95, 0.1), std::nullopt);
+  EXPECT_EQ(judge_order(2.0, 2.2, 0.1), change_kind::improvement);
+  EXPECT_EQ(judge_order(std::nan(""), 2.0, 0.1), std::nullopt);
+  EXPECT_EQ(judge_agreement(1e-12, 1e-10, 2.0), change_kind::regression);
+  EXPECT_EQ(judge_agreement(1e-15, 9e-14, 2.0), std::nullopt);         // below the 1e-13 floor
+  EXPECT_EQ(judge_agreement(std::nan(""), 1e-10, 2.0), std::nullopt);  // not compared before
+}
+
+TEST(compare_decisions, timing_threshold_from_the_repetitions) {
+  const timing_side tight{1000, 990, 1010, 5}, loose{1000, 900, 1100, 5}, single{1000, 1000, 1000, 1};
+  EXPECT_DOUBLE_EQ(timing_threshold(tight, tight), 0.15);    // the floor (3 x 2 % is below it)
+  EXPECT_DOUBLE_EQ(timing_threshold(tight, loose), 0.6);     // 3 x the larger spread, 20 %
+  EXPECT_DOUBLE_EQ(timing_threshold(single, single), 0.25);  // no spread: the fallback
+  EXPECT_DOUBLE_EQ(timing_threshold(single, loose), 0.6);    // the other side's spread still counts
+  EXPECT_TRUE(std::isnan(single.spread()));
+  EXPECT_DOUBLE_EQ(timing_threshold({1000, 900, 1080, 3}, tight), 0.54);  // spread 18 %
+  EXPECT_EQ(judge_timing(2.0, 0.6), 1);
+  EXPECT_EQ(judge_timing(1.5, 0.6), 0);
+  EXPECT_EQ(judge_timing(0.5, 0.6), -1);
+  EXPECT_EQ(judge_timing(0.7, 0.6), 0);
+}
+
+// ---------------------------------------------------------------------------------------
+// Whole files.
+
+TEST_F(compare_test, identical_files_compare_clean) {
+  const study s = small_study({"damped_spring", "pendulum"});
+  const std::string base = write(s, "base.h5"), again = write(s, "again.h5");
+  for (const auto& next : {base, again}) {
+    const comparison c = compare_studies(read_study(base), read_study(next));
+    EXPECT_EQ(c.exit_status(), 0);
+    EXPECT_TRUE(c.changes.empty()) << format_text(c);
+    EXPECT_TRUE(c.added.empty());
+    EXPECT_TRUE(c.removed.empty());
+    EXPECT_TRUE(c.differences.empty()) << format_text(c);
+    EXPECT_FALSE(c.timing_compared);
+    EXPECT_EQ(c.timing_note, "neither file is timed");
+  }
+  // Two runs of the same sweep are the same numbers: accuracy is deterministic.
+  const comparison c =
+      compare_studies(read_study(base), read_study(write(small_study({"damped_spring", "pendulum"}), "rerun.h5")));
+  EXPECT_EQ(c.exit_status(), 0) << format_text(c);
+  EXPECT_TRUE(c.changes.empty()) << format_text(c);
+}
+
+TEST_F(compare_test, grown_error_in_one_row_is_a_regression_naming_the_row) {
+  study s = small_study();
+  const std::string base = write(s, "base.h5"), next = path("new.h5");
+  fs::copy_file(base, next);
+  const auto& rk4 = method(s, "damped_spring", "rk4");
+  const std::size_t row = 2;
+  set_run_field(next, "damped_spring", "rk4", "err_pos_max", row, 100 * rk4.rows[row].metrics.err_pos_max);
+  const comparison c = compare_studies(read_study(base), read_study(next));
+  EXPECT_EQ(c.exit_status(), 1);
+  ASSERT_EQ(c.count(change_kind::regression), 1u) << format_text(c);
+  const change& r = c.changes.front();
+  EXPECT_EQ(r.problem, "damped_spring");
+  EXPECT_EQ(r.method, "rk4");
+  EXPECT_EQ(r.param_name, "dt");
+  EXPECT_EQ(r.param, rk4.rows[row].param);
+  EXPECT_EQ(r.what, "err_pos_max");
+  EXPECT_NEAR(r.ratio, 100.0, 1e-9);
+  // Every form names the row.
+  const std::string dt = format_param(method_kind::fixed_step, rk4.rows[row].param);
+  for (const auto& text : {format_text(c), format_markdown(c)}) {
+    EXPECT_NE(text.find("REGRESSION"), std::string::npos);
+    EXPECT_NE(text.find(dt), std::string::npos) << text;
+    EXPECT_NE(text.find("err_pos_max"), std::string::npos);
+  }
+  // The reverse is an improvement, not a regression.
+  const comparison back = compare_studies(read_study(next), read_study(base));
+  EXPECT_EQ(back.exit_status(), 0);
+  EXPECT_EQ(found(back, change_kind::improvement, "err_pos_max").size(), 1u);
+  // A factor of 100 passes with --error-factor 1000.
+  compare_options lax;
+  lax.error_factor = 1000;
+  EXPECT_EQ(compare_studies(read_study(base), read_study(next), lax).exit_status(), 0);
+}
+
+TEST_F(compare_test, newly_diverged_and_failed_rows) {
+  study base = small_study(), next = small_study();
+  auto& row = method(next, "damped_spring", "euler").rows.back();
+  ASSERT_FALSE(method(base, "damped_spring", "euler").rows.back().metrics.diverged);
+  row.metrics = run_metrics{};
+  row.metrics.err_pos_max = row.metrics.err_pos_final = row.metrics.err_vel_final = row.metrics.err_pos_rms =
+      std::nan("");
+  row.metrics.diverged = true;
+  row.metrics.note = "non-finite state at t = 3.2 s";
+  method(next, "damped_spring", "velocity_verlet").rows[1].metrics.failed = true;
+  const comparison c = compare(base, next);
+  EXPECT_EQ(c.exit_status(), 1);
+  const auto d = found(c, change_kind::regression, "diverged");
+  ASSERT_EQ(d.size(), 1u) << format_text(c);
+  EXPECT_EQ(d[0].method, "euler");
+  EXPECT_EQ(d[0].param, row.param);
+  EXPECT_EQ(d[0].note, "non-finite state at t = 3.2 s");
+  EXPECT_TRUE(std::isnan(d[0].ratio));
+  EXPECT_EQ(found(c, change_kind::regression, "failed").size(), 1u);
+  // The errors of a row that diverged are not judged (they are NaN).
+  EXPECT_TRUE(found(c, change_kind::regression, "err_pos_max").empty()) << format_text(c);
+  // Back again: rows that no longer diverge or fail are improvements.
+  const comparison back = compare(next, base);
+  EXPECT_EQ(back.exit_status(), 0);
+  EXPECT_EQ(found(back, change_kind::improvement, "diverged").size(), 1u);
+  EXPECT_EQ(found(back, change_kind::improvement, "failed").size(), 1u);
+}
+
+// A row skipped over the work budget has no result: newly skipped regresses, and its
+// errors are not judged. (Compared only where both files have the field.)
+TEST_F(compare_test, newly_skipped_row) {
+  const std::string file = write(small_study({"damped_spring"}, {"rk4"}), "base.h5");
+  study_data a = read_study(file), b = read_study(file);
+  auto& ma = a.problems[0].methods[0];
+  auto& mb = b.problems[0].methods[0];
+  ma.columns["skipped"].assign(ma.rows(), 0.0);
+  mb.columns["skipped"].assign(mb.rows(), 0.0);
+  mb.columns["skipped"].back() = 1;
+  mb.columns["err_pos_max"].back() = std::nan("");
+  const comparison c = compare_studies(a, b);
+  ASSERT_EQ(c.count(change_kind::regression), 1u) << format_text(c);
+  EXPECT_EQ(c.changes[0].what, "skipped");
+  EXPECT_EQ(c.changes[0].param, ma.col("param").back());
+  mb.columns.erase("skipped");  // one file without the field: not compared
+  EXPECT_EQ(compare_studies(a, b).count(change_kind::regression), 1u);  // the NaN error of a row that completed
+}
+
+TEST_F(compare_test, order_drop_and_lost_fit) {
+  study base = small_study(), next = small_study();
+  ASSERT_EQ(method(base, "damped_spring", "rk4").fit.state, fit_result::status::fitted);
+  method(next, "damped_spring", "rk4").fit.order -= 0.3;
+  method(next, "damped_spring", "euler").fit.order += 0.05;  // within --order-drop
+  auto& vv = method(next, "damped_spring", "velocity_verlet").fit;
+  vv.state = fit_result::status::insufficient;
+  vv.order = std::nan("");
+  const comparison c = compare(base, next);
+  EXPECT_EQ(c.exit_status(), 1);
+  const auto o = found(c, change_kind::regression, "observed order");
+  ASSERT_EQ(o.size(), 1u) << format_text(c);
+  EXPECT_EQ(o[0].method, "rk4");
+  EXPECT_TRUE(o[0].param_name.empty());
+  const auto lost = found(c, change_kind::regression, "order fit");
+  ASSERT_EQ(lost.size(), 1u);
+  EXPECT_EQ(lost[0].method, "velocity_verlet");
+  EXPECT_EQ(std::get<std::string>(lost[0].new_value), "insufficient");
+  compare_options lax;
+  lax.order_drop = 0.5;
+  EXPECT_EQ(found(compare(base, next, lax), change_kind::regression, "observed order").size(), 0u);
+}
+
+TEST_F(compare_test, removed_method_regresses_unless_allowed_and_added_is_listed) {
+  const study base = small_study({"damped_spring"}, {"rk4", "euler", "gsl_rk4"});
+  const study next = small_study({"damped_spring"}, {"rk4", "euler", "midpoint"});
+  const comparison c = compare(base, next);
+  ASSERT_EQ(c.removed.size(), 1u);
+  EXPECT_EQ(c.removed[0].method, "gsl_rk4");
+  EXPECT_EQ(c.removed[0].what, "method");
+  ASSERT_EQ(c.added.size(), 1u);
+  EXPECT_EQ(c.added[0].method, "midpoint");
+  EXPECT_EQ(c.count(change_kind::regression), 0u);
+  EXPECT_EQ(c.exit_status(), 1);  // the removal
+  compare_options allow;
+  allow.allow_removed = true;
+  EXPECT_EQ(compare(base, next, allow).exit_status(), 0);
+  // Only added: never a regression.
+  EXPECT_EQ(compare(small_study({"damped_spring"}, {"rk4"}), small_study({"damped_spring"}, {"rk4", "midpoint"}))
+                .exit_status(),
+            0);
+  // A problem only in BASE is removed, only in NEW added.
+  const comparison p =
+      compare(small_study({"damped_spring", "pendulum"}, {"rk4"}), small_study({"damped_spring"}, {"rk4"}));
+  ASSERT_EQ(p.removed.size(), 1u);
+  EXPECT_EQ(p.removed[0].problem, "pendulum");
+  EXPECT_EQ(p.removed[0].what, "problem");
+}
+
+TEST_F(compare_test, changed_ladder_is_reported_and_common_rows_compared) {
+  const study five = small_study({"damped_spring"}, {"rk4"}, 5), six = small_study({"damped_spring"}, {"rk4"}, 6);
+  const comparison finer = compare(five, six);
+  ASSERT_EQ(finer.added.size(), 1u);
+  EXPECT_EQ(finer.added[0].what, "ladder");
+  EXPECT_NE(finer.added[0].detail.find("1 of 6 rows only in NEW"), std::string::npos) << finer.added[0].detail;
+  EXPECT_NE(finer.added[0].detail.find("5 compared"), std::string::npos);
+  EXPECT_EQ(finer.exit_status(), 0) << format_text(finer);
+  EXPECT_FALSE(finer.differences.empty());  // levels 5 -> 6 is reported at the top
+  const comparison coarser = compare(six, five);
+  ASSERT_EQ(coarser.removed.size(), 1u);
+  EXPECT_EQ(coarser.removed[0].what, "ladder");
+  EXPECT_EQ(coarser.exit_status(), 1);
+}
+
+TEST_F(compare_test, references_and_truth) {
+  study base = small_study({"damped_spring"}, {"rk4"}), next = small_study({"damped_spring"}, {"rk4"});
+  auto& refs = next.problems[0].truth.references;
+  ASSERT_GE(refs.size(), 2u);
+  refs[0].status = "disagrees";
+  refs[0].reason = "made up";
+  refs[1].vs.pos_rel = std::max(refs[1].vs.pos_rel * 100, 1e-10);
+  next.problems[0].truth.source = refs[1].source;
+  const comparison c = compare(base, next);
+  EXPECT_EQ(c.exit_status(), 1);
+  const auto status = found(c, change_kind::regression, "reference " + refs[0].source + " status");
+  ASSERT_EQ(status.size(), 1u) << format_text(c);
+  EXPECT_EQ(std::get<std::string>(status[0].new_value), "disagrees");
+  EXPECT_EQ(status[0].note, "made up");
+  EXPECT_EQ(found(c, change_kind::regression, "reference " + refs[1].source + " err_pos_rel").size(), 1u);
+  EXPECT_EQ(found(c, change_kind::regression, "truth_source").size(), 1u);
+}
+
+TEST_F(compare_test, timing_informs_and_gates_only_when_asked) {
+  // 3 repetitions, +-2 % spread: threshold max(15 %, 3 x 4 %) = 15 %.
+  study base = small_study({"damped_spring"}, {"rk4", "euler"}),
+        next = small_study({"damped_spring"}, {"rk4", "euler"});
+  set_timings(base, 1000, 0.02, 3);
+  set_timings(next, 1000, 0.02, 3);
+  for (auto& r : method(next, "damped_spring", "rk4").rows) r.time = {2000, 1960, 2040, 3, false};  // 2x slower
+  method(next, "damped_spring", "euler").rows[0].time = {1120, 1098, 1142, 3, false};  // 12 %: within the noise
+  const comparison c = compare(base, next);
+  ASSERT_TRUE(c.timing_compared);
+  EXPECT_EQ(c.slower(), method(next, "damped_spring", "rk4").rows.size()) << format_text(c);
+  EXPECT_EQ(c.faster(), 0u);
+  EXPECT_EQ(c.exit_status(), 0);  // timing informs
+  for (const auto& t : c.timing) {
+    EXPECT_NEAR(t.threshold, 0.15, 1e-12);
+    EXPECT_EQ(t.flag, t.method == "rk4" ? 1 : 0) << t.method << " " << t.param;
+  }
+  const auto rk4 = std::find_if(c.timing_summaries.begin(), c.timing_summaries.end(),
+                                [](const timing_summary& s) { return s.method == "rk4"; });
+  ASSERT_NE(rk4, c.timing_summaries.end());
+  EXPECT_NEAR(rk4->geomean, 2.0, 1e-9);
+  compare_options gate;
+  gate.gate_timing = true;
+  EXPECT_EQ(compare(base, next, gate).exit_status(), 1);
+  EXPECT_NE(format_text(c).find("slower"), std::string::npos);
+
+  // The same 2x within a wide spread (+-40 % each side: threshold 240 %) is not flagged.
+  set_timings(base, 1000, 0.4, 3);
+  set_timings(next, 1000, 0.4, 3);
+  for (auto& r : method(next, "damped_spring", "rk4").rows) r.time = {2000, 1200, 2800, 3, false};
+  const comparison wide = compare(base, next, gate);
+  EXPECT_EQ(wide.slower(), 0u);
+  EXPECT_EQ(wide.exit_status(), 0);
+
+  // A single repetition: no spread, the 25 % fallback, said in the output.
+  set_timings(base, 1000, 0.0, 1);
+  set_timings(next, 1200, 0.0, 1);
+  const comparison single = compare(base, next);
+  EXPECT_EQ(single.slower(), 0u);
+  for (const auto& t : single.timing) EXPECT_DOUBLE_EQ(t.threshold, 0.25);
+  EXPECT_NE(format_text(single).find("single repetition"), std::string::npos);
+
+  // One side untimed: said, nothing compared.
+  const comparison half = compare(base, small_study({"damped_spring"}, {"rk4", "euler"}));
+  EXPECT_FALSE(half.timing_compared);
+  EXPECT_EQ(half.timing_note, "NEW is not timed");
+}
+
+TEST_F(compare_test, files_that_cannot_be_compared) {
+  const std::string base = write(small_study({"damped_spring"}, {"rk4"}), "base.h5");
+  // Truncated: half the bytes.
+  const std::string cut = path("cut.h5");
+  {
+    std::ifstream in(base, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::ofstream(cut, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size() / 2));
+  }
+  for (const auto& bad : {cut, path("missing.h5")}) {
+    try {
+      read_study(bad);
+      ADD_FAILURE() << bad << " was read";
+    } catch (const std::runtime_error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("'" + bad + "'"), std::string::npos) << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+  }
+  // A format this build does not read.
+  const std::string v3 = path("v3.h5");
+  fs::copy_file(base, v3);
+  set_root_long(v3, "format_version", study_format_version + 1);
+  EXPECT_THROW(read_study(v3), std::runtime_error);
+  // Two files of different format versions (both readable by some build).
+  study_data a = read_study(base), b = read_study(base);
+  b.format_version = a.format_version + 1;
+  try {
+    compare_studies(a, b);
+    ADD_FAILURE() << "different format versions compared";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("format_version"), std::string::npos) << e.what();
+  }
+  compare_options bad;
+  bad.error_factor = 0.5;
+  EXPECT_THROW(compare_studies(a, a, bad), std::invalid_argument);
+}
+
+TEST_F(compare_test, machine_and_build_differences_are_reported) {
+  const std::string base = write(small_study({"damped_spring"}, {"rk4"}), "base.h5");
+  study_data a = read_study(base), b = read_study(base);
+  b.meta["cpu"] = "Another CPU";
+  b.meta["git_commit"] = "0123456789ab";
+  b.settings["cores"] = a.settings.at("cores") + 2;
+  b.problems[0].params["k_s"] = 20;
+  const comparison c = compare_studies(a, b);
+  std::vector<std::string> what;
+  for (const auto& d : c.differences) what.push_back(d.what);
+  EXPECT_EQ(what, (std::vector<std::string>{"cpu", "cores", "git_commit", "damped_spring: k_s"}));
+  EXPECT_EQ(c.exit_status(), 0);
+  const std::string md = format_markdown(c);
+  EXPECT_NE(md.find("| cpu |"), std::string::npos) << md;
+  EXPECT_NE(md.find("Another CPU"), std::string::npos);
+}

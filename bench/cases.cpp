@@ -1,11 +1,10 @@
 #include "bench/cases.hpp"
 
 #include <benchmark/benchmark.h>
+#include <fmt/format.h>
 
 #include <chrono>
 #include <stdexcept>
-
-#include <fmt/format.h>
 
 #include "core/statistics.hpp"
 
@@ -18,36 +17,42 @@ void case_book::add(const problem_study& ps, const method_info& info, method_row
   c->name = std::move(name);
   c->family = std::move(family);
   c->row = &row;
-  if (!by_name_.emplace(c->name, c.get()).second) throw std::logic_error("two benchmark cases would share the name " + c->name);
+  if (!by_name_.emplace(c->name, c.get()).second)
+    throw std::logic_error("two benchmark cases would share the name " + c->name);
   const std::function<double()> run = ps.problem->timed_run(info.name, row.param, ps.horizon, ps.truth.times);
   timed_case* tc = c.get();
   const auto& m = row.metrics;
   const long steps = row.steps;
   const work_counters work = row.work;
   const long rejected = row.rejected_steps;
-  benchmark::RegisterBenchmark(c->name.c_str(), [this, tc, run, m, steps, work, rejected](benchmark::State& state) {
-    if (over_budget(*tc)) {
-      state.SkipWithError("cut: the previous case of this family used over half the per-case time budget");
-      return;
-    }
-    const auto start = std::chrono::steady_clock::now();
-    for (auto _ : state) benchmark::DoNotOptimize(run());
-    const double ns = std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - start).count() /
-                      static_cast<double>(std::max<benchmark::IterationCount>(1, state.iterations()));
-    record(*tc, ns);
-    state.counters["err_pos_final"] = m.err_pos_final;
-    state.counters["err_pos_max"] = m.err_pos_max;
-    state.counters["steps"] = static_cast<double>(steps);
-    state.counters["force_evals"] = static_cast<double>(work.force_evals);
-    if (rejected) state.counters["rejected_steps"] = static_cast<double>(rejected);
-    if (work.newton_iterations) state.counters["newton_iterations"] = static_cast<double>(work.newton_iterations);
-    if (work.jacobian_evals) state.counters["jacobian_evals"] = static_cast<double>(work.jacobian_evals);
-    // Wall time per step (the case uses real time): Google Benchmark divides the elapsed
-    // time by steps x iterations (an inverted iteration-invariant rate) and prints it in
-    // seconds with an SI prefix (13.8n = 13.8 ns).
-    state.counters["time_per_step"] = benchmark::Counter(
-        static_cast<double>(std::max(1L, steps)), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
-  })->Unit(benchmark::kMicrosecond)->UseRealTime();
+  benchmark::RegisterBenchmark(
+      c->name.c_str(),
+      [this, tc, run, m, steps, work, rejected](benchmark::State& state) {
+        if (over_budget(*tc)) {
+          state.SkipWithError("cut: the previous case of this family used over half the per-case time budget");
+          return;
+        }
+        const auto start = std::chrono::steady_clock::now();
+        for (auto _ : state) benchmark::DoNotOptimize(run());
+        const double ns = std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - start).count() /
+                          static_cast<double>(std::max<benchmark::IterationCount>(1, state.iterations()));
+        record(*tc, ns);
+        state.counters["err_pos_final"] = m.err_pos_final;
+        state.counters["err_pos_max"] = m.err_pos_max;
+        state.counters["steps"] = static_cast<double>(steps);
+        state.counters["force_evals"] = static_cast<double>(work.force_evals);
+        if (rejected) state.counters["rejected_steps"] = static_cast<double>(rejected);
+        if (work.newton_iterations) state.counters["newton_iterations"] = static_cast<double>(work.newton_iterations);
+        if (work.jacobian_evals) state.counters["jacobian_evals"] = static_cast<double>(work.jacobian_evals);
+        // Wall time per step (the case uses real time): Google Benchmark divides the elapsed
+        // time by steps x iterations (an inverted iteration-invariant rate) and prints it in
+        // seconds with an SI prefix (13.8n = 13.8 ns).
+        state.counters["time_per_step"] =
+            benchmark::Counter(static_cast<double>(std::max(1L, steps)),
+                               benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+      })
+      ->Unit(benchmark::kMicrosecond)
+      ->UseRealTime();
   cases_.push_back(std::move(c));
 }
 

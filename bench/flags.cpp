@@ -1,9 +1,9 @@
 #include "bench/flags.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <stdexcept>
-
-#include <fmt/format.h>
 
 #include "core/parse.hpp"
 

@@ -6,12 +6,11 @@
 // --benchmark_format; progress and the summary go to stderr. The performance ratios
 // and equal-error tables come from the study file: `stepbench ratios`.
 #include <benchmark/benchmark.h>
+#include <fmt/format.h>
 
 #include <chrono>
 #include <cstdio>
 #include <stdexcept>
-
-#include <fmt/format.h>
 
 #include "bench/cases.hpp"
 #include "bench/flags.hpp"
@@ -70,9 +69,10 @@ int main(int argc, char** argv) {
     s.timed = ts;
     if (!opts.study_out.empty()) {
       write_study(s, opts.study_out);
-      fmt::print(stderr, "stepbench_bench: wrote {} ({} mode, {} cases timed) in {:.1f} s; `stepbench ratios --study {}` "
-                 "prints the performance ratios\n", opts.study_out, ts.mode, book.timed_count(), ts.wall_seconds,
-                 opts.study_out);
+      fmt::print(stderr,
+                 "stepbench_bench: wrote {} ({} mode, {} cases timed) in {:.1f} s; `stepbench ratios --study {}` "
+                 "prints the performance ratios\n",
+                 opts.study_out, ts.mode, book.timed_count(), ts.wall_seconds, opts.study_out);
     } else {
       fmt::print(stderr, "stepbench_bench: timed {} cases in {:.1f} s ({} mode)\n", book.timed_count(), ts.wall_seconds,
                  ts.mode);

@@ -1,13 +1,12 @@
 #include "bench/scaling.hpp"
 
 #include <benchmark/benchmark.h>
+#include <fmt/format.h>
 
 #include <chrono>
 #include <memory>
 #include <string>
 #include <vector>
-
-#include <fmt/format.h>
 
 #include "study/registry.hpp"
 

@@ -1,13 +1,14 @@
 // `stepbench advise`: the cheapest method and its dt (or tolerance) for an error, from a
 // study file (study/advise.hpp).
-#include <iostream>
+#include "study/advise.hpp"
 
 #include <fmt/format.h>
+
+#include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
 #include "core/parse.hpp"
-#include "study/advise.hpp"
 
 namespace stepbench::cli {
 namespace {
@@ -46,7 +47,7 @@ int run_advise(const advise_args& args) {
     return code;
   }
   const auto answer = a.result.answer(a.methods);
-  json out = {{"problem", a.problem}, {"metric", a.metric}, {"tol", a.tol},  {"unit", a.unit},
+  json out = {{"problem", a.problem},  {"metric", a.metric}, {"tol", a.tol},  {"unit", a.unit},
               {"cost", a.result.cost}, {"timings", a.timed}, {"met", a.met()}};
   out["choice"] = answer ? pick_json(a, *answer) : json(nullptr);
   out["runners_up"] = json::array();
@@ -64,11 +65,12 @@ int run_advise(const advise_args& args) {
 
 command add_advise(CLI::App& app) {
   auto a = std::make_shared<advise_args>();
-  auto* sub = app.add_subcommand("advise",
-                                 "the cheapest stable method and its dt (or tolerance) for an error, from a study file");
+  auto* sub = app.add_subcommand(
+      "advise", "the cheapest stable method and its dt (or tolerance) for an error, from a study file");
   sub->add_option("--problem", a->problem, "problem name (one in the study file)")->required();
   sub->add_option("--tol", a->tol_text, "largest acceptable error, in the problem's units (> 0)")->required();
-  sub->add_option("--metric", a->metric, "err_pos_max, err_pos_final, err_pos_rms or err_vel_final")->capture_default_str();
+  sub->add_option("--metric", a->metric, "err_pos_max, err_pos_final, err_pos_rms or err_vel_final")
+      ->capture_default_str();
   sub->add_option("--study", a->study, "study file to read")->capture_default_str();
   sub->add_flag("--json", a->json, "print JSON");
   sub->footer("exit codes: 0 answer, 1 study file unreadable, 2 bad usage, 3 no method meets the tolerance\n");

@@ -2,10 +2,10 @@
 // The subcommands of `stepbench`, one file each. Each adds its options to the app and
 // returns the function that runs it; main() dispatches and turns exceptions into one
 // line and an exit code (2 bad usage: std::invalid_argument; 1 anything else).
+#include <CLI/CLI.hpp>
 #include <functional>
 #include <stdexcept>
-
-#include <CLI/CLI.hpp>
+#include <string>
 
 namespace stepbench::cli {
 
@@ -21,5 +21,12 @@ command add_advise(CLI::App& app);
 command add_ratios(CLI::App& app);
 command add_compare(CLI::App& app);
 command add_stability(CLI::App& app);
+command add_loop(CLI::App& app);
+command add_energy(CLI::App& app);
+
+// Turns `[problem.]param=name` into `[problem.]param=<value>` where the parameter takes
+// that name (a material pair: core/concepts.hpp's named_value), so every command's --set
+// accepts names; anything else is returned unchanged for the command to judge.
+std::string resolve_named_value(std::string assignment);
 
 }  // namespace stepbench::cli

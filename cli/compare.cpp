@@ -2,16 +2,17 @@
 // (study/compare.hpp). Exit 0 nothing regressed, 1 a regression, 2 could not compare:
 // this command maps every error, including an unreadable file, to 2 itself, so CI can
 // tell a regression from a broken job.
-#include <cmath>
-#include <iostream>
+#include "study/compare.hpp"
 
 #include <fmt/format.h>
+
+#include <cmath>
+#include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
 #include "core/parse.hpp"
 #include "core/work_precision.hpp"
-#include "study/compare.hpp"
 
 namespace stepbench::cli {
 namespace {

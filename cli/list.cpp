@@ -1,8 +1,8 @@
 // `stepbench list [--json]`: the problems with their parameters, and every method (ours,
 // the peers, the baseline) with its order and capabilities.
-#include <iostream>
-
 #include <fmt/format.h>
+
+#include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
@@ -65,7 +65,7 @@ int run_list(bool as_json) {
                  q["unit"].get<std::string>(), q["description"].get<std::string>());
   }
   for (const auto origin : {method_origin::ours, method_origin::peer, method_origin::baseline}) {
-    fmt::print("{}:\n", origin == method_origin::ours ? "integrators (ours)"
+    fmt::print("{}:\n", origin == method_origin::ours   ? "integrators (ours)"
                         : origin == method_origin::peer ? "peers"
                                                         : "baseline (for scale, never recommended)");
     for (const auto& m : all_methods()) {

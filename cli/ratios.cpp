@@ -1,15 +1,22 @@
 // `stepbench ratios [--study FILE] [--json]`: the performance figures the README quotes,
 // read from a timed study file (each figure from one run):
 //   - step cost: our rk4 against the hand-written baseline, GSL's rk4 and Boost.Odeint's,
-//     in ns per step at the finest dt where all of them were timed, on damped_spring;
+//     in ns per step at the finest dt where all of them were timed, on damped_spring; and
+//     our rk8 against its hand-written baseline and the eighth-order library steps (GSL's
+//     rk8pd, Odeint's runge_kutta_fehlberg78, ARKODE's default order-8 table) at fixed
+//     dt, on damped_spring and pendulum;
+//   - ns per right-hand-side call of the library solvers on the same problem (ARKODE and
+//     CVODE against GSL: the price of a library's own code per call);
 //   - equal error: on each problem, the time to reach each target error (err_pos_max)
 //     for the cheapest of ours and the cheapest peer, by the study's one rule
-//     (core/work_precision.hpp), and their ratio;
+//     (core/work_precision.hpp), their ratio, and the target (ours at most 0.5 x
+//     the best peer; 1.0 or worse is open);
 //   - the peers whose declared order does not hold.
+#include <fmt/format.h>
+
+#include <algorithm>
 #include <cmath>
 #include <iostream>
-
-#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
@@ -23,7 +30,7 @@ using json = nlohmann::json;
 
 struct ratios_args {
   std::string study = "results/study.h5";
-  std::vector<std::string> problems{"damped_spring", "pendulum"};
+  std::vector<std::string> problems{"damped_spring", "pendulum", "kepler"};
   std::vector<double> targets{1e-6, 1e-8, 1e-10, 1e-12};
   bool json = false;
 };
@@ -36,7 +43,10 @@ json step_costs(const study_problem& p, const std::vector<std::string>& names) {
   if (ms.empty() || !ms.front()->columns.count("time_ns")) return nullptr;
   const auto& ladder = ms.front()->col("param");
   for (std::size_t k = ladder.size(); k-- > 0;) {
-    json row = {{"problem", p.name}, {"dt", ladder[k]}, {"ns_per_step", json::object()}, {"force_evals_per_step", json::object()}};
+    json row = {{"problem", p.name},
+                {"dt", ladder[k]},
+                {"ns_per_step", json::object()},
+                {"force_evals_per_step", json::object()}};
     bool all = true;
     for (const auto* m : ms) {
       const auto& param = m->col("param");
@@ -54,6 +64,32 @@ json step_costs(const study_problem& p, const std::vector<std::string>& names) {
   return nullptr;
 }
 
+// ns per right-hand-side call of each named method: the median over its timed rows of
+// time / force evaluations (one figure per method, robust to the rows' spread).
+json ns_per_call(const study_problem& p, const std::vector<std::string>& names) {
+  json out = json::object();
+  for (const auto& n : names) {
+    const auto* m = p.find(n);
+    if (!m || !m->columns.count("time_ns")) continue;
+    std::vector<double> v;
+    const auto &t = m->col("time_ns"), &f = m->col("force_evals");
+    for (std::size_t i = 0; i < t.size(); ++i)
+      if (std::isfinite(t[i]) && f[i] > 0) v.push_back(t[i] / f[i]);
+    if (v.empty()) continue;
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    out[n] = {{"ns_per_call", v[v.size() / 2]}, {"rows", v.size()}, {"library", m->library}};
+  }
+  return out;
+}
+
+// The target for a ratio of ours over the best peer.
+std::string verdict(double ours_over_peer) {
+  if (!std::isfinite(ours_over_peer)) return "-";
+  if (ours_over_peer <= 0.5) return "met";
+  if (ours_over_peer < 1.0) return "ahead, short of 0.5";
+  return "OPEN";
+}
+
 // Cheapest of ours and cheapest peer at a target, among the methods that were timed.
 json equal_error(const study_problem& p, double target, const std::string& metric) {
   std::vector<wp_method> methods;
@@ -68,8 +104,11 @@ json equal_error(const study_problem& p, double target, const std::string& metri
   for (const auto& pick : r.ranked) {
     const auto& m = methods[pick.method];
     const auto& row = m.rows[pick.row];
-    out["ranked"].push_back({{"method", m.name}, {"origin", to_string(m.origin)}, {"param", row.param},
-                             {"time_ns", row.time_ns}, {"error", row.error}});
+    out["ranked"].push_back({{"method", m.name},
+                             {"origin", to_string(m.origin)},
+                             {"param", row.param},
+                             {"time_ns", row.time_ns},
+                             {"error", row.error}});
     if (m.origin == method_origin::ours && !ours) ours = &pick;
     if (m.origin == method_origin::peer && !peer) peer = &pick;
   }
@@ -79,6 +118,8 @@ json equal_error(const study_problem& p, double target, const std::string& metri
   out["ours"] = named(ours);
   out["peer"] = named(peer);
   out["peer_over_ours"] = ours && peer && r.cost == "time_ns" ? json(peer->cost / ours->cost) : json(nullptr);
+  out["ours_over_peer"] = ours && peer && r.cost == "time_ns" ? json(ours->cost / peer->cost) : json(nullptr);
+  out["target_0_5"] = verdict(out["ours_over_peer"].is_null() ? NAN : out["ours_over_peer"].get<double>());
   return out;
 }
 
@@ -88,6 +129,21 @@ int run_ratios(const ratios_args& a) {
   json out = {{"study", a.study}, {"cpu", s.meta.count("cpu") ? s.meta.at("cpu") : ""}};
   if (const auto* spring = s.find("damped_spring"))
     out["step_cost"] = step_costs(*spring, {"rk4", "baseline_rk4", "gsl_rk4", "odeint_rk4"});
+  out["step_cost_rk8"] = json::array();
+  out["ns_per_rhs_call"] = json::array();
+  for (const auto& name : a.problems)
+    if (const auto* p = s.find(name)) {
+      // The eighth-order fixed steps at the finest dt where all were timed: ours, the
+      // hand-written floor, and the libraries' (Odeint's only where Boost is present).
+      std::vector<std::string> names{"rk8", "baseline_rk8", "gsl_rk8pd", "arkode_erk8"};
+      if (p->find("odeint_rkf78")) names.push_back("odeint_rkf78");
+      if (auto sc = step_costs(*p, names); !sc.is_null()) out["step_cost_rk8"].push_back(sc);
+      out["ns_per_rhs_call"].push_back(
+          {{"problem", p->name},
+           {"methods", ns_per_call(*p, {"gsl_rk8pd_adaptive", "gsl_rkf45_adaptive", "arkode_erk8_adaptive",
+                                        "arkode_erk5_adaptive", "cvode_adams", "cvode_bdf", "gsl_rk8pd", "arkode_erk8",
+                                        "odeint_rkf78_adaptive", "odeint_bulirsch_stoer"})}});
+    }
   out["equal_error"] = json::array();
   for (const auto& name : a.problems)
     if (const auto* p = s.find(name))
@@ -97,50 +153,90 @@ int run_ratios(const ratios_args& a) {
   for (const auto& p : s.problems)
     for (const auto& m : p.methods)
       if (m.declared_order_holds == 0)
-        out["order_notes"].push_back({{"problem", p.name}, {"method", m.name}, {"declared", m.declared_order},
-                                      {"observed", m.fit_slope}});
+        out["order_notes"].push_back(
+            {{"problem", p.name}, {"method", m.name}, {"declared", m.declared_order}, {"observed", m.fit_slope}});
   if (a.json) {
     std::cout << out.dump(2) << "\n";
     return 0;
   }
 
-  fmt::print("Performance ratios from {} ({}; each figure measured in that one run)\n", a.study, out["cpu"].get<std::string>());
+  fmt::print("Performance ratios from {} ({}; each figure measured in that one run)\n", a.study,
+             out["cpu"].get<std::string>());
   if (const auto& sc = out["step_cost"]; !sc.is_null()) {
     const auto& ns = sc["ns_per_step"];
-    fmt::print("\nStep cost, {} at dt = {:.6g} s (ns per step):", sc["problem"].get<std::string>(), sc["dt"].get<double>());
+    fmt::print("\nStep cost, {} at dt = {:.6g} s (ns per step):", sc["problem"].get<std::string>(),
+               sc["dt"].get<double>());
     for (const auto& [k, v] : ns.items()) fmt::print("  {} {:.2f}", k, v.get<double>());
     fmt::print("\n");
     auto ratio = [&](const char* x, const char* y, const char* target, auto ok) {
       if (!ns.contains(x) || !ns.contains(y)) return;
       const double r = ns[x].get<double>() / ns[y].get<double>();
-      fmt::print("  {:<28} {:>6.2f}   target {} {}\n", fmt::format("{} / {}", x, y), r, target, ok(r) ? "met" : "NOT MET");
+      fmt::print("  {:<28} {:>6.2f}   target {} {}\n", fmt::format("{} / {}", x, y), r, target,
+                 ok(r) ? "met" : "NOT MET");
     };
     ratio("rk4", "baseline_rk4", "<= 1.15", [](double r) { return r <= 1.15; });
     ratio("gsl_rk4", "rk4", ">= 6", [](double r) { return r >= 6.0; });
     if (sc["force_evals_per_step"].contains("gsl_rk4"))
-      fmt::print("    (GSL's rk4 estimates its error by step doubling: {:.2f} force evaluations a step against our 4)\n",
-                 sc["force_evals_per_step"]["gsl_rk4"].get<double>());
+      fmt::print(
+          "    (GSL's rk4 estimates its error by step doubling: {:.2f} force evaluations a step against our 4)\n",
+          sc["force_evals_per_step"]["gsl_rk4"].get<double>());
     ratio("rk4", "odeint_rk4", "<= 0.85", [](double r) { return r <= 0.85; });
   } else {
     fmt::print("\nStep cost: rk4 and its peers on damped_spring were not all timed\n");
   }
+  for (const auto& sc : out["step_cost_rk8"]) {
+    const auto& ns = sc["ns_per_step"];
+    const auto& fe = sc["force_evals_per_step"];
+    fmt::print("\nStep cost, eighth order, {} at dt = {:.6g} s (ns per step; force evaluations a step):\n ",
+               sc["problem"].get<std::string>(), sc["dt"].get<double>());
+    for (const auto& [k, v] : ns.items()) fmt::print("  {} {:.1f} ({:.2f})", k, v.get<double>(), fe[k].get<double>());
+    fmt::print("\n");
+    auto ratio = [&](const char* x, const char* y, const char* target, auto ok) {
+      if (!ns.contains(x) || !ns.contains(y)) return;
+      const double r = ns[x].get<double>() / ns[y].get<double>();
+      fmt::print("  {:<28} {:>6.2f}{}\n", fmt::format("{} / {}", x, y), r,
+                 target ? fmt::format("   target {} {}", target, ok(r) ? "met" : "NOT MET") : std::string());
+    };
+    ratio("rk8", "baseline_rk8", "<= 1.15", [](double r) { return r <= 1.15; });
+    ratio("gsl_rk8pd", "rk8", nullptr, [](double) { return true; });
+    ratio("odeint_rkf78", "rk8", nullptr, [](double) { return true; });
+    ratio("arkode_erk8", "rk8", nullptr, [](double) { return true; });
+  }
+  if (!out["ns_per_rhs_call"].empty()) {
+    fmt::print("\nns per right-hand-side call (median over the timed rows of time / force evaluations):\n");
+    for (const auto& e : out["ns_per_rhs_call"]) {
+      fmt::print("  {:<15}", e["problem"].get<std::string>());
+      for (const auto& [k, v] : e["methods"].items()) fmt::print("  {} {:.1f}", k, v["ns_per_call"].get<double>());
+      fmt::print("\n");
+    }
+  }
   fmt::print("\nEqual error: time to reach err_pos_max (cheapest measured row that reaches it; the study's rule)\n");
-  fmt::print("  {:<15} {:>7}  {:<34} {:<34} {}\n", "problem", "target", "cheapest of ours", "cheapest peer", "peer / ours");
+  fmt::print("  {:<15} {:>7}  {:<34} {:<34} {:>11} {:>11}  {}\n", "problem", "target", "cheapest of ours",
+             "cheapest peer", "peer / ours", "ours / peer", "target <= 0.5");
   auto who = [](const json& j) {
-    return j.is_null() ? std::string("none reaches it")
-                       : fmt::format("{} {}", j["method"].get<std::string>(), format_time_ns(j["time_ns"].get<double>()));
+    return j.is_null()
+               ? std::string("none reaches it")
+               : fmt::format("{} {}", j["method"].get<std::string>(), format_time_ns(j["time_ns"].get<double>()));
   };
   for (const auto& e : out["equal_error"])
-    fmt::print("  {:<15} {:>7.0e}  {:<34} {:<34} {}\n", e["problem"].get<std::string>(), e["target"].get<double>(),
-               who(e["ours"]), who(e["peer"]),
-               e["peer_over_ours"].is_null() ? "-" : fmt::format("{:.2f}", e["peer_over_ours"].get<double>()));
+    fmt::print("  {:<15} {:>7.0e}  {:<34} {:<34} {:>11} {:>11}  {}\n", e["problem"].get<std::string>(),
+               e["target"].get<double>(), who(e["ours"]), who(e["peer"]),
+               e["peer_over_ours"].is_null() ? "-" : fmt::format("{:.2f}", e["peer_over_ours"].get<double>()),
+               e["ours_over_peer"].is_null() ? "-" : fmt::format("{:.2f}", e["ours_over_peer"].get<double>()),
+               e["target_0_5"].get<std::string>());
+  std::string open;
+  for (const auto& e : out["equal_error"])
+    if (e["target_0_5"] == "OPEN")
+      open += fmt::format("{}{} at {:.0e}", open.empty() ? "" : ", ", e["problem"].get<std::string>(),
+                          e["target"].get<double>());
+  fmt::print("  open (ours / peer >= 1.0): {}\n", open.empty() ? "none" : open);
   for (const auto& e : out["equal_error"]) {
     if (e["problem"] != "pendulum" || e["target"].get<double>() != 1e-6) continue;
     fmt::print("\n  pendulum, every method to err_pos_max = 1e-6:\n");
     for (const auto& r : e["ranked"])
-      fmt::print("    {:<24} {:>10}  {} {:g}{}\n", r["method"].get<std::string>(), format_time_ns(r["time_ns"].get<double>()),
-                 r["origin"] == "ours" ? "ours," : "", r["param"].get<double>(),
-                 r["origin"] == "baseline" ? "  (baseline, for scale)" : "");
+      fmt::print("    {:<24} {:>10}  {} {:g}{}\n", r["method"].get<std::string>(),
+                 format_time_ns(r["time_ns"].get<double>()), r["origin"] == "ours" ? "ours," : "",
+                 r["param"].get<double>(), r["origin"] == "baseline" ? "  (baseline, for scale)" : "");
   }
   if (const auto& f = out["equal_error_final"]; !f.is_null())
     fmt::print("\n  pendulum to err_pos_final = 1e-6 instead: cheapest of ours {}, cheapest peer {}\n", who(f["ours"]),

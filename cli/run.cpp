@@ -1,9 +1,9 @@
 // `stepbench run`: one problem, one method, one dt (or tolerance); prints the final state,
 // the true state, the errors and the work.
-#include <iostream>
-
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+
+#include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
@@ -33,13 +33,17 @@ int run_run(const run_args& a) {
   if (auto err = problem->validate(); !err.empty())
     throw std::invalid_argument(fmt::format("problem {}: {}", a.problem, err));
   const bool fixed = m.kind == method_kind::fixed_step;
-  if (fixed && a.dt_text.empty()) throw std::invalid_argument(fmt::format("{} is a fixed-step method: give --dt", m.name));
+  if (fixed && a.dt_text.empty())
+    throw std::invalid_argument(fmt::format("{} is a fixed-step method: give --dt", m.name));
   if (!fixed && a.tol_text.empty()) throw std::invalid_argument(fmt::format("{} is adaptive: give --tol", m.name));
-  if (fixed && !a.tol_text.empty()) throw std::invalid_argument(fmt::format("{} is a fixed-step method: --tol does not apply", m.name));
-  if (!fixed && !a.dt_text.empty()) throw std::invalid_argument(fmt::format("{} is adaptive: --dt does not apply", m.name));
+  if (fixed && !a.tol_text.empty())
+    throw std::invalid_argument(fmt::format("{} is a fixed-step method: --tol does not apply", m.name));
+  if (!fixed && !a.dt_text.empty())
+    throw std::invalid_argument(fmt::format("{} is adaptive: --dt does not apply", m.name));
   const double param = parse_number(fixed ? a.dt_text : a.tol_text, fixed ? "--dt" : "--tol");
   if (!(param > 0.0))
-    throw std::invalid_argument(fmt::format("{} must be > 0, got {}", fixed ? "--dt" : "--tol", fixed ? a.dt_text : a.tol_text));
+    throw std::invalid_argument(
+        fmt::format("{} must be > 0, got {}", fixed ? "--dt" : "--tol", fixed ? a.dt_text : a.tol_text));
   if (!fixed && !(param < 1.0)) throw std::invalid_argument(fmt::format("--tol must be < 1, got {}", a.tol_text));
   double horizon = problem->horizon();
   if (!a.horizon_text.empty()) {

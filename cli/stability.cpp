@@ -3,14 +3,15 @@
 // (a) from the amplification matrix of one step, (b) from long runs, and whether a method
 // is unstable for every dt or unconditionally stable. The study file carries the same
 // figures and the stability regions under /stability.
-#include <cmath>
-#include <iostream>
+#include "study/stability.hpp"
 
 #include <fmt/format.h>
+
+#include <cmath>
+#include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
-#include "study/stability.hpp"
 
 namespace stepbench::cli {
 namespace {
@@ -41,9 +42,10 @@ int run_stability(bool as_json) {
   fmt::print("  oscillator: x'' = -omega^2 x (F = -m omega^2 x), y = omega dt\n");
   fmt::print("  decay:      pure damper F = -m lambda v (v' = -lambda v; x integrates v), y = lambda dt\n");
   fmt::print("  theory (a):   root of rho(M(y)) - 1 - {:g}, M the amplification matrix of one step\n", s.rho_tol);
-  fmt::print("  measured (b): bisection on runs of {} steps, unstable when the largest |state| of the second half\n"
-             "                exceeds {:g} x that of the first half (or passes {:g} x the start)\n",
-             s.run_steps, s.envelope_growth, s.blowup_factor);
+  fmt::print(
+      "  measured (b): bisection on runs of {} steps, unstable when the largest |state| of the second half\n"
+      "                exceeds {:g} x that of the first half (or passes {:g} x the start)\n",
+      s.run_steps, s.envelope_growth, s.blowup_factor);
   fmt::print("  adaptive methods: the step they take when every attempt is accepted (tolerance {:g})\n\n",
              always_accept_tolerance);
   fmt::print("{:<20} {:<10} {:>12} {:>12} {:>10}  {}\n", "integrator", "test", "theory (a)", "measured (b)",

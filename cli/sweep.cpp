@@ -1,12 +1,13 @@
 // `stepbench sweep`: the accuracy study (every method on every problem over its ladder,
 // untimed) into an HDF5 study file.
+#include "study/sweep.hpp"
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include "cli/commands.hpp"
 #include "core/parse.hpp"
 #include "study/study_file.hpp"
-#include "study/sweep.hpp"
 
 namespace stepbench::cli {
 namespace {
@@ -73,9 +74,10 @@ command add_sweep(CLI::App& app) {
   sub->add_option("--out", a->out, "study file to write")->capture_default_str();
   sub->add_flag("--quick", a->quick, "8 levels and every other tolerance (the CI study)");
   sub->add_flag("--quiet", a->quiet, "print only the summary line");
-  sub->footer("exit codes: 0 written, every case completed (or diverged, or skipped over the work budget); 1 a file "
-              "error, or a problem without a trusted truth (the file is still written); 2 bad usage; 3 written, but some "
-              "case failed (each named on stderr)\n");
+  sub->footer(
+      "exit codes: 0 written, every case completed (or diverged, or skipped over the work budget); 1 a file "
+      "error, or a problem without a trusted truth (the file is still written); 2 bad usage; 3 written, but some "
+      "case failed (each named on stderr)\n");
   return {sub, [a] { return run_sweep_command(*a); }};
 }
 

@@ -8,13 +8,13 @@
 // may interpolate inside the step it took: dense output). What a method needs or offers
 // beyond that (a Jacobian, symplecticity, reuse of the last force) is declared in its
 // `capabilities`, which the registry and the study file report.
+#include <Eigen/Core>
 #include <array>
 #include <cmath>
 #include <concepts>
 #include <string>
 #include <string_view>
-
-#include <Eigen/Core>
+#include <vector>
 
 namespace stepbench {
 
@@ -58,10 +58,10 @@ concept problem = requires(const P& p, double t, const typename P::vec& x, typen
   { P::description } -> std::convertible_to<std::string_view>;
   { P::position_unit } -> std::convertible_to<std::string_view>;  // "m", or "rad" for an angle
   { P::force_depends_on_velocity } -> std::convertible_to<bool>;
-  { P::parameters() };
+  {P::parameters()};
   { p.dim() } -> std::convertible_to<int>;
   { p.mass() } -> std::convertible_to<double>;
-  { p.force(t, x, x, f) };
+  {p.force(t, x, x, f)};
   { p.initial() } -> std::same_as<phase<typename P::vec>>;
   { p.horizon() } -> std::convertible_to<double>;
   { p.validate() } -> std::convertible_to<std::string>;  // empty when the parameters are valid
@@ -77,23 +77,88 @@ concept has_energy = requires(const P& p, const typename P::vec& x) {
   { p.energy(x, x) } -> std::convertible_to<double>;
 };
 
+// What one pass of a problem's contact resolution did (resolve_contacts, below).
+struct contact_outcome {
+  int resolved = 0;      // contacts whose response was applied (approaching, penetrated or touching)
+  int tunnelled = 0;     // contacts found deeper than the problem's stated tunnelling depth
+  double depth = 0.0;    // the deepest penetration found, >= 0
+  bool changed = false;  // the state was changed (a response, or a body moved back to a surface)
+};
+
+// A problem with contacts (a ground plane, walls, other bodies): the drive loop, not the
+// integrator, handles them (core/drive.hpp). contact_gap is the smallest signed distance
+// of the contacts (< 0: penetrated); resolve_contacts applies the lecture's response
+// (digest section 5: move back to the surface, v_b = (1 - k_f) v_t - k_r v_n) to every
+// penetrated or touching contact that approaches, moves every penetrated body back to
+// its surface, and says what it did; locate_contacts chooses the mode: false
+// `end_of_step` (what games do: resolve after the step), true `locate` (find the contact
+// time inside the step, resolve there, finish the step).
+template <class P>
+concept has_contacts = requires(const P& p, double t, typename P::vec& x) {
+  { p.contact_gap(t, x, x) } -> std::convertible_to<double>;
+  { p.resolve_contacts(t, x, x) } -> std::same_as<contact_outcome>;
+  { p.locate_contacts() } -> std::convertible_to<bool>;
+};
+
+// A problem whose exact contacts are known (bouncing_ball: the bounce sequence;
+// bouncing_balls: the event-driven simulation): the contacts with t <= t_end. `positions`
+// (the state's position at each contact) may be empty when there are too many bodies for
+// contact-by-contact matching to mean anything; `count` is always the number of contacts.
+struct exact_contact_list {
+  long count = 0;
+  std::vector<double> times;
+  std::vector<std::vector<double>> positions;
+};
+template <class P>
+concept has_exact_contacts = requires(const P& p, double t) {
+  { p.exact_contacts(t) } -> std::same_as<exact_contact_list>;
+};
+
+// A problem with an angular momentum about a fixed point (kepler): recorded with its
+// error beside the energy's.
+template <class P>
+concept has_angular_momentum = requires(const P& p, const typename P::vec& x) {
+  { p.angular_momentum(x, x) } -> std::convertible_to<double>;
+};
+
+// A problem with a period (pendulum, kepler): the long-run energy study counts its
+// horizon in periods.
+template <class P>
+concept has_period = requires(const P& p) {
+  { p.period() } -> std::convertible_to<double>;
+};
+
+// A parameter that also takes a name (a material pair of the lecture's friction table):
+// `--set sliding_block.material=steel_on_steel` is the value of the entry named so. A
+// problem lists, per parameter, the names it understands with their values and a line
+// each (`stepbench list` prints them).
+struct named_value {
+  std::string name;
+  double value = 0.0;
+  std::string description;
+};
+template <class P>
+concept has_named_values = requires(std::string_view param) {
+  { P::named_values(param) } -> std::same_as<std::vector<named_value>>;
+};
+
 // A problem may give the force Jacobians dF/dx and dF/dv itself (in a matrix type of
 // its choosing: dense for a few coordinates, banded for a chain); otherwise the
 // implicit methods get forward differences, whose force evaluations are counted.
 template <class P>
 concept has_jacobian = requires(const P& p, double t, const typename P::vec& x, typename P::jacobian_matrix& j) {
-  { p.jacobian(t, x, x, j, j) };
+  {p.jacobian(t, x, x, j, j)};
   { p.make_jacobian() } -> std::same_as<typename P::jacobian_matrix>;  // zeroed, of the right shape
 };
 
 // What a method needs and offers, beyond advancing the state. Reported by `stepbench
 // list` and recorded in the study file.
 struct capabilities {
-  bool symplectic = false;          // preserves the symplectic form (bounded energy error on oscillators)
-  bool reuses_last_force = false;   // the last stage's force is the next step's first (FSAL)
-  bool needs_jacobian = false;      // solves with dF/dx, dF/dv (implicit methods)
-  bool error_estimate = false;      // estimates its local error (adaptive methods)
-  bool dense_output = false;        // interpolates inside its last step
+  bool symplectic = false;         // preserves the symplectic form (bounded energy error on oscillators)
+  bool reuses_last_force = false;  // the last stage's force is the next step's first (FSAL)
+  bool needs_jacobian = false;     // solves with dF/dx, dF/dv (implicit methods)
+  bool error_estimate = false;     // estimates its local error (adaptive methods)
+  bool dense_output = false;       // interpolates inside its last step
 };
 
 // The work an integrator reports beyond force evaluations (implicit and adaptive
@@ -136,14 +201,16 @@ inline void size_like(const Vec& like, Vec& first, More&... more) {
 // Odeint's steppers keep theirs, sized once by their resizer. A method without scratch
 // space has the step itself.
 template <class I, class Sys>
-concept has_stepper = requires { typename I::template stepper<Sys>; };
+concept has_stepper = requires {
+  typename I::template stepper<Sys>;
+};
 
 template <class I, class Sys>
 struct stepper_of {
   using type = I;
 };
 template <class I, class Sys>
-  requires has_stepper<I, Sys>
+requires has_stepper<I, Sys>
 struct stepper_of<I, Sys> {
   using type = typename I::template stepper<Sys>;
 };
@@ -165,7 +232,7 @@ concept integrator = requires(const I& i, const detail::probe_system& sys, step_
   { I::order } -> std::convertible_to<int>;
   { I::description } -> std::convertible_to<std::string_view>;
   { I::traits } -> std::convertible_to<capabilities>;
-  { stepper_t<I, detail::probe_system>(i).step(sys, 0.0, s, 0.1) };
+  {stepper_t<I, detail::probe_system>(i).step(sys, 0.0, s, 0.1)};
 };
 
 // The outcome of one attempt of an adaptive step.
@@ -180,26 +247,25 @@ struct step_attempt {
 // proposes the next dt. On rejection the state is unchanged. `initial_dt` proposes the
 // first step of a run.
 template <class I>
-concept adaptive_integrator =
-    requires(const I& i, const detail::probe_system& sys, step_state<detail::probe_system::vec>& s) {
-      { I::name } -> std::convertible_to<std::string_view>;
-      { I::order } -> std::convertible_to<int>;
-      { I::description } -> std::convertible_to<std::string_view>;
-      { I::traits } -> std::convertible_to<capabilities>;
-      { I(1e-6) };
-      { I::force_evals_per_step } -> std::convertible_to<int>;  // for the step budget
-      { stepper_t<I, detail::probe_system>(i).initial_dt(sys, 0.0, s, 1.0) } -> std::convertible_to<double>;
-      { stepper_t<I, detail::probe_system>(i).try_step(sys, 0.0, s, 0.1) } -> std::same_as<step_attempt>;
-    };
+concept adaptive_integrator = requires(const I& i, const detail::probe_system& sys,
+                                       step_state<detail::probe_system::vec>& s) {
+  { I::name } -> std::convertible_to<std::string_view>;
+  { I::order } -> std::convertible_to<int>;
+  { I::description } -> std::convertible_to<std::string_view>;
+  { I::traits } -> std::convertible_to<capabilities>;
+  {I(1e-6)};
+  { I::force_evals_per_step } -> std::convertible_to<int>;  // for the step budget
+  { stepper_t<I, detail::probe_system>(i).initial_dt(sys, 0.0, s, 1.0) } -> std::convertible_to<double>;
+  { stepper_t<I, detail::probe_system>(i).try_step(sys, 0.0, s, 0.1) } -> std::same_as<step_attempt>;
+};
 
 // An adaptive integrator that interpolates inside its last accepted step (Odeint's
 // "dense-output stepper"): the drive loop records the sample times from the
 // interpolant instead of shortening steps to land on them.
 template <class I>
-concept dense_output_integrator =
-    adaptive_integrator<I> && requires(const I& i, detail::probe_system::vec& x) {
-      { stepper_t<I, detail::probe_system>(i).interpolate(0.5, x, x) };
-    };
+concept dense_output_integrator = adaptive_integrator<I> && requires(const I& i, detail::probe_system::vec& x) {
+  {stepper_t<I, detail::probe_system>(i).interpolate(0.5, x, x)};
+};
 
 // 1 / m. The integrators work with the force and fold 1 / m into their step
 // coefficients (v += (h / m) F, the momentum form's own idea): one multiplication less

@@ -1,10 +1,10 @@
 #include "core/convergence_fit.hpp"
 
-#include "core/statistics.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
+
+#include "core/statistics.hpp"
 
 namespace stepbench {
 
@@ -37,8 +37,8 @@ fit_result fit_order(const fit_input& in) {
   for (int k = 0; k + 1 < n; ++k)
     if (in.error[k] > 0.0 && in.error[k + 1] > 0.0)
       local.push_back(std::log(in.error[k] / in.error[k + 1]) / std::log(in.dt[k] / in.dt[k + 1]));
-  const bool converging = !local.empty() && median(local) > 0.5 &&
-                          in.error[0] > 100.0 * roundoff_noise(in.steps[0], in.scale);
+  const bool converging =
+      !local.empty() && median(local) > 0.5 && in.error[0] > 100.0 * roundoff_noise(in.steps[0], in.scale);
   if (all_roundoff && !converging) {
     out.state = fit_result::status::exact;
     out.note = "error at round-off at every level: the method is exact for this problem";
@@ -46,17 +46,19 @@ fit_result fit_order(const fit_input& in) {
   }
 
   auto usable = [&](int k) {
-    return !in.diverged[k] && std::isfinite(in.error[k]) && in.error[k] > 100.0 * roundoff_noise(in.steps[k], in.scale) &&
-           in.error[k] < 0.1 * in.scale;
+    return !in.diverged[k] && std::isfinite(in.error[k]) &&
+           in.error[k] > 100.0 * roundoff_noise(in.steps[k], in.scale) && in.error[k] < 0.1 * in.scale;
   };
   auto slope = [&](int k) { return std::log(in.error[k] / in.error[k + 1]) / std::log(in.dt[k] / in.dt[k + 1]); };
   // The window grown coarser from the pair (end - 1, end) while each local slope stays
   // within 0.1 of the median so far. It starts at the finest usable pair; when that pair
   // is the odd one out (the first touch of round-off) and leaves fewer than three levels,
-  // the next coarser end is tried.
+  // the next coarser end is tried. A pair whose error does not fall (slope below 0.5) is
+  // an error floor, not an asymptotic range, however consistent its neighbours (an
+  // eighth-order method on the orbit: three levels of accumulated round-off at slope -0.6).
   int first = -1, last = -1;
   for (int end = n - 1; end >= 2 && first < 0; --end) {
-    if (!usable(end) || !usable(end - 1)) continue;
+    if (!usable(end) || !usable(end - 1) || !(slope(end - 1) >= 0.5)) continue;
     std::vector<double> slopes{slope(end - 1)};
     int start = end - 1;
     while (start > 0 && usable(start - 1) && std::abs(slope(start - 1) - median(slopes)) <= 0.1) {
@@ -66,8 +68,9 @@ fit_result fit_order(const fit_input& in) {
     if (end - start + 1 >= 3) first = start, last = end;
   }
   if (first < 0) {
-    out.note = "fewer than three consecutive levels in the asymptotic range (the rest diverged, are at round-off "
-               "or pre-asymptotic)";
+    out.note =
+        "fewer than three consecutive levels in the asymptotic range (the rest diverged, are at round-off "
+        "or pre-asymptotic)";
     return out;
   }
   // Least squares for log10 e = p log10 dt + c.

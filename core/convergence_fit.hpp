@@ -35,16 +35,19 @@ struct fit_result {
   status state = status::insufficient;
   double order = std::numeric_limits<double>::quiet_NaN();  // NaN unless fitted
   double intercept = 0.0;
-  double residual = 0.0;     // RMS of the log10 residuals
-  std::vector<int> levels;   // ladder indices used by the fit
-  std::string note;          // why, when not fitted
+  double residual = 0.0;    // RMS of the log10 residuals
+  std::vector<int> levels;  // ladder indices used by the fit
+  std::string note;         // why, when not fitted
 };
 
 inline const char* to_string(fit_result::status s) {
   switch (s) {
-    case fit_result::status::fitted: return "fitted";
-    case fit_result::status::exact: return "exact";
-    default: return "insufficient";
+    case fit_result::status::fitted:
+      return "fitted";
+    case fit_result::status::exact:
+      return "exact";
+    default:
+      return "insufficient";
   }
 }
 

@@ -1,8 +1,8 @@
 #include "core/drive.hpp"
 
-#include <stdexcept>
-
 #include <fmt/format.h>
+
+#include <stdexcept>
 
 namespace stepbench {
 
@@ -27,8 +27,8 @@ std::vector<record_point> plan_records(double horizon, double dt, std::span<cons
       p.on_grid = false;
     }
     if (!plan.empty() && p.step == plan.back().step && p.on_grid && plan.back().on_grid)
-      throw std::invalid_argument(fmt::format("record times {:g} and {:g} fall on the same step of dt {:g}",
-                                              plan.back().t, t, dt));
+      throw std::invalid_argument(
+          fmt::format("record times {:g} and {:g} fall on the same step of dt {:g}", plan.back().t, t, dt));
     plan.push_back(p);
   }
   return plan;

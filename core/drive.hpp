@@ -4,19 +4,21 @@
 // (problem, integrator); everything inside a loop inlines.
 //
 // Every loop runs the same named stages per step, as Box2D names its solver stages:
-//   advance     the integrator's step (or an adaptive attempt, repeated until accepted)
-//   after_step  the problem's hook, where a contact would be resolved; it clears the
-//               cached force when it changes the state
+//   advance     the integrator's step (or an adaptive attempt, repeated until accepted);
+//               in `locate` contact mode it also finds a contact inside the step, steps
+//               to it, resolves it and finishes the step
+//   after_step  the problem's hook: in `end_of_step` contact mode the contacts are
+//               resolved here; a changed state clears the cached force
 //   record      the state at a requested time: reached by the step (fixed grid), by
 //               shortening a step to land on it, or from the method's dense output
+// No integrator knows about contacts.
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <span>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "core/concepts.hpp"
 #include "core/system.hpp"
@@ -64,24 +66,53 @@ struct drive_result {
   long steps = 0;           // accepted steps taken
   long rejected_steps = 0;  // adaptive methods: attempts the error test rejected
   work_counters work{};
-  bool non_finite = false;  // a NaN or Inf appeared: the run stopped there
-  std::string failure;      // why the run stopped early (step size underflow, ...), else empty
+  bool non_finite = false;   // a NaN or Inf appeared: the run stopped there
+  std::string failure;       // why the run stopped early (step size underflow, ...), else empty
   bool over_budget = false;  // stopped by the step budget (with the reason in `failure`): skipped, not failed
   std::vector<double> sample_t;
   Eigen::MatrixXd samples;  // column j: [x; v] at sample_t[j]
   double t_final = 0.0;
   phase<Vec> final_state;
 
+  // Contacts (problems with contacts only; core/concepts.hpp's has_contacts).
+  static constexpr std::size_t recorded_contacts = 64;  // the first ones are recorded with their time
+  static constexpr int contact_position_dims = 4;       // ... and their position, up to this many coordinates
+  long contacts = 0;                                    // contacts resolved (responses applied)
+  long tunnelled = 0;                                   // contacts found deeper than the problem's tunnelling depth
+  double max_penetration = 0.0;                         // the deepest penetration found before a resolution
+  std::vector<double> contact_times;  // the first recorded_contacts: when resolved (end_of_step: the step's end)
+  Eigen::MatrixXd contact_x;          // column k: the position just after contact k (empty for larger states)
+
+  // Sizes everything a run records, once: no step allocates.
   void start(int dim, std::size_t count) {
+    contact_times.reserve(recorded_contacts);
+    if (dim <= contact_position_dims) contact_x.resize(dim, static_cast<Eigen::Index>(recorded_contacts));
     sample_t.reserve(count);
     samples.resize(2 * dim, static_cast<Eigen::Index>(count));
   }
+
+  // A resolution at t that left the position x: every contact it resolved is counted
+  // (several at once share the time).
+  template <class X>
+  void contact(double t, const contact_outcome& c, const Eigen::MatrixBase<X>& x) {
+    tunnelled += c.tunnelled;
+    max_penetration = std::max(max_penetration, c.depth);
+    for (int k = 0; k < c.resolved; ++k, ++contacts) {
+      if (contact_times.size() >= recorded_contacts) continue;
+      if (contact_x.size() > 0) contact_x.col(static_cast<Eigen::Index>(contact_times.size())) = x;
+      contact_times.push_back(t);
+    }
+  }
+
   template <class X, class V>
   void record(double t, const Eigen::MatrixBase<X>& x, const Eigen::MatrixBase<V>& v) {
     const auto j = static_cast<Eigen::Index>(sample_t.size());
     const auto d = x.size();
-    samples.col(j).head(d) = x;
-    samples.col(j).tail(d) = v;
+    // Coordinate by coordinate: GCC 12 misreads Eigen's packet copy from a Map of the
+    // second half of a peer's two-coordinate std::array state as reading past it
+    // (-Wstringop-overread); the copy is exact either way.
+    double* col = samples.col(j).data();
+    for (Eigen::Index i = 0; i < d; ++i) col[i] = x[i], col[d + i] = v[i];
     sample_t.push_back(t);
   }
 };
@@ -102,12 +133,100 @@ concept has_after_step = requires(const P& p, double t, typename P::vec& x) {
   { p.after_step(t, x, x) } -> std::convertible_to<bool>;
 };
 
-// Stage after_step: the problem's hook (contacts). A state it changes invalidates the
-// cached force.
+// Stage after_step: the problem's hook, and in end_of_step mode its contacts. A state
+// it changes invalidates the cached force. Returns what the contact resolution did.
 template <problem P, class Vec>
-inline void after_step(const P& problem, double t, step_state<Vec>& s) {
+inline contact_outcome after_step(const P& problem, double t, step_state<Vec>& s) {
   if constexpr (has_after_step<P>) {
     if (problem.after_step(t, s.x, s.v)) s.f_current = false;
+  }
+  if constexpr (has_contacts<P>) {
+    if (!problem.locate_contacts()) {
+      const contact_outcome c = problem.resolve_contacts(t, s.x, s.v);
+      if (c.changed) s.f_current = false;
+      return c;
+    }
+  }
+  return {};
+}
+
+// Resolves the contacts at t (locate mode, at the located time) and records them.
+template <problem P, class Vec>
+inline void resolve_here(const P& problem, double t, step_state<Vec>& s, drive_result<Vec>& out) {
+  if constexpr (has_contacts<P>) {
+    const contact_outcome c = problem.resolve_contacts(t, s.x, s.v);
+    if (c.changed) s.f_current = false;
+    out.contact(t, c, s.x);
+  }
+}
+
+// The Illinois variant of regula falsi (Dahlquist & Bjorck, Numerical Methods, sec.
+// 6.2.2) on a gap with g(lo) > 0 >= g(hi), to |hi - lo| <= tol. Returns the contact point
+// from the penetrated side (the response moves the body back to the surface): hi, or a
+// point where the gap is exactly zero. `last` is the last point evaluated, so a caller
+// whose state follows each evaluation knows whether it must evaluate the root again.
+template <class Gap>
+inline double illinois_contact(double lo, double hi, double g_lo, double g_hi, double tol, Gap&& gap, double& last) {
+  int side = 0;
+  last = hi;
+  for (int k = 0; k < 100 && hi - lo > tol; ++k) {
+    double x = lo + (hi - lo) * g_lo / (g_lo - g_hi);
+    if (!(x > lo && x < hi)) x = 0.5 * (lo + hi);
+    const double g = gap(x);
+    last = x;
+    if (g == 0.0) return x;
+    if (g > 0.0) {
+      lo = x, g_lo = g;
+      if (side == -1) g_hi *= 0.5;
+      side = -1;
+    } else {
+      hi = x, g_hi = g;
+      if (side == 1) g_lo *= 0.5;
+      side = 1;
+    }
+  }
+  return hi;
+}
+
+// Stage advance in locate mode: steps from t by h; when the step ends penetrated, the
+// contact time is found by the method's own step (re-stepping from the saved start
+// with the Illinois variant of regula falsi on the gap, to 1e-12 of h), the state is
+// stepped there, the contact resolved, and the rest of the step taken (which may meet
+// another contact). Every re-step's force evaluations are counted. A ball coming to
+// rest would meet contacts ever closer together (Zeno): after 64 contacts within one
+// step the rest of it is taken with end-of-step resolution.
+template <problem P, class Stepper, class Sys, class Vec>
+inline void advance_locating(const P& problem, Stepper& stepper, const Sys& sys, double t, step_state<Vec>& s, double h,
+                             step_state<Vec>& start, drive_result<Vec>& out) {
+  double done = 0.0;
+  for (int contacts = 0; done < h; ++contacts) {
+    const double t0 = t + done, rest = h - done;
+    start = s;
+    stepper.step(sys, t0, s, rest);
+    const double gap_end = problem.contact_gap(t0 + rest, s.x, s.v);
+    if (!(gap_end < 0.0)) return;
+    const double gap_start = problem.contact_gap(t0, start.x, start.v);
+    if (!(gap_start > 0.0) || contacts >= 64) {
+      // Already touching at the start (resting), or Zeno: resolve at the end of the step.
+      resolve_here(problem, t0 + rest, s, out);
+      return;
+    }
+    // The contact time: the root of g(tau) = the gap after a step of tau from the start.
+    double last = rest;
+    const double tau = illinois_contact(
+        0.0, rest, gap_start, gap_end, 1e-12 * h,
+        [&](double trial) {
+          s = start;
+          stepper.step(sys, t0, s, trial);
+          return problem.contact_gap(t0 + trial, s.x, s.v);
+        },
+        last);
+    if (last != tau) {
+      s = start;
+      stepper.step(sys, t0, s, tau);
+    }
+    resolve_here(problem, t0 + tau, s, out);
+    done += tau;
   }
 }
 
@@ -130,7 +249,7 @@ struct loop_end {
 };
 template <class Advance, class AfterStep, class Record>
 [[gnu::always_inline]] inline loop_end fixed_step_loop(double dt, double horizon, std::span<const record_point> plan,
-                                                   Advance&& advance, AfterStep&& after_step, Record&& record) {
+                                                       Advance&& advance, AfterStep&& after_step, Record&& record) {
   const long n = steps_for(horizon, dt);
   auto next = plan.begin();
   long i = 0;
@@ -179,9 +298,16 @@ template <problem P, integrator I>
   prepare_stepper(stepper, sys, s.x);
   drive_result<Vec> out;
   out.start(problem.dim(), plan.size());
+  step_state<Vec> start = s;  // the start of a step, for locating a contact inside it
   const loop_end end = fixed_step_loop(
-      dt, horizon, plan, [&](double t, double h) { stepper.step(sys, t, s, h); },
-      [&](double t) { stepbench::after_step(problem, t, s); },
+      dt, horizon, plan,
+      [&](double t, double h) {
+        if constexpr (has_contacts<P>) {
+          if (problem.locate_contacts()) return advance_locating(problem, stepper, sys, t, s, h, start, out);
+        }
+        stepper.step(sys, t, s, h);
+      },
+      [&](double t) { out.contact(t, stepbench::after_step(problem, t, s), s.x); },
       [&](double t) {
         if (!all_finite(s.x, s.v)) return out.non_finite = true, false;
         out.record(t, s.x, s.v);
@@ -249,9 +375,48 @@ template <problem P, adaptive_integrator I>
     }
     const double t_old = t;
     t = lands ? target : t + a.dt_taken;
+    const double t_step_end = t;  // the end of the step the dense output covers
     ++out.steps;
+    // locate: a contact inside the accepted step is found on the method's dense output
+    // (Illinois on the gap of the interpolated state); the state there is resolved and
+    // the rest of the step is discarded (the next attempt starts from the contact). A
+    // method without dense output resolves at the end of its step, as end_of_step does.
+    if constexpr (has_contacts<P>) {
+      if (problem.locate_contacts() && problem.contact_gap(t, s.x, s.v) < 0.0) {
+        if constexpr (dense) {
+          // The bracket: the first sample of the dense output (16 a step) where the gap turns
+          // from positive to not. A step that starts from a contact (gap 0, moving away) and
+          // ends past the next one has no sign change between its ends alone.
+          auto gap_at = [&](double theta) {
+            stepper.interpolate(theta, x_dense, v_dense);
+            return problem.contact_gap(t_old + theta * (t_step_end - t_old), x_dense, v_dense);
+          };
+          constexpr int samples = 16;
+          double lo = 0.0, hi = 1.0, g_lo = gap_at(0.0), g_hi = problem.contact_gap(t, s.x, s.v);
+          for (int j = 1; j <= samples; ++j) {
+            const double theta_j = static_cast<double>(j) / samples;
+            const double g = j == samples ? g_hi : gap_at(theta_j);
+            if (g_lo > 0.0 && !(g > 0.0)) {
+              hi = theta_j, g_hi = g;
+              break;
+            }
+            lo = theta_j, g_lo = g;
+          }
+          if (g_lo > 0.0) {
+            double last = hi;
+            const double theta = illinois_contact(lo, hi, g_lo, g_hi, 1e-12, gap_at, last);
+            if (last != theta) stepper.interpolate(theta, x_dense, v_dense);
+            t = t_old + theta * (t_step_end - t_old);
+            s.x = x_dense;
+            s.v = v_dense;
+            s.f_current = false;
+          }
+        }
+        resolve_here(problem, t, s, out);
+      }
+    }
     // after_step
-    after_step(problem, t, s);
+    out.contact(t, after_step(problem, t, s), s.x);
     if (!all_finite(s.x, s.v)) {
       out.non_finite = true;
       break;
@@ -262,7 +427,7 @@ template <problem P, adaptive_integrator I>
         if (*next == t) {
           out.record(t, s.x, s.v);
         } else {
-          stepper.interpolate((*next - t_old) / (t - t_old), x_dense, v_dense);
+          stepper.interpolate((*next - t_old) / (t_step_end - t_old), x_dense, v_dense);
           out.record(*next, x_dense, v_dense);
         }
       }

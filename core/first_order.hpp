@@ -2,13 +2,11 @@
 // y' = [v; F / m] for first-order solvers (the references, the first-order peers), with
 // the same arithmetic as the step loop: the force model times 1 / m computed once. It
 // keeps its own x, v, F workspace (sized once), so a call allocates nothing.
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
-
 #include <memory>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "core/band_matrix.hpp"
 #include "core/concepts.hpp"

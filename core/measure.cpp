@@ -1,10 +1,11 @@
 #include "core/measure.hpp"
 
+#include <fmt/format.h>
+
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
-
-#include <fmt/format.h>
 
 namespace stepbench {
 namespace {
@@ -45,14 +46,19 @@ void set_scales(const problem_instance& p, truth_table& t) {
     vs = std::max(vs, norm_part(y, dim, dim));
     if (p.has_energy()) es = std::max({es, std::abs(p.energy(y)), kinetic(p, y)});
   }
+  if (p.has_angular_momentum()) {
+    double ls = std::abs(p.angular_momentum(y0));
+    for (const auto& y : t.y) ls = std::max(ls, std::abs(p.angular_momentum(y)));
+    t.angmom_scale = ls > 0.0 ? ls : 1.0;
+  }
   t.pos_scale = xs > 0.0 ? xs : 1.0;
   t.vel_scale = vs > 0.0 ? vs : 1.0;
   t.energy_scale = es > 0.0 ? es : 1.0;
 }
 
 std::string disagreement(const agreement& a, double limit) {
-  return fmt::format("relative error {:.3e} (position) {:.3e} (velocity) exceeds the agreement limit {:.1e}",
-                     a.pos_rel, a.vel_rel, limit);
+  return fmt::format("relative error {:.3e} (position) {:.3e} (velocity) exceeds the agreement limit {:.1e}", a.pos_rel,
+                     a.vel_rel, limit);
 }
 
 }  // namespace
@@ -81,6 +87,12 @@ truth_table build_truth(const problem_instance& problem, std::span<const double>
     for (const char* source : reference_sources) {
       reference_check rc;
       rc.source = source;
+      if (sys.has_contacts() && !reference_handles_contacts(source)) {
+        rc.status = "unsupported";
+        rc.reason = "the problem has contacts, and this reference has no root finding to stop at them";
+        t.references.push_back(std::move(rc));
+        continue;
+      }
       try {
         rc.solution = solve_reference(source, sys, times, opts.tol);
       } catch (const std::runtime_error& e) {
@@ -100,14 +112,15 @@ truth_table build_truth(const problem_instance& problem, std::span<const double>
     for (std::size_t j = 0; j < t.y.size(); ++j)
       for (double value : t.y[j])
         if (!std::isfinite(value))
-          throw std::runtime_error(fmt::format(
-              "the closed form of problem {} is not finite at t = {:g}: are the parameters in range?", problem.name(),
-              t.times[j]));
+          throw std::runtime_error(
+              fmt::format("the closed form of problem {} is not finite at t = {:g}: are the parameters in range?",
+                          problem.name(), t.times[j]));
     set_scales(problem, t);
     for (auto* r : ok) {
       r->compared_with = t.source;
       r->vs = compare(r->solution.y, t.y, dim, t.pos_scale, t.vel_scale);
-      if (!(r->vs.worst() <= t.agreement_limit)) r->status = "disagrees", r->reason = disagreement(r->vs, t.agreement_limit);
+      if (!(r->vs.worst() <= t.agreement_limit))
+        r->status = "disagrees", r->reason = disagreement(r->vs, t.agreement_limit);
     }
   } else {
     // The best-agreeing pair, on scales from the first usable reference.
@@ -146,8 +159,15 @@ truth_table build_truth(const problem_instance& problem, std::span<const double>
       }
     }
   }
+  if (problem.has_exact_contacts() && !t.times.empty()) {
+    const exact_contact_list c = problem.exact_contacts(t.times.back());
+    t.contact_count = c.count;
+    t.contact_times = c.times;
+    t.contact_positions = c.positions;
+  }
   if (!std::isfinite(t.pos_scale) || !std::isfinite(t.vel_scale))
-    throw std::runtime_error(fmt::format("the motion of problem {} overflows: are the parameters in range?", problem.name()));
+    throw std::runtime_error(
+        fmt::format("the motion of problem {} overflows: are the parameters in range?", problem.name()));
   return t;
 }
 
@@ -156,8 +176,12 @@ run_metrics measure(const problem_instance& problem, const run_result& run, cons
   const int dim = problem.dim();
   auto all_nan = [&] {
     m.err_pos_final = m.err_vel_final = m.err_pos_max = m.err_pos_rms = m.energy_drift = m.energy_err_max = nan;
+    m.angmom_drift = m.angmom_err_max = m.contact_count_err = m.contact_time_err = m.contact_pos_err = nan;
     return m;
   };
+  m.contacts = run.contacts;
+  m.tunnelled = run.tunnelled;
+  m.max_penetration = run.max_penetration;
   if (run.skipped) {
     m.skipped = true;
     m.note = run.failure;
@@ -180,7 +204,7 @@ run_metrics measure(const problem_instance& problem, const run_result& run, cons
   }
   if (run.sample_t.size() != truth.times.size())
     throw std::logic_error("measure: the run's samples do not match the truth's times");
-  double sum_sq = 0.0, e_max = 0.0;
+  double sum_sq = 0.0, e_max = 0.0, l_max = 0.0;
   for (size_t j = 0; j < truth.times.size(); ++j) {
     if (std::abs(run.sample_t[j] - truth.times[j]) > 1e-12 * std::max(1.0, truth.times[j]))
       throw std::logic_error("measure: a sample time differs from the truth's");
@@ -189,6 +213,9 @@ run_metrics measure(const problem_instance& problem, const run_result& run, cons
     sum_sq += e * e;
     if (problem.has_energy())
       e_max = std::max(e_max, std::abs(problem.energy(run.sample_y[j]) - problem.energy(truth.y[j])));
+    if (problem.has_angular_momentum())
+      l_max =
+          std::max(l_max, std::abs(problem.angular_momentum(run.sample_y[j]) - problem.angular_momentum(truth.y[j])));
   }
   m.err_pos_rms = std::sqrt(sum_sq / static_cast<double>(truth.times.size()));
   const auto& y_final = run.final_y;
@@ -201,6 +228,25 @@ run_metrics measure(const problem_instance& problem, const run_result& run, cons
   } else {
     m.energy_drift = m.energy_err_max = nan;
   }
+  if (problem.has_angular_momentum()) {
+    m.angmom_drift = (problem.angular_momentum(y_final) - problem.angular_momentum(y_true)) / truth.angmom_scale;
+    m.angmom_err_max = l_max / truth.angmom_scale;
+  } else {
+    m.angmom_drift = m.angmom_err_max = nan;
+  }
+  // Contacts, matched in order: the k-th of the run against the k-th exact one. NaN where
+  // there is nothing to compare (no exact contacts, or none matched).
+  const bool exact_contacts = truth.contact_count >= 0;
+  m.contact_count_err = exact_contacts ? static_cast<double>(run.contacts - truth.contact_count) : nan;
+  const std::size_t matched = std::min(run.contact_times.size(), truth.contact_times.size());
+  const std::size_t matched_x = std::min({matched, run.contact_positions.size(), truth.contact_positions.size()});
+  m.contact_time_err = matched > 0 ? 0.0 : nan;
+  m.contact_pos_err = matched_x > 0 ? 0.0 : nan;
+  for (std::size_t k = 0; k < matched; ++k)
+    m.contact_time_err = std::max(m.contact_time_err, std::abs(run.contact_times[k] - truth.contact_times[k]));
+  for (std::size_t k = 0; k < matched_x; ++k)
+    m.contact_pos_err =
+        std::max(m.contact_pos_err, norm_diff(run.contact_positions[k], truth.contact_positions[k], 0, dim));
   if (!(m.err_pos_max <= blowup_factor * truth.pos_scale)) {
     m.diverged = true;
     m.note = fmt::format("position error {:.3g} exceeds {:g} times the amplitude", m.err_pos_max, blowup_factor);

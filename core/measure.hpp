@@ -45,7 +45,12 @@ struct truth_table {
   double pos_scale = 1.0;     // max |x| over the initial state and the samples
   double vel_scale = 1.0;     // max |v| likewise
   double energy_scale = 1.0;  // max of |E| and kinetic energy likewise (see measure.cpp)
+  double angmom_scale = 1.0;  // max |L| likewise (problems with an angular momentum)
   double agreement_limit = 0.0;
+  // The exact contacts up to the horizon (problems with exact contacts; count -1 without).
+  long contact_count = -1;
+  std::vector<double> contact_times;
+  std::vector<std::vector<double>> contact_positions;
 };
 
 struct truth_options {
@@ -67,14 +72,24 @@ agreement compare(std::span<const std::vector<double>> a, std::span<const std::v
 struct run_metrics {
   double err_pos_final = 0.0;  // |x_N - x(T)|, Euclidean, in the problem's position unit
   double err_vel_final = 0.0;
-  double err_pos_max = 0.0;    // max over the sample times
-  double err_pos_rms = 0.0;    // root mean square over the sample times
-  double energy_drift = 0.0;   // (E(y_N) - E(y(T))) / energy_scale, signed; NaN without energy
-  double energy_err_max = 0.0; // max over samples of |E(y_j) - E(y(t_j))| / energy_scale
-  bool diverged = false;       // blew up: non-finite, or beyond blowup_factor x the amplitude
-  bool failed = false;         // the method could not complete the run, or there is no trusted truth
-  bool skipped = false;        // not run to the end: over the work budget
-  std::string note;            // why diverged, failed or skipped
+  double err_pos_max = 0.0;     // max over the sample times
+  double err_pos_rms = 0.0;     // root mean square over the sample times
+  double energy_drift = 0.0;    // (E(y_N) - E(y(T))) / energy_scale, signed; NaN without energy
+  double energy_err_max = 0.0;  // max over samples of |E(y_j) - E(y(t_j))| / energy_scale
+  double angmom_drift = 0.0;    // (L(y_N) - L(y(T))) / angmom_scale, signed; NaN without angular momentum
+  double angmom_err_max = 0.0;  // max over samples of |L(y_j) - L(y(t_j))| / angmom_scale; NaN without
+  // Contacts (0 and NaN on a problem without them). Errors are matched contact by contact,
+  // the k-th of the run with the k-th exact one, over the first min(run's, exact, 64).
+  long contacts = 0;               // contacts the run resolved
+  double contact_count_err = 0.0;  // contacts - exact contacts up to the horizon (NaN: no exact contacts)
+  double contact_time_err = 0.0;   // max |t_k - t_k exact| [s]
+  double contact_pos_err = 0.0;    // max |x_k - x_k exact| (position just after contact k)
+  long tunnelled = 0;              // contacts found deeper than the problem's tunnelling depth
+  double max_penetration = 0.0;    // deepest penetration met before a resolution
+  bool diverged = false;           // blew up: non-finite, or beyond blowup_factor x the amplitude
+  bool failed = false;             // the method could not complete the run, or there is no trusted truth
+  bool skipped = false;            // not run to the end: over the work budget
+  std::string note;                // why diverged, failed or skipped
 };
 
 // Measures a run against the truth. The run's sample times must be the truth's

@@ -20,9 +20,12 @@ enum class method_kind { fixed_step, adaptive };
 
 inline std::string_view to_string(method_origin o) {
   switch (o) {
-    case method_origin::ours: return "ours";
-    case method_origin::peer: return "peer";
-    default: return "baseline";
+    case method_origin::ours:
+      return "ours";
+    case method_origin::peer:
+      return "peer";
+    default:
+      return "baseline";
   }
 }
 inline std::string_view to_string(method_kind k) { return k == method_kind::fixed_step ? "fixed_step" : "adaptive"; }
@@ -65,6 +68,12 @@ struct run_result {
   std::vector<double> sample_t;
   std::vector<std::vector<double>> sample_y;  // [x; v] at sample_t
   std::vector<double> final_y;                // [x; v] where the run stopped
+  // Contacts (a problem with contacts, run by a loop that resolves them: core/drive.hpp).
+  long contacts = 0;                                   // contacts resolved
+  long tunnelled = 0;                                  // contacts deeper than the problem's tunnelling depth
+  double max_penetration = 0.0;                        // the deepest penetration met before a resolution
+  std::vector<double> contact_times;                   // the first 64
+  std::vector<std::vector<double>> contact_positions;  // position just after each of those (small states only)
 };
 
 }  // namespace stepbench

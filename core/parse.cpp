@@ -1,10 +1,10 @@
 #include "core/parse.hpp"
 
+#include <fmt/format.h>
+
 #include <charconv>
 #include <cmath>
 #include <stdexcept>
-
-#include <fmt/format.h>
 
 namespace stepbench {
 

@@ -2,9 +2,9 @@
 // Strict parsing of command-line values: a number is the whole string or an error.
 #include <map>
 #include <string>
-#include <vector>
 #include <string_view>
 #include <utility>
+#include <vector>
 
 namespace stepbench {
 

@@ -15,6 +15,9 @@
 
 namespace stepbench {
 
+struct loop_config;  // core/game_loop.hpp
+struct loop_result;
+
 struct param_value {
   std::string name;
   std::string unit;
@@ -32,6 +35,11 @@ class problem_instance {
   virtual std::vector<param_value> params() const = 0;
   // Sets a parameter; throws std::invalid_argument naming an unknown parameter.
   virtual void set(std::string_view param, double value) = 0;
+  // Sets a parameter from text: a number, or a name the parameter understands (a
+  // material pair: named_values below); throws std::invalid_argument otherwise.
+  virtual void set_text(std::string_view param, std::string_view text) = 0;
+  // The names a parameter understands, with their values (empty for most).
+  virtual std::vector<named_value> named_values(std::string_view param) const = 0;
   virtual std::string validate() const = 0;  // "" when valid
   virtual double horizon() const = 0;
   virtual bool has_closed_form() const = 0;
@@ -42,6 +50,16 @@ class problem_instance {
   // Total energy of [x; v]; NaN when the problem defines none.
   virtual double energy(std::span<const double> y) const = 0;
   virtual std::vector<double> initial() const = 0;  // [x0; v0]
+  // Angular momentum of [x; v] about the problem's fixed point; NaN when it has none.
+  virtual bool has_angular_momentum() const = 0;
+  virtual double angular_momentum(std::span<const double> y) const = 0;
+  // The period of the motion (pendulum, kepler); NaN when it has none.
+  virtual double period() const = 0;
+  // Contacts: "none", "end_of_step" or "locate" (core/concepts.hpp's has_contacts).
+  virtual std::string_view contact_mode() const = 0;
+  // The exact contacts up to t_end; throws std::logic_error for a problem without them.
+  virtual bool has_exact_contacts() const = 0;
+  virtual exact_contact_list exact_contacts(double t_end) const = 0;
   // The first-order form y' = [v; F/m] for the reference solvers.
   virtual ode_system ode() const = 0;
 
@@ -56,6 +74,11 @@ class problem_instance {
   // the returned function, for timing. Returns a value of the final state to keep.
   virtual std::function<double()> timed_run(std::string_view method, double param, double horizon,
                                             std::span<const double> times, const run_limits& limits = {}) const = 0;
+  // The game loop `config` drives with our fixed-step integrator `method` (core/game_loop.hpp),
+  // simulated whole in code instantiated for the pair. Throws std::invalid_argument for
+  // a method that is not one of our fixed-step integrators, or a config that
+  // loop_config_error refuses.
+  virtual loop_result loop(std::string_view method, const loop_config& config) const = 0;
   virtual std::unique_ptr<problem_instance> clone() const = 0;
 };
 

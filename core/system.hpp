@@ -16,7 +16,7 @@ struct jacobian_type {
   using type = Eigen::Matrix<double, P::vec::RowsAtCompileTime, P::vec::RowsAtCompileTime>;
 };
 template <problem P>
-  requires has_jacobian<P>
+requires has_jacobian<P>
 struct jacobian_type<P> {
   using type = typename P::jacobian_matrix;
 };

@@ -1,10 +1,10 @@
 #include "core/work_precision.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
-
-#include <fmt/format.h>
 
 namespace stepbench {
 namespace {
@@ -91,7 +91,7 @@ cheapest_result cheapest(const std::vector<wp_method>& methods, double target, b
     if (!lowest) {
       bool any_diverged = false;
       for (const auto& d : m.rows) any_diverged = any_diverged || d.diverged;
-      reason = m.rows.empty()   ? "no rows in the study"
+      reason = m.rows.empty() ? "no rows in the study"
                : any_diverged ? fmt::format("diverged or failed at every {}", what_param(m.kind))
                               : fmt::format("failed at every {}", what_param(m.kind));
     } else if (m.rows[*lowest].error <= target) {  // accurate enough, but every such row was cut
@@ -120,8 +120,7 @@ std::vector<front_point> pareto_front(const std::vector<wp_method>& methods, boo
     for (std::size_t ri = 0; ri < methods[mi].rows.size(); ++ri) {
       const auto& r = methods[mi].rows[ri];
       const double cost = by_time ? r.time_ns : r.force_evals;
-      if (!r.completed || !std::isfinite(r.error) || !(std::isfinite(cost) && cost > 0.0) || (timed && r.cut))
-        continue;
+      if (!r.completed || !std::isfinite(r.error) || !(std::isfinite(cost) && cost > 0.0) || (timed && r.cut)) continue;
       pts.push_back({mi, ri, cost, r.error});
     }
   }

@@ -28,8 +28,8 @@ inline constexpr const char* error_metrics[] = {"err_pos_max", "err_pos_final", 
 bool is_error_metric(std::string_view name);
 
 struct wp_row {
-  double param = 0.0;  // dt [s] or relative tolerance
-  double error = std::numeric_limits<double>::quiet_NaN();  // the chosen metric
+  double param = 0.0;                                         // dt [s] or relative tolerance
+  double error = std::numeric_limits<double>::quiet_NaN();    // the chosen metric
   double time_ns = std::numeric_limits<double>::quiet_NaN();  // NaN: not timed
   double force_evals = 0.0;
   bool completed = true;  // did not diverge or fail
@@ -61,8 +61,8 @@ struct wp_exclusion {
 
 struct cheapest_result {
   double target = 0.0;
-  std::string cost;              // "time_ns" or "force_evals"
-  std::vector<wp_pick> ranked;   // cheapest first, baselines included (flagged by origin)
+  std::string cost;             // "time_ns" or "force_evals"
+  std::vector<wp_pick> ranked;  // cheapest first, baselines included (flagged by origin)
   std::vector<wp_exclusion> excluded;
   std::optional<wp_pick> best_achieved;  // when no method of ours or a peer qualifies: lowest error seen
   // The answer: the first ranked method that is not a baseline; nullopt when none.

@@ -28,10 +28,9 @@
 // counted.
 // Everything is counted: force and Jacobian evaluations by the system, and here the
 // Newton iterations and the linear solves.
+#include <Eigen/Core>
 #include <cmath>
 #include <limits>
-
-#include <Eigen/Core>
 
 #include "core/concepts.hpp"
 #include "core/linear_solve.hpp"
@@ -131,8 +130,7 @@ struct backward_euler_newton {
       f.swap(f_try);
       r.swap(r_try);
       r_norm = r_try_norm;
-      if (lambda * delta.template lpNorm<Eigen::Infinity>() <=
-          update_tol * v1.template lpNorm<Eigen::Infinity>())
+      if (lambda * delta.template lpNorm<Eigen::Infinity>() <= update_tol * v1.template lpNorm<Eigen::Infinity>())
         return true;
     }
     return r_norm <= residual_tol * scale(m, h) + subnormal_floor;

@@ -10,10 +10,9 @@
 //    times h, q the order of the error estimate; with `beta` > 0 the PI controller of
 //    HNW I sec. IV.2 / dopri5.f (Gustafsson's stabilisation: (err_old)^beta in the
 //    denominator), and never larger than h right after a rejected step.
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
-
-#include <Eigen/Core>
 
 #include "core/concepts.hpp"
 
@@ -50,8 +49,8 @@ inline double starting_step(const Sys& sys, double t, const Vec& x0, const Vec& 
   vs = v0 + (h0 * im) * f0;
   sys.force(t + h0, xs, vs, fs);
   const double d2 = norm((vs - v0).eval(), (im * (fs - f0)).eval()) / h0;
-  const double h1 = std::max(d1, d2) <= 1e-15 ? std::max(1e-6, h0 * 1e-3)
-                                              : std::pow(0.01 / std::max(d1, d2), 1.0 / (p + 1));
+  const double h1 =
+      std::max(d1, d2) <= 1e-15 ? std::max(1e-6, h0 * 1e-3) : std::pow(0.01 / std::max(d1, d2), 1.0 / (p + 1));
   return std::min({100.0 * h0, h1, horizon});
 }
 

@@ -29,11 +29,18 @@ inline auto baseline_acceleration(const pendulum& p) {
 
 struct baseline_rk4 {
   static method_info info() {
-    return {"baseline_rk4", "hand-written RK4 on plain doubles, fully inlined: the speed-of-light step, for scale",
-            method_origin::baseline, method_kind::fixed_step, 4.0, {}, "hand-written"};
+    return {"baseline_rk4",
+            "hand-written RK4 on plain doubles, fully inlined: the speed-of-light step, for scale",
+            method_origin::baseline,
+            method_kind::fixed_step,
+            4.0,
+            {},
+            "hand-written"};
   }
   template <problem P>
-  static constexpr bool applies = requires(const P& p) { baseline_acceleration(p)(0.0, 0.0); };
+  static constexpr bool applies = requires(const P& p) {
+    baseline_acceleration(p)(0.0, 0.0);
+  };
 
   template <problem P>
   static auto prepare(const P& p, double dt, double horizon, std::span<const double> times, const run_limits&) {

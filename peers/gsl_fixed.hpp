@@ -40,7 +40,8 @@ int gsl_fixed_rhs(double t, const double y[], double dydt[], void* params) {
 // The three GSL steppers a user might run at a fixed step.
 struct gsl_rk4_tag {
   static constexpr const char* name = "gsl_rk4";
-  static constexpr const char* description = "GSL rk4 at fixed dt (gsl_odeiv2_step_apply; error estimate by step doubling)";
+  static constexpr const char* description =
+      "GSL rk4 at fixed dt (gsl_odeiv2_step_apply; error estimate by step doubling)";
   static const gsl_odeiv2_step_type* type() { return gsl_odeiv2_step_rk4; }
 };
 struct gsl_rk2_tag {
@@ -60,8 +61,13 @@ struct gsl_fixed {
     // The order GSL declares for the stepper (gsl_odeiv2_step_order): the study fits what
     // it achieves and reports both (rk2 advances with the third-order member of its pair).
     std::unique_ptr<gsl_odeiv2_step, gsl_step_deleter> probe(gsl_odeiv2_step_alloc(Stepper::type(), 2));
-    return {Stepper::name, Stepper::description, method_origin::peer, method_kind::fixed_step,
-            static_cast<double>(gsl_odeiv2_step_order(probe.get())), {}, "GSL"};
+    return {Stepper::name,
+            Stepper::description,
+            method_origin::peer,
+            method_kind::fixed_step,
+            static_cast<double>(gsl_odeiv2_step_order(probe.get())),
+            {},
+            "GSL"};
   }
   template <problem P>
   static constexpr bool applies = true;
@@ -79,8 +85,9 @@ struct gsl_fixed {
     gsl_odeiv2_system sys{&gsl_fixed_rhs<P>, nullptr, static_cast<size_t>(n), &ctx};
     std::unique_ptr<gsl_odeiv2_step, gsl_step_deleter> step(gsl_odeiv2_step_alloc(Stepper::type(), n));
     if (!step) throw std::runtime_error("gsl_odeiv2_step_alloc failed");
-    Eigen::Matrix<double, vec::RowsAtCompileTime == Eigen::Dynamic ? Eigen::Dynamic : 2 * vec::RowsAtCompileTime, 1>
-        y(n), yerr(n), dydt_in(n), dydt_out(n);
+    Eigen::Matrix<double, vec::RowsAtCompileTime == Eigen::Dynamic ? Eigen::Dynamic : 2 * vec::RowsAtCompileTime, 1> y(
+        n),
+        yerr(n), dydt_in(n), dydt_out(n);
     const auto s0 = p.initial();
     y << s0.x, s0.v;
     gsl_fixed_rhs<P>(0.0, y.data(), dydt_in.data(), &ctx);
@@ -90,8 +97,8 @@ struct gsl_fixed {
     const loop_end end = fixed_step_loop(
         dt, horizon, plan,
         [&](double t, double h) {
-          const int status = gsl_odeiv2_step_apply(step.get(), t, h, y.data(), yerr.data(), dydt_in.data(),
-                                                   dydt_out.data(), &sys);
+          const int status =
+              gsl_odeiv2_step_apply(step.get(), t, h, y.data(), yerr.data(), dydt_in.data(), dydt_out.data(), &sys);
           if (status != GSL_SUCCESS)
             throw std::runtime_error(std::string("gsl_odeiv2_step_apply: ") + gsl_strerror(status));
           dydt_in = dydt_out;

@@ -1,6 +1,7 @@
 #pragma once
-// The adaptive library solvers a user might pick instead: GSL's driver (rkf45, rk8pd)
-// and SUNDIALS CVODE (Adams, BDF), over a ladder of tolerances (rtol = atol = tol),
+// The adaptive library solvers a user might pick instead: GSL's driver (rkf45, rk8pd),
+// SUNDIALS CVODE (Adams, BDF) and ARKODE's explicit Runge-Kutta stepper (ERKStep with its
+// default tables of order 8 and 5), over a ladder of tolerances (rtol = atol = tol),
 // with output at the sample times. They are the reference solvers' wrappers
 // (references/) at the user's tolerance, so each C library is wrapped once.
 #include <span>
@@ -27,6 +28,13 @@ drive_result<Vec> as_run(const reference_solution& sol, int dim) {
   for (std::size_t j = 0; j < sol.y.size(); ++j) {
     const Eigen::Map<const Eigen::VectorXd> y(sol.y[j].data(), 2 * dim);
     out.record(sol.times[j], y.head(dim), y.tail(dim));
+  }
+  if (sol.diverged) {  // a fixed-step run that blew up (ARKODE): recorded as diverged
+    out.non_finite = true;
+    out.final_state = {Vec::Constant(dim, std::numeric_limits<double>::quiet_NaN()),
+                       Vec::Constant(dim, std::numeric_limits<double>::quiet_NaN())};
+    out.t_final = sol.y.empty() ? 0.0 : sol.times[sol.y.size() - 1];
+    return out;
   }
   const Eigen::Map<const Eigen::VectorXd> last(sol.y.back().data(), 2 * dim);
   out.final_state = {last.head(dim), last.tail(dim)};
@@ -68,11 +76,29 @@ struct cvode_bdf_solver {
   }
 };
 
+// ARKODE ERKStep with its default table of an order (ARKODE_FEHLBERG_13_7_8 for 8,
+// ARKODE_CASH_KARP_6_4_5 for 5 in SUNDIALS 6.4), landing on each sample time with
+// ERKStepSetStopTime; the order recorded is the table's q as ARKODE loads it.
+template <int Order>
+struct arkode_erk_solver {
+  static constexpr const char* name = Order == 8 ? "arkode_erk8_adaptive" : "arkode_erk5_adaptive";
+  static constexpr const char* description = Order == 8
+                                                 ? "ARKODE ERKStep, default order-8 table (Fehlberg 7(8), 13 stages)"
+                                                 : "ARKODE ERKStep, default order-5 table (Cash-Karp 5(4), 6 stages)";
+  static constexpr const char* library = "SUNDIALS ARKODE";
+  static double declared_order() { return arkode_erk_default_table(Order).q; }
+  static reference_solution solve(const ode_system& s, std::span<const double> t, double tol) {
+    return solve_arkode_erk(s, t, Order, {tol, tol});
+  }
+};
+
 template <class Solver>
 struct library_adaptive {
   static method_info info() {
-    return {Solver::name, Solver::description, method_origin::peer, method_kind::adaptive,
-            std::numeric_limits<double>::quiet_NaN(), {.error_estimate = true}, Solver::library};
+    double order = std::numeric_limits<double>::quiet_NaN();
+    if constexpr (requires { Solver::declared_order(); }) order = Solver::declared_order();
+    return {Solver::name, Solver::description,      method_origin::peer, method_kind::adaptive,
+            order,        {.error_estimate = true}, Solver::library};
   }
   template <problem P>
   static constexpr bool applies = true;

@@ -33,8 +33,12 @@ inline bool odeint_record(drive_result<Vec>& out, double t, const X& x, const V&
 
 struct odeint_rk4 {
   static method_info info() {
-    return {"odeint_rk4", "Boost.Odeint runge_kutta4 on std::array", method_origin::peer, method_kind::fixed_step,
-            static_cast<double>(boost::numeric::odeint::runge_kutta4<std::array<double, 2>>::order_value), {},
+    return {"odeint_rk4",
+            "Boost.Odeint runge_kutta4 on std::array",
+            method_origin::peer,
+            method_kind::fixed_step,
+            static_cast<double>(boost::numeric::odeint::runge_kutta4<std::array<double, 2>>::order_value),
+            {},
             "Boost.Odeint"};
   }
   template <problem P>
@@ -65,7 +69,9 @@ struct odeint_rk4 {
     out.start(d, plan.size());
     const loop_end end = fixed_step_loop(
         dt, horizon, plan, [&](double t, double h) { stepper.do_step(system, y, t, h); }, [](double) {},
-        [&](double t) { return odeint_record(out, t, std::span<const double>(y.data(), d), std::span<const double>(y.data() + d, d)); });
+        [&](double t) {
+          return odeint_record(out, t, std::span<const double>(y.data(), d), std::span<const double>(y.data() + d, d));
+        });
     out.steps = end.steps;
     out.t_final = end.t;
     out.work.force_evals = calls;
@@ -80,9 +86,12 @@ struct odeint_rk4 {
 // second order; the study fits what it achieves and reports both.
 struct odeint_velocity_verlet {
   static method_info info() {
-    return {"odeint_velocity_verlet", "Boost.Odeint velocity_verlet on std::array (declares order 1)",
-            method_origin::peer, method_kind::fixed_step,
-            static_cast<double>(boost::numeric::odeint::velocity_verlet<std::array<double, 1>>::order_value), {},
+    return {"odeint_velocity_verlet",
+            "Boost.Odeint velocity_verlet on std::array (declares order 1)",
+            method_origin::peer,
+            method_kind::fixed_step,
+            static_cast<double>(boost::numeric::odeint::velocity_verlet<std::array<double, 1>>::order_value),
+            {},
             "Boost.Odeint"};
   }
   template <problem P>

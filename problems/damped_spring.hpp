@@ -15,9 +15,8 @@
 // over-damped side through expm1). Away from critical damping the over-damped motion is
 // evaluated as c1 e^{r1 t} + c2 e^{r2 t} with the roots written without cancellation, so
 // heavy damping (gamma >> w0) keeps its digits in v too.
-#include <cmath>
-
 #include <Eigen/Core>
+#include <cmath>
 
 #include "core/concepts.hpp"
 
@@ -114,7 +113,9 @@ struct spring_damper {
   }
   // Mechanical energy; the damper dissipates it, so it is compared with the exact
   // solution's energy, not with E(0).
-  double energy(const vec& x, const vec& v) const { return 0.5 * mass_kg * v.squaredNorm() + 0.5 * k_s * x.squaredNorm(); }
+  double energy(const vec& x, const vec& v) const {
+    return 0.5 * mass_kg * v.squaredNorm() + 0.5 * k_s * x.squaredNorm();
+  }
 };
 
 // The lecture's RK4 example (digest sections 4 and 6): a unit mass, k = 10, b = 1.

@@ -12,11 +12,11 @@
 //   sin(theta / 2) = k sn(K - w0 t | k^2),   theta' = -2 k w0 cn(K - w0 t | k^2),
 // (differentiate: cos(theta/2) = dn, and d sn/du = cn dn). The exact period is
 // T = 4 K(k) / w0. sn, cn come from gsl_sf_elljac_e, K from the AGM (below).
-#include <cmath>
-#include <numbers>
+#include <gsl/gsl_sf_elljac.h>
 
 #include <Eigen/Core>
-#include <gsl/gsl_sf_elljac.h>
+#include <cmath>
+#include <numbers>
 
 #include "core/concepts.hpp"
 

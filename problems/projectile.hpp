@@ -2,10 +2,9 @@
 // Projectile motion (digest section 2): up is +z, gravity g = [0, 0, -g]. Launched from
 // the origin along +x at `speed` and `angle_deg` above the horizon. The horizon is the
 // flight time back to launch height, 2 v_z / g. Closed form x(t) = x0 + v0 t + g t^2 / 2.
+#include <Eigen/Core>
 #include <cmath>
 #include <numbers>
-
-#include <Eigen/Core>
 
 #include "core/concepts.hpp"
 
@@ -34,8 +33,8 @@ struct projectile {
     };
   }
   std::string validate() const {
-    for (auto err : {require_positive("speed", speed), require_positive("gravity", gravity),
-                     require_positive("mass_kg", mass_kg)})
+    for (auto err :
+         {require_positive("speed", speed), require_positive("gravity", gravity), require_positive("mass_kg", mass_kg)})
       if (!err.empty()) return err;
     if (!(angle_deg > 0.0 && angle_deg < 180.0)) return "angle_deg must be in (0, 180) so the ball flies";
     return {};
@@ -54,7 +53,9 @@ struct projectile {
     const vec v0 = launch_velocity();
     return {v0 * t + 0.5 * g() * t * t, v0 + g() * t};
   }
-  double energy(const vec& x, const vec& v) const { return 0.5 * mass_kg * v.squaredNorm() + mass_kg * gravity * x.z(); }
+  double energy(const vec& x, const vec& v) const {
+    return 0.5 * mass_kg * v.squaredNorm() + mass_kg * gravity * x.z();
+  }
 
   // The lecture's formulas (digest section 2), launch and landing at the same height.
   double flight_time() const { return 2.0 * launch_velocity().z() / gravity; }

@@ -19,9 +19,8 @@
 // with the coordinates of mass i at 3i..3i+2, a spring couples only neighbouring masses,
 // so dF/dx and dF/dv have 5 sub- and 5 super-diagonals and the implicit methods solve in
 // O(n) (core/band_matrix.hpp), not through a dense O(n^3) solve.
-#include <cmath>
-
 #include <Eigen/Core>
+#include <cmath>
 
 #include "core/band_matrix.hpp"
 #include "core/concepts.hpp"
@@ -60,9 +59,9 @@ struct spring_chain {
   std::string validate() const {
     if (!(masses >= 2 && masses <= (1 << 20) && masses == std::floor(masses)))
       return "masses must be a whole number from 2 to 1048576";
-    for (auto err : {require_positive("rope_mass_kg", rope_mass_kg), require_positive("rope_length_m", rope_length_m),
-                     require_positive("k_s", k_s), require_positive("duration", duration),
-                     require_finite("gravity", gravity)})
+    for (auto err :
+         {require_positive("rope_mass_kg", rope_mass_kg), require_positive("rope_length_m", rope_length_m),
+          require_positive("k_s", k_s), require_positive("duration", duration), require_finite("gravity", gravity)})
       if (!err.empty()) return err;
     if (!(std::isfinite(k_d) && k_d >= 0.0)) return "k_d must be finite and >= 0";
     return {};
@@ -130,7 +129,8 @@ struct spring_chain {
       add_spring_blocks(dfdv, s, b);
     }
     for (int r = 0; r < 3; ++r)  // the pinned mass
-      for (int c = std::max(0, r - bandwidth); c <= std::min(dim() - 1, r + bandwidth); ++c) dfdx(r, c) = dfdv(r, c) = 0.0;
+      for (int c = std::max(0, r - bandwidth); c <= std::min(dim() - 1, r + bandwidth); ++c)
+        dfdx(r, c) = dfdv(r, c) = 0.0;
   }
 
   // Kinetic, gravitational and spring energy; the dampers dissipate it.

@@ -1,12 +1,19 @@
 // Solutions from SUNDIALS ARKODE 5.x's explicit Runge-Kutta stepper (ERKStep): with its
 // default table of order 8 (ARKODE_FEHLBERG_13_7_8) an independent high-order reference
-// beside GSL's rk8pd; as a peer (order 5: ARKODE_DORMAND_PRINCE_7_4_5, or 8) what a
-// SUNDIALS user gets. ERKStepSetStopTime lands exactly on each output time instead of
-// interpolating past it.
+// beside GSL's rk8pd; as a peer (order 8, or 5: ARKODE_CASH_KARP_6_4_5 in SUNDIALS 6.4,
+// arkode_erkstep.h's ERKSTEP_DEFAULT_5), adaptive or at fixed steps, what a SUNDIALS user
+// gets. ERKStepSetStopTime lands exactly on each output time instead of interpolating
+// past it.
+// arkode_butcher.h uses FILE without including <cstdio>, so <cstdio> comes first.
+// clang-format off
+#include <cstdio>
+// clang-format on
+#include <arkode/arkode_butcher_erk.h>
 #include <arkode/arkode_erkstep.h>
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -45,7 +52,8 @@ int arkode_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) noexce
   return 0;
 }
 
-void arkode_error_handler(int error_code, const char* module, const char* function, char* msg, void* user_data) noexcept {
+void arkode_error_handler(int error_code, const char* module, const char* function, char* msg,
+                          void* user_data) noexcept {
   if (error_code == ARK_WARNING) return;
   auto& st = *static_cast<arkode_callback_state*>(user_data);
   st.last_message = std::string(module) + "/" + function + ": " + msg;
@@ -67,9 +75,69 @@ struct arkode_handles {
 
 }  // namespace
 
+arkode_erk_table_info arkode_erk_default_table(int order) {
+  // ERKStepSetOrder's choice (arkode_erkstep.h, ERKSTEP_DEFAULT_<q>).
+  int id = ARKODE_ERK_NONE;
+  const char* name = "";
+  switch (order) {
+    case 2:
+      id = ERKSTEP_DEFAULT_2, name = "ERKSTEP_DEFAULT_2";
+      break;
+    case 3:
+      id = ERKSTEP_DEFAULT_3, name = "ERKSTEP_DEFAULT_3";
+      break;
+    case 4:
+      id = ERKSTEP_DEFAULT_4, name = "ERKSTEP_DEFAULT_4";
+      break;
+    case 5:
+      id = ERKSTEP_DEFAULT_5, name = "ERKSTEP_DEFAULT_5";
+      break;
+    case 6:
+      id = ERKSTEP_DEFAULT_6, name = "ERKSTEP_DEFAULT_6";
+      break;
+    case 8:
+      id = ERKSTEP_DEFAULT_8, name = "ERKSTEP_DEFAULT_8";
+      break;
+    default:
+      throw std::invalid_argument("ARKODE ERKStep has no default table of order " + std::to_string(order));
+  }
+  switch (id) {  // the names of arkode_butcher_erk.h's IDs that the defaults use
+    case ARKODE_HEUN_EULER_2_1_2:
+      name = "ARKODE_HEUN_EULER_2_1_2";
+      break;
+    case ARKODE_BOGACKI_SHAMPINE_4_2_3:
+      name = "ARKODE_BOGACKI_SHAMPINE_4_2_3";
+      break;
+    case ARKODE_ZONNEVELD_5_3_4:
+      name = "ARKODE_ZONNEVELD_5_3_4";
+      break;
+    case ARKODE_CASH_KARP_6_4_5:
+      name = "ARKODE_CASH_KARP_6_4_5";
+      break;
+    case ARKODE_DORMAND_PRINCE_7_4_5:
+      name = "ARKODE_DORMAND_PRINCE_7_4_5";
+      break;
+    case ARKODE_VERNER_8_5_6:
+      name = "ARKODE_VERNER_8_5_6";
+      break;
+    case ARKODE_FEHLBERG_13_7_8:
+      name = "ARKODE_FEHLBERG_13_7_8";
+      break;
+    default:
+      break;
+  }
+  const ARKodeButcherTable table = ARKodeButcherTable_LoadERK(static_cast<ARKODE_ERKTableID>(id));
+  if (!table) throw std::runtime_error(std::string("ARKodeButcherTable_LoadERK(") + name + ") returned null");
+  arkode_erk_table_info out{name, table->stages, table->q, table->p};
+  ARKodeButcherTable_Free(table);
+  return out;
+}
+
 reference_solution solve_arkode_erk(const ode_system& sys, std::span<const double> times, int order,
-                                    reference_tolerances tol) {
+                                    reference_tolerances tol, double fixed_step) {
   const std::string source = "arkode_erk" + std::to_string(order);
+  if (fixed_step < 0.0 || !std::isfinite(fixed_step))
+    throw std::invalid_argument(source + ": the fixed step must be finite and >= 0 (0: adaptive)");
   detail::validate_reference_input(source, sys, times, tol);
   const auto start = std::chrono::steady_clock::now();
   arkode_callback_state st;
@@ -78,7 +146,8 @@ reference_solution solve_arkode_erk(const ode_system& sys, std::span<const doubl
   const auto fail = [&](const std::string& call, int flag) {
     // ERKStepGetReturnFlagName returns a malloc'd string the caller frees (arkode_io.c).
     char* name = ERKStepGetReturnFlagName(flag);
-    std::string what = source + ": " + call + " failed, flag " + std::to_string(flag) + " (" + (name ? name : "?") + ")";
+    std::string what =
+        source + ": " + call + " failed, flag " + std::to_string(flag) + " (" + (name ? name : "?") + ")";
     std::free(name);
     if (st.non_finite) what += "; right-hand side returned a non-finite value at t=" + detail::num(st.non_finite_t);
     if (!st.last_message.empty()) what += "; " + st.last_message;
@@ -97,6 +166,7 @@ reference_solution solve_arkode_erk(const ode_system& sys, std::span<const doubl
   check("ERKStepSetUserData", ERKStepSetUserData(h.mem, &st));
   check("ERKStepSetOrder", ERKStepSetOrder(h.mem, order));
   check("ERKStepSStolerances", ERKStepSStolerances(h.mem, tol.rtol, tol.atol));
+  if (fixed_step > 0.0) check("ERKStepSetFixedStep", ERKStepSetFixedStep(h.mem, fixed_step));
   check("ERKStepSetMaxNumSteps", ERKStepSetMaxNumSteps(h.mem, sys.max_steps_per_output));
   // At a discontinuity an order-8 method at a tight tolerance needs many rejections in a
   // row to shrink its step; ARKODE's default of 7 gives up where GSL and CVODE do not.
@@ -112,10 +182,16 @@ reference_solution solve_arkode_erk(const ode_system& sys, std::span<const doubl
     sunrealtype t = 0.0;
     const int flag = ERKStepEvolve(h.mem, tout, h.y, &t, ARK_NORMAL);
     if (st.error) std::rethrow_exception(st.error);
-    if (flag < 0) fail("ERKStepEvolve at t=" + detail::num(t) + " towards t=" + detail::num(tout), flag);
     const double* y = N_VGetArrayPointer(h.y);
-    for (std::size_t i = 0; i < n; ++i)
-      if (!std::isfinite(y[i])) throw std::runtime_error(source + ": non-finite state at t=" + detail::num(tout));
+    const bool finite = std::all_of(y, y + n, [](double v) { return std::isfinite(v); });
+    // At a fixed step nothing shrinks the step: a step beyond the stability limit grows
+    // until the right-hand side or the state is not finite, which is the run diverging.
+    if (fixed_step > 0.0 && (st.non_finite || !finite)) {
+      out.diverged = true;
+      break;
+    }
+    if (flag < 0) fail("ERKStepEvolve at t=" + detail::num(t) + " towards t=" + detail::num(tout), flag);
+    if (!finite) throw std::runtime_error(source + ": non-finite state at t=" + detail::num(tout));
     out.y.emplace_back(y, y + n);
   }
   auto& s = out.stats;

@@ -111,6 +111,20 @@ int cvode_band_jacobian(sunrealtype t, N_Vector y, N_Vector, SUNMatrix jac, void
   return 0;
 }
 
+// The contact gap as CVODE's root function (CVRootFn, user guide 6.x): one root, the
+// smallest signed distance of the problem's contacts.
+int cvode_contact_root(sunrealtype t, N_Vector y, sunrealtype* gout, void* user_data) noexcept {
+  auto& st = *static_cast<cvode_callback_state*>(user_data);
+  if (st.error) return -1;
+  try {
+    gout[0] = st.sys->contact_gap(t, st.plain(N_VGetArrayPointer(y)));
+  } catch (...) {
+    st.error = std::current_exception();
+    return -1;
+  }
+  return 0;
+}
+
 // Replaces CVODE's default handler, which prints to stderr; the message goes into the
 // exception instead (CVodeSetErrHandlerFn, user guide 6.x).
 void cvode_error_handler(int error_code, const char* module, const char* function, char* msg,
@@ -228,38 +242,76 @@ reference_solution solve_cvode(const ode_system& sys, std::span<const double> ti
   out.times.assign(times.begin(), times.end());
   out.y.reserve(times.size());
 
+  // Contacts: CVODE finds the root of the gap (decreasing crossings only), returns there
+  // (CV_ROOT_RETURN), the problem's response is applied to the state, and CVODE starts
+  // afresh from it (CVodeReInit: the solution's derivative jumps, so no history carries
+  // over). ReInit resets CVODE's counters, so they are summed over the segments.
+  reference_stats before_reinit;
+  long contacts = 0, roots = 0;
+  constexpr long max_contacts = 100000;  // a Zeno sequence (a ball coming to rest) stops here with a message
+  if (sys.has_contacts()) {
+    check("CVodeRootInit", CVodeRootInit(h.mem, 1, &cvode_contact_root));
+    int direction = -1;
+    check("CVodeSetRootDirection", CVodeSetRootDirection(h.mem, &direction));
+  }
+  std::vector<double> y_resolved;
+  auto add_counters = [&](reference_stats& into) {
+    long steps = 0, err_fails = 0, solve_fails = 0, rhs = 0, nni = 0, lin_rhs = 0, jac = 0;
+    check("CVodeGetNumSteps", CVodeGetNumSteps(h.mem, &steps));
+    check("CVodeGetNumErrTestFails", CVodeGetNumErrTestFails(h.mem, &err_fails));
+    check("CVodeGetNumStepSolveFails", CVodeGetNumStepSolveFails(h.mem, &solve_fails));
+    check("CVodeGetNumRhsEvals", CVodeGetNumRhsEvals(h.mem, &rhs));
+    into.steps += steps;
+    into.failed_steps += err_fails + solve_fails;
+    into.rhs_evals += rhs;
+    if (method == cvode_method::bdf) {
+      check("CVodeGetNumNonlinSolvIters", CVodeGetNumNonlinSolvIters(h.mem, &nni));
+      check("CVodeGetNumLinRhsEvals", CVodeGetNumLinRhsEvals(h.mem, &lin_rhs), flag_kind::cvls);
+      check("CVodeGetNumJacEvals", CVodeGetNumJacEvals(h.mem, &jac), flag_kind::cvls);
+      into.newton_iterations += nni;
+      into.lin_rhs_evals += lin_rhs;
+      into.jac_evals += jac;
+      into.linear_solves += nni;  // a direct linear solver does one solve per Newton iteration
+    }
+  };
+
   const auto n = static_cast<std::size_t>(sys.n);
   for (double tout : times) {
     // CV_NORMAL: CVODE steps past tout and interpolates its Nordsieck history there, which
     // is accurate to the integration tolerance (user guide 6.x, CVode).
     sunrealtype t = 0.0;
-    const int flag = CVode(h.mem, tout, h.y, &t, CV_NORMAL);
+    int flag = CVode(h.mem, tout, h.y, &t, CV_NORMAL);
+    while (flag == CV_ROOT_RETURN) {
+      if (st.error) std::rethrow_exception(st.error);
+      if (++roots > max_contacts)
+        throw std::runtime_error(std::string(source) + ": more than " + std::to_string(max_contacts) +
+                                 " contacts before t=" + detail::num(tout) + " (a Zeno sequence?)");
+      const auto y = st.plain(N_VGetArrayPointer(h.y));
+      y_resolved.assign(y.begin(), y.end());
+      if (const int resolved = sys.resolve_contacts(t, y_resolved); resolved > 0) {
+        contacts += resolved;
+        to_solver_layout(st, y_resolved, N_VGetArrayPointer(h.y));
+        add_counters(before_reinit);
+        check("CVodeReInit", CVodeReInit(h.mem, t, h.y));
+      }
+      flag = CVode(h.mem, tout, h.y, &t, CV_NORMAL);
+    }
     if (st.error) std::rethrow_exception(st.error);
     if (flag < 0) fail("CVode at t=" + detail::num(t) + " towards t=" + detail::num(tout), flag);
     const auto y = st.plain(N_VGetArrayPointer(h.y));
     for (std::size_t i = 0; i < n; ++i)
-      if (!std::isfinite(y[i])) throw std::runtime_error(std::string(source) + ": non-finite state at t=" +
-                                                         detail::num(tout));
+      if (!std::isfinite(y[i]))
+        throw std::runtime_error(std::string(source) + ": non-finite state at t=" + detail::num(tout));
     out.y.emplace_back(y.begin(), y.end());
   }
 
-  auto& s = out.stats;
-  long err_fails = 0, solve_fails = 0;
-  check("CVodeGetNumSteps", CVodeGetNumSteps(h.mem, &s.steps));
-  check("CVodeGetNumErrTestFails", CVodeGetNumErrTestFails(h.mem, &err_fails));
   // Since SUNDIALS 6.2 CVodeGetNumNonlinSolvConvFails counts every nonlinear solver failure,
   // including ones recovered by a Jacobian update within the same attempt; the failed step
   // attempts are CVodeGetNumStepSolveFails (SUNDIALS changelog, release 6.2.0).
-  check("CVodeGetNumStepSolveFails", CVodeGetNumStepSolveFails(h.mem, &solve_fails));
-  s.failed_steps = err_fails + solve_fails;
-  check("CVodeGetNumRhsEvals", CVodeGetNumRhsEvals(h.mem, &s.rhs_evals));
-  if (method == cvode_method::bdf) {
-    check("CVodeGetNumNonlinSolvIters", CVodeGetNumNonlinSolvIters(h.mem, &s.newton_iterations));
-    check("CVodeGetNumLinRhsEvals", CVodeGetNumLinRhsEvals(h.mem, &s.lin_rhs_evals), flag_kind::cvls);
-    check("CVodeGetNumJacEvals", CVodeGetNumJacEvals(h.mem, &s.jac_evals), flag_kind::cvls);
-    // A direct linear solver does one solve per Newton iteration.
-    s.linear_solves = s.newton_iterations;
-  }
+  auto& s = out.stats;
+  s = before_reinit;
+  add_counters(s);
+  out.contacts = contacts;
   s.rhs_evals_counted = st.calls;
   s.rtol = tol.rtol;
   s.atol = tol.atol;

@@ -2,8 +2,8 @@
 // Shared by the GSL and CVODE wrappers; not part of the interface (reference.hpp).
 #include <cstdio>
 #include <exception>
-#include <string>
 #include <span>
+#include <string>
 #include <string_view>
 
 #include "references/reference.hpp"

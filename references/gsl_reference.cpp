@@ -70,7 +70,8 @@ reference_solution solve_gsl(const ode_system& sys, std::span<const double> time
   if (!driver) throw std::runtime_error(source + ": gsl_odeiv2_driver_alloc_y_new returned null");
   // nmax bounds the steps of one driver_apply call (0 would mean unbounded): a problem too
   // stiff for an explicit solver fails in seconds with a message instead of running on.
-  if (int s = gsl_odeiv2_driver_set_nmax(driver.get(), static_cast<unsigned long>(sys.max_steps_per_output)); s != GSL_SUCCESS)
+  if (int s = gsl_odeiv2_driver_set_nmax(driver.get(), static_cast<unsigned long>(sys.max_steps_per_output));
+      s != GSL_SUCCESS)
     throw std::runtime_error(source + ": gsl_odeiv2_driver_set_nmax failed, status " + std::to_string(s));
 
   reference_solution out;
@@ -85,15 +86,13 @@ reference_solution solve_gsl(const ode_system& sys, std::span<const double> time
     if (st.error) std::rethrow_exception(st.error);
     if (st.non_finite)
       throw std::runtime_error(source + ": right-hand side returned a non-finite value at t=" +
-                               detail::num(st.non_finite_t) + " (integrating towards t=" + detail::num(tout) +
-                               ")");
+                               detail::num(st.non_finite_t) + " (integrating towards t=" + detail::num(tout) + ")");
     if (status != GSL_SUCCESS)
       throw std::runtime_error(source + ": gsl_odeiv2_driver_apply failed at t=" + detail::num(t) +
                                " towards t=" + detail::num(tout) + ", status " + std::to_string(status) + " (" +
                                gsl_strerror(status) + ")");
     for (double v : y)
-      if (!std::isfinite(v))
-        throw std::runtime_error(source + ": non-finite state at t=" + detail::num(tout));
+      if (!std::isfinite(v)) throw std::runtime_error(source + ": non-finite state at t=" + detail::num(tout));
     out.y.push_back(y);
   }
 

@@ -1,20 +1,18 @@
 // Input validation shared by the reference solvers, and dispatch by source name.
 #include "references/reference.hpp"
 
-#include "references/detail.hpp"
-
 #include <cmath>
 #include <stdexcept>
 #include <string>
+
+#include "references/detail.hpp"
 
 namespace stepbench {
 namespace detail {
 
 void validate_reference_input(std::string_view source, const ode_system& sys, std::span<const double> times,
                               reference_tolerances tol) {
-  const auto fail = [&](const std::string& what) {
-    throw std::invalid_argument(std::string(source) + ": " + what);
-  };
+  const auto fail = [&](const std::string& what) { throw std::invalid_argument(std::string(source) + ": " + what); };
   if (sys.n <= 0) fail("system dimension n must be positive, got " + std::to_string(sys.n));
   if (sys.y0.size() != static_cast<std::size_t>(sys.n))
     fail("y0 has " + std::to_string(sys.y0.size()) + " entries, expected n = " + std::to_string(sys.n));
@@ -22,6 +20,10 @@ void validate_reference_input(std::string_view source, const ode_system& sys, st
     if (!std::isfinite(v)) fail("y0 has a non-finite entry");
   if (!sys.rhs) fail("rhs is not set");
   if (sys.max_steps_per_output < 1) fail("the step budget must be positive");
+  if (sys.has_contacts() && !reference_handles_contacts(source))
+    fail("this reference does not handle contacts (only CVODE's root finding does)");
+  if (static_cast<bool>(sys.contact_gap) != static_cast<bool>(sys.resolve_contacts))
+    fail("contact_gap and resolve_contacts come together");
   if (times.empty()) fail("no output times");
   for (std::size_t i = 0; i < times.size(); ++i) {
     if (!std::isfinite(times[i]) || times[i] <= 0.0)
@@ -37,6 +39,8 @@ void validate_reference_input(std::string_view source, const ode_system& sys, st
 }
 
 }  // namespace detail
+
+bool reference_handles_contacts(std::string_view source) { return source == "cvode_bdf" || source == "cvode_adams"; }
 
 reference_solution solve_reference(std::string_view source, const ode_system& sys, std::span<const double> times,
                                    reference_tolerances tol) {

@@ -1,11 +1,11 @@
 #include "study/advise.hpp"
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
-
-#include <fmt/format.h>
-#include <fmt/ranges.h>
 
 namespace stepbench {
 namespace {
@@ -16,9 +16,12 @@ std::string cost_text(const std::string& cost, const wp_row& r) {
 
 std::string label(const wp_method& m) {
   switch (m.origin) {
-    case method_origin::peer: return m.name + " (peer)";
-    case method_origin::baseline: return m.name + " (baseline, for scale)";
-    default: return m.name;
+    case method_origin::peer:
+      return m.name + " (peer)";
+    case method_origin::baseline:
+      return m.name + " (baseline, for scale)";
+    default:
+      return m.name;
   }
 }
 
@@ -33,7 +36,8 @@ advice advise(const study_data& study, const std::string& problem, const std::st
     std::vector<std::string> names;
     for (const auto& q : study.problems) names.push_back(q.name);
     throw std::invalid_argument(fmt::format("problem '{}' is not in the study file '{}' (it has: {})", problem,
-                                            study.path, names.empty() ? "none" : fmt::format("{}", fmt::join(names, ", "))));
+                                            study.path,
+                                            names.empty() ? "none" : fmt::format("{}", fmt::join(names, ", "))));
   }
   advice a;
   a.problem = problem;
@@ -50,8 +54,8 @@ std::string format_advice(const advice& a, std::size_t runners_up) {
   const auto& r = a.result;
   std::string out;
   const std::string cost_name = r.cost == "time_ns" ? "measured time per run (median)"
-                                : a.timed          ? "force evaluations (some qualifying rows are not timed)"
-                                                   : "force evaluations (the study has no timings)";
+                                : a.timed           ? "force evaluations (some qualifying rows are not timed)"
+                                                    : "force evaluations (the study has no timings)";
   // The stability margin: how far the chosen row is from the rows that blew up.
   auto margin = [&](const wp_pick& p) {
     const auto kind = a.methods[p.method].kind;
@@ -72,8 +76,9 @@ std::string format_advice(const advice& a, std::size_t runners_up) {
     out += fmt::format("no method in the study meets {} <= {:g} {} on {}", a.metric, a.tol, a.unit, a.problem);
     if (r.best_achieved) {
       const auto& m = a.methods[r.best_achieved->method];
-      out += fmt::format("; the best achieved is {} {:.3g} {} by {} at {}", a.metric, m.rows[r.best_achieved->row].error,
-                         a.unit, m.name, format_param(m.kind, m.rows[r.best_achieved->row].param));
+      out +=
+          fmt::format("; the best achieved is {} {:.3g} {} by {} at {}", a.metric, m.rows[r.best_achieved->row].error,
+                      a.unit, m.name, format_param(m.kind, m.rows[r.best_achieved->row].param));
     }
     out += "\n";
   } else {
@@ -87,7 +92,8 @@ std::string format_advice(const advice& a, std::size_t runners_up) {
     if (!answer || p.method != answer->method) others.push_back(&p);
   if (!others.empty()) {
     out += answer ? "runners-up:\n" : "for scale:\n";
-    for (std::size_t i = 0; i < others.size() && i < runners_up; ++i) out += fmt::format("  {}. {}\n", i + 2, line(*others[i]));
+    for (std::size_t i = 0; i < others.size() && i < runners_up; ++i)
+      out += fmt::format("  {}. {}\n", i + 2, line(*others[i]));
     if (others.size() > runners_up)
       out += fmt::format("  ... and {} more that also meet the tolerance\n", others.size() - runners_up);
   }

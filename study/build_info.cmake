@@ -19,6 +19,7 @@ inline constexpr const char* git_commit = \"${commit}\";
 inline constexpr const char* compiler = \"${COMPILER}\";
 inline constexpr const char* build_type = \"${BUILD_TYPE}\";
 inline constexpr const char* dependencies = \"${DEPENDENCIES}\";
+inline constexpr const char* build_flags = \"${FLAGS}\";
 }
 ")
 if(EXISTS "${OUT}")

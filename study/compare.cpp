@@ -1,5 +1,7 @@
 #include "study/compare.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <iterator>
@@ -7,8 +9,6 @@
 #include <stdexcept>
 #include <string_view>
 #include <tuple>
-
-#include <fmt/format.h>
 
 #include "core/work_precision.hpp"
 
@@ -298,8 +298,9 @@ void root_differences(const study_data& base, const study_data& next, comparison
   const std::set<std::string> skip{"created_utc", "wall_seconds", "benchmark_wall_seconds"};
   // Machine, build and mode first: they decide whether the timings compare at all.
   const std::vector<std::string> first{
-      "cpu",          "cores",   "num_cpus",   "mhz_per_cpu", "cpu_scaling_enabled", "compiler", "build_type",
-      "dependencies", "version", "git_commit", "timing",      "benchmark_mode"};
+      "cpu",        "cores",      "num_cpus",      "mhz_per_cpu", "cpu_scaling_enabled",
+      "compiler",   "build_type", "dependencies",  "build_flags", "version",
+      "git_commit", "timing",     "benchmark_mode"};
   std::map<std::string, std::pair<std::string, std::string>> all;
   const auto gather = [&](const study_data& s, bool is_new) {
     for (const auto& [k, v] : s.meta) (is_new ? all[k].second : all[k].first) = v;
@@ -564,6 +565,10 @@ std::vector<std::string> describe_thresholds(const compare_options& o) {
                   "by more than {:g}x above {:g}; a problem regresses when its truth_source changes or its truth "
                   "is no longer trusted.",
                   o.error_factor, agreement_floor),
+      fmt::format("A stability limit of our methods (/stability, from the amplification matrix) regresses when it "
+                  "moves by more than {:g} %, or when a method becomes or stops being unstable for every dt or "
+                  "unconditionally stable.",
+                  100 * stability_tolerance),
       fmt::format("What only BASE has (a problem, a method, a reference, rows of a ladder) {}; what only NEW has is "
                   "listed as added.",
                   o.allow_removed ? "is listed (--allow-removed)" : "regresses (unless --allow-removed)"),
@@ -595,6 +600,44 @@ std::size_t comparison::gating() const {
          (options.gate_timing ? slower() : 0);
 }
 
+// The stability limits of our methods (/stability): a limit that moves by more than
+// stability_tolerance (relative), or a method that becomes (or stops being) stable for
+// every dt or unstable for every dt, is a regression.
+void check_stability(const study_data& base, const study_data& next, const compare_options& opts, comparison& out) {
+  for (const auto& b : base.stability) {
+    const auto it = std::find_if(next.stability.begin(), next.stability.end(),
+                                 [&](const auto& n) { return n.integrator == b.integrator && n.test == b.test; });
+    if (it == next.stability.end()) {
+      if (!next.stability.empty() && !opts.allow_removed)
+        out.removed.push_back({"stability", b.integrator, "limit " + b.test, "in BASE only"});
+      continue;
+    }
+    change c;
+    c.problem = "stability";
+    c.method = b.integrator;
+    auto flags = [](const study_stability_limit& l) {
+      return l.unconditionally_stable ? std::string("unconditionally stable")
+             : l.unstable_for_all_dt  ? std::string("unstable for every dt")
+                                      : std::string("finite limit");
+    };
+    if (flags(b) != flags(*it)) {
+      c.kind = change_kind::regression;
+      c.what = b.test + " stability";
+      c.old_value = flags(b);
+      c.new_value = flags(*it);
+      out.changes.push_back(c);
+    } else if (std::isfinite(b.theory) && std::isfinite(it->theory) &&
+               std::abs(it->theory / b.theory - 1.0) > stability_tolerance) {
+      c.kind = change_kind::regression;
+      c.what = b.test + " stability limit (y = w dt or lambda dt)";
+      c.old_value = b.theory;
+      c.new_value = it->theory;
+      c.ratio = it->theory / b.theory;
+      out.changes.push_back(c);
+    }
+  }
+}
+
 comparison compare_studies(const study_data& base, const study_data& next, const compare_options& opts) {
   if (!(opts.error_factor >= 1.0) || !std::isfinite(opts.error_factor))
     throw std::invalid_argument(
@@ -623,7 +666,7 @@ comparison compare_studies(const study_data& base, const study_data& next, const
   if (out.timing_compared) {
     std::string differ;
     for (const auto& d : out.differences)
-      for (const char* k : {"cpu", "cores", "compiler", "build_type", "dependencies", "benchmark_mode"})
+      for (const char* k : {"cpu", "cores", "compiler", "build_type", "build_flags", "dependencies", "benchmark_mode"})
         if (d.what == k) differ += (differ.empty() ? "" : ", ") + d.what;
     if (!differ.empty()) out.timing_note = fmt::format("the files differ in {}: the ratios measure that too", differ);
   }
@@ -640,6 +683,7 @@ comparison compare_studies(const study_data& base, const study_data& next, const
   for (const auto& np : next.problems)
     if (!base.find(np.name))
       out.added.push_back({np.name, "", "problem", plural(np.methods.size(), "method", "methods")});
+  check_stability(base, next, opts, out);
   summarize_timing(out);
   return out;
 }

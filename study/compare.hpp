@@ -39,6 +39,8 @@ inline constexpr double error_floor_rel = 1e-12;  // x pos_scale (position error
 // A reference's agreement (err_pos_rel, err_vel_rel) is already relative; the reference
 // tolerance is 1e-13, so agreement below it is noise.
 inline constexpr double agreement_floor = 1e-13;
+// A stability limit (/stability/limits, theory) that moves by more than this regresses.
+inline constexpr double stability_tolerance = 0.01;
 
 // Timing noise: a row is flagged when new/old > 1 + threshold (slower) or
 // < 1 / (1 + threshold) (faster), threshold = max(floor, 3 x the larger relative spread

@@ -1,9 +1,9 @@
 #include "study/h5.hpp"
 
+#include <fmt/format.h>
+
 #include <cstring>
 #include <stdexcept>
-
-#include <fmt/format.h>
 
 namespace stepbench::h5 {
 namespace {
@@ -35,7 +35,8 @@ void attr(H5::H5Object& obj, const std::string& name, double value) {
 }
 void attr(H5::H5Object& obj, const std::string& name, long value) {
   const std::int64_t v = value;
-  obj.createAttribute(name, H5::PredType::NATIVE_INT64, H5::DataSpace(H5S_SCALAR)).write(H5::PredType::NATIVE_INT64, &v);
+  obj.createAttribute(name, H5::PredType::NATIVE_INT64, H5::DataSpace(H5S_SCALAR))
+      .write(H5::PredType::NATIVE_INT64, &v);
 }
 void attr(H5::H5Object& obj, const std::string& name, int value) { attr(obj, name, static_cast<long>(value)); }
 void attr(H5::H5Object& obj, const std::string& name, const std::vector<int>& values) {
@@ -59,10 +60,25 @@ void dataset(H5::Group& g, const std::string& name, const std::vector<std::vecto
   const hsize_t dims[2] = {rows.size(), rows.empty() ? 0 : rows.front().size()};
   std::vector<double> flat;
   for (const auto& r : rows) flat.insert(flat.end(), r.begin(), r.end());
-  g.createDataSet(name, H5::PredType::NATIVE_DOUBLE, H5::DataSpace(2, dims)).write(flat.data(), H5::PredType::NATIVE_DOUBLE);
+  g.createDataSet(name, H5::PredType::NATIVE_DOUBLE, H5::DataSpace(2, dims))
+      .write(flat.data(), H5::PredType::NATIVE_DOUBLE);
 }
 
-void table::add(std::string name, std::vector<double> values) { columns_.emplace_back(std::move(name), std::move(values)); }
+void compressed_grid(H5::Group& g, const std::string& name, const std::vector<std::vector<double>>& rows) {
+  const hsize_t dims[2] = {rows.size(), rows.empty() ? 0 : rows.front().size()};
+  std::vector<double> flat;
+  for (const auto& r : rows) flat.insert(flat.end(), r.begin(), r.end());
+  H5::DSetCreatPropList props;
+  props.setChunk(2, dims);
+  props.setShuffle();
+  props.setDeflate(6);
+  g.createDataSet(name, H5::PredType::IEEE_F32LE, H5::DataSpace(2, dims), props)
+      .write(flat.data(), H5::PredType::NATIVE_DOUBLE);
+}
+
+void table::add(std::string name, std::vector<double> values) {
+  columns_.emplace_back(std::move(name), std::move(values));
+}
 void table::add(std::string name, std::vector<std::int64_t> values) {
   columns_.emplace_back(std::move(name), std::move(values));
 }
@@ -78,7 +94,8 @@ void table::write(H5::Group& g, const std::string& name) const {
   std::vector<std::size_t> offset;
   for (const auto& [col_name, col] : columns_) {
     const std::size_t n = std::visit([](const auto& v) { return v.size(); }, col);
-    if (!offset.empty() && n != rows) throw std::logic_error(fmt::format("table {}: column {} has {} rows, not {}", name, col_name, n, rows));
+    if (!offset.empty() && n != rows)
+      throw std::logic_error(fmt::format("table {}: column {} has {} rows, not {}", name, col_name, n, rows));
     rows = n;
     const std::size_t size = std::visit(
         [](const auto& v) -> std::size_t {
@@ -124,7 +141,9 @@ void table::write(H5::Group& g, const std::string& name) const {
   g.createDataSet(name, file_type, H5::DataSpace(1, &n)).write(buffer.data(), memory);
 }
 
-bool has_link(const H5::Group& g, const std::string& name) { return H5Lexists(g.getId(), name.c_str(), H5P_DEFAULT) > 0; }
+bool has_link(const H5::Group& g, const std::string& name) {
+  return H5Lexists(g.getId(), name.c_str(), H5P_DEFAULT) > 0;
+}
 bool is_group(const H5::Group& g, const std::string& name) {
   return has_link(g, name) && g.childObjType(name) == H5O_TYPE_GROUP;
 }

@@ -22,6 +22,9 @@ void attr(H5::H5Object& obj, const std::string& name, const std::vector<double>&
 
 void dataset(H5::Group& g, const std::string& name, const std::vector<double>& v);
 void dataset(H5::Group& g, const std::string& name, const std::vector<std::vector<double>>& rows);
+// A 2-D grid for drawing (e.g. |R(z)| over the complex plane): stored as float32 with
+// shuffle and deflate, a quarter of the doubles' size; readers get it converted back.
+void compressed_grid(H5::Group& g, const std::string& name, const std::vector<std::vector<double>>& rows);
 
 // A table under construction: columns of equal length, written as one compound dataset
 // (packed in the file; fields in the order added).
@@ -34,8 +37,8 @@ class table {
   void write(H5::Group& g, const std::string& dataset) const;
 
  private:
-  using column = std::variant<std::vector<double>, std::vector<std::int64_t>, std::vector<std::int8_t>,
-                              std::vector<std::string>>;
+  using column =
+      std::variant<std::vector<double>, std::vector<std::int64_t>, std::vector<std::int8_t>, std::vector<std::string>>;
   std::vector<std::pair<std::string, column>> columns_;
 };
 

@@ -23,5 +23,4 @@ std::vector<method_info> integrators();
 // Throws std::invalid_argument naming the unknown method and the known ones.
 const method_info& find_method(std::string_view name);
 
-
 }  // namespace stepbench

@@ -1,5 +1,7 @@
 #include "study/stability.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -9,8 +11,6 @@
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <fmt/format.h>
 
 #include "core/drive.hpp"
 #include "core/system.hpp"
@@ -125,8 +125,8 @@ struct complex_damper_problem {
                       p{"mass_kg", &complex_damper_problem::mass_kg, "kg", "mass"}};
   }
   std::string validate() const {
-    for (auto err : {require_finite("rate_re", rate_re), require_finite("rate_im", rate_im),
-                     require_positive("mass_kg", mass_kg)})
+    for (auto err :
+         {require_finite("rate_re", rate_re), require_finite("rate_im", rate_im), require_positive("mass_kg", mass_kg)})
       if (!err.empty()) return err;
     return {};
   }
@@ -293,8 +293,8 @@ stability_limit limit_of(const P& p, stability_test test, const stability_settin
   }
   if (e0 > s.rho_tol) {
     if (!(e0 > s.clear_factor * s.rho_tol)) {
-      out.note = fmt::format("rho - 1 = {:.3g} at y = {:g}: too close to the round-off allowance to classify", e0,
-                             ys.front());
+      out.note =
+          fmt::format("rho - 1 = {:.3g} at y = {:g}: too close to the round-off allowance to classify", e0, ys.front());
       return out;
     }
     out.unstable_for_all_dt = true;
@@ -318,9 +318,10 @@ stability_limit limit_of(const P& p, stability_test test, const stability_settin
         out.unconditionally_stable = true;
       } else {
         // Stable wherever the step exists: no verdict on the rest.
-        out.note = fmt::format("stable at every y of the scan where the step exists; the step fails at {} of {} "
-                               "scan points, from y = {:.4g} ({})",
-                               failures, ys.size(), out.step_failed_at, first_why);
+        out.note = fmt::format(
+            "stable at every y of the scan where the step exists; the step fails at {} of {} "
+            "scan points, from y = {:.4g} ({})",
+            failures, ys.size(), out.step_failed_at, first_why);
         return out;
       }
     }
@@ -473,8 +474,9 @@ void write_stability(H5::Group& root, const stability_data& d) {
   const auto& s = d.settings;
   H5::Group g = root.createGroup("stability");
   attr(g, "oscillator", "x'' = -omega^2 x as F = -m omega^2 x; y = omega dt; initial (x, v) = (1, 0)");
-  attr(g, "decay", "pure damper F = -m lambda v, so v' = -lambda v and x integrates v; y = lambda dt; initial "
-                   "(x, v) = (0, 1)");
+  attr(g, "decay",
+       "pure damper F = -m lambda v, so v' = -lambda v and x integrates v; y = lambda dt; initial "
+       "(x, v) = (0, 1)");
   attr(g, "adaptive_tolerance", always_accept_tolerance);
   attr(g, "y_min", s.y_min);
   attr(g, "y_max", s.y_max);
@@ -526,7 +528,7 @@ void write_stability(H5::Group& root, const stability_data& d) {
     for (std::size_t i = 0; i < r.im.size(); ++i)
       rows[i].assign(r.abs_r[k].begin() + static_cast<std::ptrdiff_t>(i * r.re.size()),
                      r.abs_r[k].begin() + static_cast<std::ptrdiff_t>((i + 1) * r.re.size()));
-    h5::dataset(regions, r.integrators[k], rows);
+    h5::compressed_grid(regions, r.integrators[k], rows);
   }
 }
 

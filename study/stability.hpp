@@ -21,11 +21,10 @@
 // `stepbench stability`.
 #include <H5Cpp.h>
 
+#include <Eigen/Core>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace stepbench {
 
@@ -107,7 +106,7 @@ struct stability_limit {
   // y is neither stable nor unstable: a method whose step fails somewhere gets neither
   // flag unless the runs and the scan decide without it.
   double step_failed_at = 0.0;
-  std::string note;  // what the scan and the long runs found, in words
+  std::string note;                                                  // what the scan and the long runs found, in words
   double rel_difference() const { return measured / theory - 1.0; }  // NaN unless both are finite
 };
 

@@ -1,11 +1,11 @@
 #include "study/study_file.hpp"
 
+#include <fmt/format.h>
 #include <unistd.h>
-
-#include <csignal>
 
 #include <cerrno>
 #include <cmath>
+#include <csignal>
 #include <cstring>
 #include <ctime>
 #include <filesystem>
@@ -13,10 +13,10 @@
 #include <stdexcept>
 #include <thread>
 
-#include <fmt/format.h>
-
 #include "build_info.hpp"
+#include "study/energy.hpp"
 #include "study/h5.hpp"
+#include "study/loop.hpp"
 #include "study/stability.hpp"
 #include "study/substeps.hpp"
 
@@ -174,6 +174,12 @@ void write_problem(H5::Group& parent, const problem_study& ps, bool timed) {
   attr(g, "has_closed_form", static_cast<int>(p.has_closed_form()));
   attr(g, "has_energy", static_cast<int>(p.has_energy()));
   attr(g, "has_jacobian", static_cast<int>(p.has_jacobian()));
+  attr(g, "has_angular_momentum", static_cast<int>(p.has_angular_momentum()));
+  attr(g, "angmom_scale", ps.truth.angmom_scale);
+  // Contacts: the mode, and the exact contacts up to the horizon (-1 and empty without).
+  attr(g, "contact_mode", std::string(p.contact_mode()));
+  attr(g, "contacts_exact", ps.truth.contact_count);
+  if (!ps.truth.contact_times.empty()) h5::dataset(g, "contact_times", ps.truth.contact_times);
   // Every method that runs on the problem, so a reader can tell a method that does not
   // apply (the baseline off its two problems) from one missing from a damaged file.
   std::string applies;
@@ -257,6 +263,14 @@ h5::table runs_table(const std::vector<method_row>& rows, bool timed) {
   t.add("err_pos_rms", col([](const method_row& r) { return r.metrics.err_pos_rms; }));
   t.add("energy_drift", col([](const method_row& r) { return r.metrics.energy_drift; }));
   t.add("energy_err_max", col([](const method_row& r) { return r.metrics.energy_err_max; }));
+  t.add("angmom_drift", col([](const method_row& r) { return r.metrics.angmom_drift; }));
+  t.add("angmom_err_max", col([](const method_row& r) { return r.metrics.angmom_err_max; }));
+  t.add("contacts", col([](const method_row& r) { return std::int64_t{r.metrics.contacts}; }));
+  t.add("contact_count_err", col([](const method_row& r) { return r.metrics.contact_count_err; }));
+  t.add("contact_time_err", col([](const method_row& r) { return r.metrics.contact_time_err; }));
+  t.add("contact_pos_err", col([](const method_row& r) { return r.metrics.contact_pos_err; }));
+  t.add("tunnelled", col([](const method_row& r) { return std::int64_t{r.metrics.tunnelled}; }));
+  t.add("max_penetration", col([](const method_row& r) { return r.metrics.max_penetration; }));
   t.add("diverged", col([](const method_row& r) { return static_cast<std::int8_t>(r.metrics.diverged); }));
   t.add("failed", col([](const method_row& r) { return static_cast<std::int8_t>(r.metrics.failed); }));
   t.add("skipped", col([](const method_row& r) { return static_cast<std::int8_t>(r.metrics.skipped); }));
@@ -284,10 +298,9 @@ std::vector<wp_method> work_precision_input(const problem_study& ps, const std::
   for (const auto& ms : ps.methods) {
     wp_method m{ms.info.name, ms.info.origin, ms.info.kind, {}};
     for (const auto& r : ms.rows)
-      m.rows.push_back({r.param, metric_value(r.metrics, metric), r.time.time_ns,
-                        static_cast<double>(r.work.force_evals),
-                        !r.metrics.diverged && !r.metrics.failed && !r.metrics.skipped,
-                        r.metrics.diverged, r.time.cut});
+      m.rows.push_back(
+          {r.param, metric_value(r.metrics, metric), r.time.time_ns, static_cast<double>(r.work.force_evals),
+           !r.metrics.diverged && !r.metrics.failed && !r.metrics.skipped, r.metrics.diverged, r.time.cut});
     out.push_back(std::move(m));
   }
   return out;
@@ -336,6 +349,7 @@ void write_study(const study& s, const std::string& path) {
     attr(file, "compiler", build_info::compiler);
     attr(file, "build_type", build_info::build_type);
     attr(file, "dependencies", build_info::dependencies);
+    attr(file, "build_flags", build_info::build_flags);
     attr(file, "created_utc", utc_now_iso8601());
     attr(file, "cpu", cpu_model());
     attr(file, "cores", static_cast<int>(std::thread::hardware_concurrency()));
@@ -347,6 +361,8 @@ void write_study(const study& s, const std::string& path) {
     attr(file, "reference_atol", s.options.tol.atol);
     attr(file, "fit_metric", "err_pos_max");
     attr(file, "divergence_factor", blowup_factor);
+    attr(file, "work_budget", s.options.limits.work_budget);
+    attr(file, "max_adaptive_steps", s.options.limits.max_steps);
     attr(file, "equal_error_targets", equal_error_targets());
     attr(file, "wall_seconds", s.wall_seconds);
     attr(file, "timing", static_cast<int>(s.timed.has_value()));
@@ -365,6 +381,8 @@ void write_study(const study& s, const std::string& path) {
     H5::Group problems = file.createGroup("problems");
     for (const auto& ps : s.problems) write_problem(problems, ps, s.timed.has_value());
     write_substeps(file, s.substeps, s.timed.has_value());
+    write_loop(file, s);           // /loop: the game-loop study (study/loop.hpp), when the study holds one
+    write_energy(file, s.energy);  // /energy: the long-run energy study (study/energy.hpp)
     file.close();
   } catch (const H5::Exception& e) {
     std::remove(tmp.c_str());

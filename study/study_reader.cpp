@@ -1,12 +1,11 @@
 #include "study/study_reader.hpp"
 
 #include <H5Cpp.h>
+#include <fmt/format.h>
 
 #include <cmath>
 #include <filesystem>
 #include <stdexcept>
-
-#include <fmt/format.h>
 
 #include "study/h5.hpp"
 #include "study/study_file.hpp"
@@ -41,7 +40,8 @@ study_method read_method(const H5::Group& g, const std::string& name) {
   m.fit_levels = h5::int_array_attr(g, "fit_levels");
   if (!h5::is_dataset(g, "runs")) throw std::runtime_error(fmt::format("missing dataset 'runs' in {}", g.getObjName()));
   const H5::DataSet ds = g.openDataSet("runs");
-  if (ds.getTypeClass() != H5T_COMPOUND) throw std::runtime_error(fmt::format("{}/runs is not a table", g.getObjName()));
+  if (ds.getTypeClass() != H5T_COMPOUND)
+    throw std::runtime_error(fmt::format("{}/runs is not a table", g.getObjName()));
   const H5::CompType type = ds.getCompType();
   for (int i = 0; i < type.getNmembers(); ++i) {
     const std::string field = type.getMemberName(i);
@@ -88,7 +88,8 @@ study_problem read_problem(const H5::Group& g, const std::string& name) {
                               h5::double_attr(r, "err_vel_rel"), h5::long_attr(r, "is_truth") != 0});
     }
   }
-  if (!h5::is_group(g, "methods")) throw std::runtime_error(fmt::format("missing group 'methods' in {}", g.getObjName()));
+  if (!h5::is_group(g, "methods"))
+    throw std::runtime_error(fmt::format("missing group 'methods' in {}", g.getObjName()));
   const H5::Group methods = g.openGroup("methods");
   for (const auto& m : h5::children(methods)) p.methods.push_back(read_method(methods.openGroup(m), m));
   return p;
@@ -149,9 +150,20 @@ study_data read_study(const std::string& path) {
       }
     }
     out.timed = h5::long_attr(file, "timing") != 0;
+    if (h5::is_group(file, "stability")) {
+      const H5::Group g = file.openGroup("stability");
+      if (!h5::is_dataset(g, "limits")) throw fail("missing dataset /stability/limits");
+      const H5::DataSet ds = g.openDataSet("limits");
+      const auto integrator = h5::read_strings(ds, "integrator"), test = h5::read_strings(ds, "test");
+      const auto theory = h5::read_doubles(ds, "theory"), measured = h5::read_doubles(ds, "measured");
+      const auto all = h5::read_ints(ds, "unstable_for_all_dt"), uncond = h5::read_ints(ds, "unconditionally_stable");
+      for (std::size_t i = 0; i < integrator.size(); ++i)
+        out.stability.push_back({integrator[i], test[i], theory[i], measured[i], all[i] != 0, uncond[i] != 0});
+    }
     if (!h5::is_group(file, "problems")) throw fail("missing group 'problems'");
     const H5::Group problems = file.openGroup("problems");
-    for (const auto& name : h5::children(problems)) out.problems.push_back(read_problem(problems.openGroup(name), name));
+    for (const auto& name : h5::children(problems))
+      out.problems.push_back(read_problem(problems.openGroup(name), name));
   } catch (const H5::Exception& e) {
     throw fail(fmt::format("HDF5: {} (truncated or corrupt?)", e.getDetailMsg()));
   } catch (const std::runtime_error& e) {

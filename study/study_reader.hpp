@@ -45,6 +45,13 @@ struct study_problem {
   const study_method* find(const std::string& method) const;
 };
 
+// One row of /stability/limits.
+struct study_stability_limit {
+  std::string integrator, test;
+  double theory = 0.0, measured = 0.0;  // NaN where they do not apply
+  bool unstable_for_all_dt = false, unconditionally_stable = false;
+};
+
 struct study_data {
   std::string path;
   long format_version = 0;
@@ -52,6 +59,7 @@ struct study_data {
   std::map<std::string, double> settings;   // numeric scalar root attributes (cores, levels, base_steps, ...)
   bool timed = false;
   std::vector<study_problem> problems;
+  std::vector<study_stability_limit> stability;  // empty when the file has no /stability
   const study_problem* find(const std::string& problem) const;
 };
 

@@ -1,9 +1,9 @@
 #include "study/substeps.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <limits>
-
-#include <fmt/format.h>
 
 #include "core/work_precision.hpp"
 #include "study/h5.hpp"
@@ -47,18 +47,21 @@ std::string damping_text(double d) {
 std::string describe(const substep_verdict& v) {
   const bool by_time = v.cost_kind == "time_ns";
   auto cost = [&](double c) { return by_time ? format_time_ns(c) : fmt::format("{:.0f} force evaluations", c); };
-  std::string s = fmt::format("{}: one {} step a frame costs {} for a max position error of {:.3g} and {}; ", v.problem,
-                              v.implicit_method, cost(v.implicit_cost), v.implicit_error, damping_text(v.implicit_damping));
+  std::string s =
+      fmt::format("{}: one {} step a frame costs {} for a max position error of {:.3g} and {}; ", v.problem,
+                  v.implicit_method, cost(v.implicit_cost), v.implicit_error, damping_text(v.implicit_damping));
   if (v.substeps_at_equal_cost == 0) {
     s += fmt::format("even one {} step costs more", v.explicit_method);
   } else if (!std::isfinite(v.explicit_error)) {
-    s += fmt::format("at that cost {} affords {} substep{}, which diverge{}", v.explicit_method, v.substeps_at_equal_cost,
-                     v.substeps_at_equal_cost == 1 ? "" : "s", v.substeps_at_equal_cost == 1 ? "s" : "");
+    s += fmt::format("at that cost {} affords {} substep{}, which diverge{}", v.explicit_method,
+                     v.substeps_at_equal_cost, v.substeps_at_equal_cost == 1 ? "" : "s",
+                     v.substeps_at_equal_cost == 1 ? "s" : "");
   } else {
     s += fmt::format("at that cost {} affords {} substeps: error {:.3g} ({}) and {}", v.explicit_method,
                      v.substeps_at_equal_cost, v.explicit_error,
-                     v.explicit_error < v.implicit_error ? fmt::format("{:.3g}x smaller", v.implicit_error / v.explicit_error)
-                                                         : fmt::format("{:.3g}x larger", v.explicit_error / v.implicit_error),
+                     v.explicit_error < v.implicit_error
+                         ? fmt::format("{:.3g}x smaller", v.implicit_error / v.explicit_error)
+                         : fmt::format("{:.3g}x larger", v.explicit_error / v.implicit_error),
                      damping_text(v.explicit_damping));
   }
   if (v.substeps_to_match > 0)
@@ -79,13 +82,14 @@ std::vector<substep_study> run_substeps(const study& s, const substep_options& o
     st.problem = ps.problem->name();
     st.frame_dt = ps.horizon / opts.frames;
     for (const auto& info : ps.problem->methods()) {
-      const bool is_implicit =
-          std::find(opts.implicit_methods.begin(), opts.implicit_methods.end(), info.name) != opts.implicit_methods.end();
-      const bool is_explicit =
-          std::find(opts.explicit_methods.begin(), opts.explicit_methods.end(), info.name) != opts.explicit_methods.end();
+      const bool is_implicit = std::find(opts.implicit_methods.begin(), opts.implicit_methods.end(), info.name) !=
+                               opts.implicit_methods.end();
+      const bool is_explicit = std::find(opts.explicit_methods.begin(), opts.explicit_methods.end(), info.name) !=
+                               opts.explicit_methods.end();
       if (!is_implicit && !is_explicit) continue;
       substep_method m{info, {}};
-      for (int n : is_implicit ? std::vector<int>{1} : opts.counts) m.rows.push_back(run_one(ps, info.name, n, st.frame_dt, s.options));
+      for (int n : is_implicit ? std::vector<int>{1} : opts.counts)
+        m.rows.push_back(run_one(ps, info.name, n, st.frame_dt, s.options));
       st.methods.push_back(std::move(m));
     }
     out.push_back(std::move(st));
@@ -169,7 +173,8 @@ void write_substeps(H5::Group& root, const std::vector<substep_study>& studies, 
     v.add("implicit_cost", col([](const substep_verdict& x) { return x.implicit_cost; }));
     v.add("implicit_error", col([](const substep_verdict& x) { return x.implicit_error; }));
     v.add("implicit_damping", col([](const substep_verdict& x) { return x.implicit_damping; }));
-    v.add("substeps_at_equal_cost", col([](const substep_verdict& x) { return std::int64_t{x.substeps_at_equal_cost}; }));
+    v.add("substeps_at_equal_cost",
+          col([](const substep_verdict& x) { return std::int64_t{x.substeps_at_equal_cost}; }));
     v.add("explicit_cost", col([](const substep_verdict& x) { return x.explicit_cost; }));
     v.add("explicit_error", col([](const substep_verdict& x) { return x.explicit_error; }));
     v.add("explicit_damping", col([](const substep_verdict& x) { return x.explicit_damping; }));

@@ -10,10 +10,10 @@
 // run, max_j (E_true(t_j) - E(t_j)) / energy_scale. At equal cost per frame (the
 // measured time when the study is timed, else force evaluations), the verdict says how
 // many substeps the implicit step's cost buys and what they achieve.
+#include <H5Cpp.h>
+
 #include <string>
 #include <vector>
-
-#include <H5Cpp.h>
 
 #include "study/sweep.hpp"
 
@@ -27,11 +27,12 @@ std::vector<substep_study> run_substeps(const study& s, const substep_options& o
 struct substep_verdict {
   std::string problem, implicit_method, explicit_method, cost_kind;  // cost_kind: time_ns or force_evals
   double implicit_cost = 0.0, implicit_error = 0.0, implicit_damping = 0.0;
-  int substeps_at_equal_cost = 0;  // the most substeps that cost no more than the implicit step (0: even one costs more)
+  int substeps_at_equal_cost =
+      0;  // the most substeps that cost no more than the implicit step (0: even one costs more)
   double explicit_cost = 0.0, explicit_error = 0.0, explicit_damping = 0.0;  // at that n (NaN if 0)
-  int substeps_to_match = 0;       // the fewest substeps whose error is at most the implicit step's (0: none)
-  double cost_to_match = 0.0;      // their cost (NaN if none)
-  std::string summary;             // one line, as measured
+  int substeps_to_match = 0;   // the fewest substeps whose error is at most the implicit step's (0: none)
+  double cost_to_match = 0.0;  // their cost (NaN if none)
+  std::string summary;         // one line, as measured
 };
 std::vector<substep_verdict> substep_verdicts(const substep_study& s, bool timed);
 

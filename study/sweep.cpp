@@ -1,11 +1,11 @@
 #include "study/sweep.hpp"
 
+#include <fmt/format.h>
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
-
-#include <fmt/format.h>
 
 #include "core/drive.hpp"
 #include "study/substeps.hpp"
@@ -52,7 +52,7 @@ void validate(const sweep_options& opts) {
     throw std::invalid_argument(fmt::format(
         "the ladder's finest level would take {:.3g} steps (base_steps 2^(levels-1)); the limit is 1e8", finest));
   for (const auto& [name, params] : opts.overrides) {
-    auto problem = make_problem(name);  // throws, naming an unknown problem
+    auto problem = make_problem(name);                                     // throws, naming an unknown problem
     for (const auto& [param, value] : params) problem->set(param, value);  // throws for an unknown parameter
     if (!opts.problems.empty() && !contains(opts.problems, name))
       throw std::invalid_argument(fmt::format("--set names problem {}, which is not in the sweep", name));
@@ -70,7 +70,8 @@ void validate(const sweep_options& opts) {
 
 std::vector<double> dt_ladder(double horizon, const sweep_options& opts) {
   std::vector<double> out;
-  for (int k = 0; k < opts.levels; ++k) out.push_back(horizon / (static_cast<double>(opts.base_steps) * std::ldexp(1.0, k)));
+  for (int k = 0; k < opts.levels; ++k)
+    out.push_back(horizon / (static_cast<double>(opts.base_steps) * std::ldexp(1.0, k)));
   return out;
 }
 
@@ -105,9 +106,11 @@ method_study run_method(const problem_study& ps, const method_info& m, const swe
       const double nan = std::numeric_limits<double>::quiet_NaN();
       auto& mt = row.metrics;
       mt.err_pos_final = mt.err_vel_final = mt.err_pos_max = mt.err_pos_rms = mt.energy_drift = mt.energy_err_max = nan;
+      mt.angmom_drift = mt.angmom_err_max = mt.contact_count_err = mt.contact_time_err = mt.contact_pos_err = nan;
       mt.skipped = true;
-      mt.note = fmt::format("skipped: about {:.3g} force evaluations x {:g} coordinates exceed the work budget of {:.3g}",
-                            2.0 * static_cast<double>(ms.rows.back().work.force_evals), dim, opts.limits.work_budget);
+      mt.note =
+          fmt::format("skipped: about {:.3g} force evaluations x {:g} coordinates exceed the work budget of {:.3g}",
+                      2.0 * static_cast<double>(ms.rows.back().work.force_evals), dim, opts.limits.work_budget);
       ms.rows.push_back(std::move(row));
       continue;
     }
@@ -131,7 +134,7 @@ study run_sweep(const sweep_options& opts) {
     ps.horizon = ps.problem->horizon();
     ps.truth = build_truth(*ps.problem, sample_times(ps.horizon, opts.sample_count), {.tol = opts.tol});
     for (const auto& r : ps.truth.references)
-      if (r.status != "ok")
+      if (r.status != "ok" && r.status != "unsupported")
         std::fprintf(stderr, "warning: %s: reference %s %s: %s\n", name.c_str(), r.source.c_str(), r.status.c_str(),
                      r.reason.c_str());
     if (!ps.truth.trusted)
@@ -145,6 +148,17 @@ study run_sweep(const sweep_options& opts) {
     out.problems.push_back(std::move(ps));
   }
   out.substeps = run_substeps(out, opts.substeps);
+  loop_options loop = opts.loop;
+  loop.progress = opts.progress;
+  out.loop = run_loop_study(out, loop);
+  // The energy study on the selected problems and methods only.
+  energy_options energy = opts.energy;
+  energy.progress = opts.progress;
+  if (!opts.problems.empty())
+    std::erase_if(energy.scenes, [&](const energy_scene& e) { return !contains(opts.problems, e.problem); });
+  if (energy.methods.empty()) energy.methods = opts.methods;
+  if (energy.scenes.empty()) energy.enabled = false;
+  out.energy = run_energy_study(energy, opts.overrides);
   out.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }
@@ -156,14 +170,15 @@ std::vector<std::string> failed_cases(const study& s) {
     for (const auto& ms : ps.methods)
       for (const auto& r : ms.rows)
         if (r.metrics.failed)
-          out.push_back(fmt::format("{}/{} at {} {:g}: {}", ps.problem->name(), ms.info.name,
-                                    param_name(ms.info.kind), r.param, r.metrics.note));
+          out.push_back(fmt::format("{}/{} at {} {:g}: {}", ps.problem->name(), ms.info.name, param_name(ms.info.kind),
+                                    r.param, r.metrics.note));
   }
   for (const auto& st : s.substeps)
     for (const auto& m : st.methods)
       for (const auto& r : m.rows)
         if (r.row.metrics.failed)
-          out.push_back(fmt::format("substeps/{}/{} at n = {}: {}", st.problem, m.info.name, r.substeps, r.row.metrics.note));
+          out.push_back(
+              fmt::format("substeps/{}/{} at n = {}: {}", st.problem, m.info.name, r.substeps, r.row.metrics.note));
   return out;
 }
 

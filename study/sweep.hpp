@@ -13,6 +13,8 @@
 #include "core/convergence_fit.hpp"
 #include "core/measure.hpp"
 #include "core/method.hpp"
+#include "study/energy.hpp"
+#include "study/loop.hpp"
 #include "study/registry.hpp"
 
 namespace stepbench {
@@ -35,14 +37,16 @@ struct sweep_options {
   std::vector<std::string> methods;   // empty: all that run on each problem
   // Parameter overrides per problem: overrides["pendulum"]["theta0_deg"] = 30.
   std::map<std::string, std::map<std::string, double>> overrides;
-  int levels = 12;       // dt ladder length (at least 8 for the default study)
-  int base_steps = 32;   // steps at the coarsest level; dt_k = T / (base_steps 2^k)
-  int sample_count = 32; // fixed sample times j T / sample_count; must divide base_steps
+  int levels = 12;        // dt ladder length (at least 8 for the default study)
+  int base_steps = 32;    // steps at the coarsest level; dt_k = T / (base_steps 2^k)
+  int sample_count = 32;  // fixed sample times j T / sample_count; must divide base_steps
   std::vector<double> tolerances = tolerance_ladder();
   reference_tolerances tol{};
-  run_limits limits{};    // the work budget of one run (core/method.hpp)
+  run_limits limits{};         // the work budget of one run (core/method.hpp)
   substep_options substeps{};  // the small-steps comparison (study/substeps.hpp)
-  bool progress = false;  // one line per problem on stderr
+  loop_options loop{};         // the game-loop study (study/loop.hpp)
+  energy_options energy{};     // the long-run energy study (study/energy.hpp)
+  bool progress = false;       // one line per problem on stderr
 };
 
 // Wall time of one whole run, from the benchmark (absent unless timed).
@@ -67,7 +71,7 @@ struct method_row {
 struct method_study {
   method_info info;
   std::vector<method_row> rows;
-  fit_result fit;  // against dt (fixed-step) or against the tolerance (adaptive)
+  fit_result fit;                 // against dt (fixed-step) or against the tolerance (adaptive)
   int declared_order_holds = -1;  // see core/convergence_fit.hpp
 };
 
@@ -92,7 +96,7 @@ struct timing_settings {
 
 struct substep_row {
   int substeps = 1;
-  method_row row;          // param = dt = frame / substeps
+  method_row row;              // param = dt = frame / substeps
   double extra_damping = 0.0;  // max_j (E_true - E) / energy_scale; NaN without energy or when not completed
 };
 
@@ -111,6 +115,8 @@ struct study {
   sweep_options options;
   std::vector<problem_study> problems;
   std::vector<substep_study> substeps;
+  loop_study loop;      // empty when the options disable it or name none of the problems
+  energy_study energy;  // empty when the options disable it
   double wall_seconds = 0.0;
   std::optional<timing_settings> timed;
 };

@@ -8,7 +8,6 @@
 
 #include <cmath>
 #include <fstream>
-
 #include <nlohmann/json.hpp>
 
 #include "study/sweep.hpp"
@@ -59,11 +58,14 @@ TEST(accuracy_fixture, our_rows_are_bit_identical) {
       EXPECT_TRUE(same_bits(got.param, number(r["dt"]))) << key << " row " << i;
       EXPECT_EQ(got.steps, r["steps"].get<long>()) << key << " row " << i;
       EXPECT_EQ(got.work.force_evals, r["force_evals"].get<long>()) << key << " row " << i;
-      for (const auto& [field, value] : {std::pair{"err_pos_final", m.err_pos_final}, {"err_vel_final", m.err_vel_final},
-                                         {"err_pos_max", m.err_pos_max}, {"err_pos_rms", m.err_pos_rms},
-                                         {"energy_drift", m.energy_drift}, {"energy_err_max", m.energy_err_max}}) {
-        EXPECT_TRUE(same_bits(value, number(r[field]))) << key << " row " << i << " " << field << ": " << value
-                                                        << " != " << number(r[field]);
+      for (const auto& [field, value] : {std::pair{"err_pos_final", m.err_pos_final},
+                                         {"err_vel_final", m.err_vel_final},
+                                         {"err_pos_max", m.err_pos_max},
+                                         {"err_pos_rms", m.err_pos_rms},
+                                         {"energy_drift", m.energy_drift},
+                                         {"energy_err_max", m.energy_err_max}}) {
+        EXPECT_TRUE(same_bits(value, number(r[field])))
+            << key << " row " << i << " " << field << ": " << value << " != " << number(r[field]);
         ++compared;
       }
       EXPECT_EQ(m.diverged, r["diverged"].get<int>() != 0) << key << " row " << i;

@@ -2,17 +2,15 @@
 // small studies written to temporary files and changed one figure at a time, either in
 // the file (a field of one `runs` row rewritten with the HDF5 API) or in the study before
 // it is written.
-#include <gtest/gtest.h>
-
 #include <H5Cpp.h>
+#include <fmt/format.h>
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-
-#include <fmt/format.h>
 
 #include "study/compare.hpp"
 #include "study/study_file.hpp"
@@ -249,7 +247,7 @@ TEST_F(compare_test, newly_skipped_row) {
   ASSERT_EQ(c.count(change_kind::regression), 1u) << format_text(c);
   EXPECT_EQ(c.changes[0].what, "skipped");
   EXPECT_EQ(c.changes[0].param, ma.col("param").back());
-  mb.columns.erase("skipped");  // one file without the field: not compared
+  mb.columns.erase("skipped");                                          // one file without the field: not compared
   EXPECT_EQ(compare_studies(a, b).count(change_kind::regression), 1u);  // the NaN error of a row that completed
 }
 

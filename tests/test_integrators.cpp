@@ -40,13 +40,23 @@ TEST(integrators, one_step_matches_taylor_series_to_order) {
   damped_spring p;
   p.k_s = 1.0;
   p.k_d = 0.0;
-  const double dt = 1e-2;
+  auto one_step_error = [&]<class I>(double dt) {
+    const auto s = drive(p, I{}, dt, dt, no_records).final_state;
+    return std::abs(s.x[0] - std::cos(dt)) + std::abs(s.v[0] + std::sin(dt));
+  };
   for_each_type(all_integrators{}, [&]<class I>() {
     if constexpr (integrator<I>) {
-      const auto s = drive(p, I{}, dt, dt, no_records).final_state;
-      const double err = std::abs(s.x[0] - std::cos(dt)) + std::abs(s.v[0] + std::sin(dt));
-      EXPECT_LT(err, 2.0 * std::pow(dt, I::order + 1)) << I::name;
-      EXPECT_GT(err, 1e-3 * std::pow(dt, I::order + 2)) << I::name << " is suspiciously better than its order";
+      if constexpr (I::order < 6) {
+        const double dt = 1e-2;
+        const double err = one_step_error.template operator()<I>(dt);
+        EXPECT_LT(err, 2.0 * std::pow(dt, I::order + 1)) << I::name;
+        EXPECT_GT(err, 1e-3 * std::pow(dt, I::order + 2)) << I::name << " is suspiciously better than its order";
+      } else {
+        // An eighth-order step is at round-off by dt = 0.1 on this problem; the local
+        // order shows as the slope between two large steps instead.
+        const double e1 = one_step_error.template operator()<I>(0.8), e2 = one_step_error.template operator()<I>(0.4);
+        EXPECT_NEAR(std::log2(e1 / e2), I::order + 1, 0.5) << I::name << ": " << e1 << " " << e2;
+      }
     }
   });
 }
@@ -91,10 +101,10 @@ TEST(drive, record_plan_on_and_off_the_grid) {
   const auto r = drive(p, euler{}, 1.0, 10.0, plan);
   ASSERT_EQ(r.sample_t.size(), 3u);
   EXPECT_DOUBLE_EQ(r.sample_t[1], 2.5);
-  EXPECT_DOUBLE_EQ(r.samples(0, 0), 10.0);        // x(2): 0 + 10
+  EXPECT_DOUBLE_EQ(r.samples(0, 0), 10.0);         // x(2): 0 + 10
   EXPECT_DOUBLE_EQ(r.samples(0, 1), 10.0 + 10.0);  // + v(2) 0.5 = 20 * 0.5
-  EXPECT_EQ(r.steps, 10);                           // grid steps; the split step counts once
-  EXPECT_EQ(r.work.force_evals, 11);                // one evaluation more for the split
+  EXPECT_EQ(r.steps, 10);                          // grid steps; the split step counts once
+  EXPECT_EQ(r.work.force_evals, 11);               // one evaluation more for the split
   // Record times must increase within (0, horizon].
   EXPECT_THROW(plan_records(10.0, 1.0, std::vector<double>{2.0, 1.0}), std::invalid_argument);
   EXPECT_THROW(plan_records(10.0, 1.0, std::vector<double>{11.0}), std::invalid_argument);
@@ -134,7 +144,8 @@ TEST(integrators, hand_scheduled_steps_equal_their_tableaux) {
       k.combine(tableau.b, dt, dt * inverse_mass(sys), s0.x, s0.v, x1, v1);
       const double scale = s0.x.norm() + dt * s0.v.norm() + dt * dt * f0.norm() / sys.mass();
       EXPECT_LE((s.x - x1).norm(), 8 * std::numeric_limits<double>::epsilon() * scale) << name << " dt " << dt;
-      EXPECT_LE((s.v - v1).norm(), 8 * std::numeric_limits<double>::epsilon() * (s0.v.norm() + dt * f0.norm() / sys.mass()))
+      EXPECT_LE((s.v - v1).norm(),
+                8 * std::numeric_limits<double>::epsilon() * (s0.v.norm() + dt * f0.norm() / sys.mass()))
           << name << " dt " << dt;
     }
   };

@@ -117,8 +117,8 @@ TEST_P(reference_source, counters_are_consistent) {
 TEST(gsl_rk8pd, rhs_call_identity) {
   long total_failed = 0;
   for (const auto& sys : {undamped(), damped(), kicked()}) {
-    for (const reference_tolerances tol : {reference_tolerances{}, reference_tolerances{1e-8, 1e-10},
-                                           reference_tolerances{1e-5, 1e-7}}) {
+    for (const reference_tolerances tol :
+         {reference_tolerances{}, reference_tolerances{1e-8, 1e-10}, reference_tolerances{1e-5, 1e-7}}) {
       const auto s = solve_gsl_rk8pd(sys, output_times(), tol).stats;
       EXPECT_EQ(s.rhs_evals_counted, 1 + 13 * (s.steps + s.failed_steps))
           << "rtol " << tol.rtol << ": steps " << s.steps << ", failed " << s.failed_steps;
@@ -205,9 +205,9 @@ TEST(references, cost_is_sane_on_damped_oscillator) {
   const auto ts = output_times();
   for (const char* src : reference_sources) {
     const auto s = solve_reference(src, damped(), ts).stats;
-    std::cout << "  " << src << ": steps " << s.steps << ", failed " << s.failed_steps << ", rhs_evals "
-              << s.rhs_evals << ", lin_rhs_evals " << s.lin_rhs_evals << ", jac_evals " << s.jac_evals
-              << ", rhs_evals_counted " << s.rhs_evals_counted << ", wall " << s.wall_seconds << " s\n";
+    std::cout << "  " << src << ": steps " << s.steps << ", failed " << s.failed_steps << ", rhs_evals " << s.rhs_evals
+              << ", lin_rhs_evals " << s.lin_rhs_evals << ", jac_evals " << s.jac_evals << ", rhs_evals_counted "
+              << s.rhs_evals_counted << ", wall " << s.wall_seconds << " s\n";
     const std::string name = src;
     EXPECT_LT(s.steps, name == "gsl_rk8pd" ? 20'000 : 100'000) << name;
   }

@@ -37,6 +37,9 @@ TEST(sweep, observed_orders_match_expected) {
     const auto& ps = find(default_study(), name);
     for (const auto& ms : ps.methods) {
       if (ms.info.origin != method_origin::ours || ms.info.kind != method_kind::fixed_step) continue;
+      // Eighth-order methods reach round-off within two levels of the ladder; their bar
+      // (0.3, on stated levels) is in test_high_order.cpp.
+      if (ms.info.declared_order >= 6) continue;
       ASSERT_EQ(ms.fit.state, fit_result::status::fitted) << name << "/" << ms.info.name << ": " << ms.fit.note;
       EXPECT_NEAR(ms.fit.order, ms.info.declared_order, 0.15) << name << "/" << ms.info.name;
       EXPECT_GE(ms.fit.levels.size(), 3u) << name << "/" << ms.info.name;
@@ -222,9 +225,13 @@ TEST(sweep, divergence_follows_the_stability_limit) {
       EXPECT_FALSE(row.metrics.diverged) << "dt " << row.param;
     }
   }
-  // No stable method of ours diverges anywhere on the gentle problems.
+  // No stable method of ours diverges anywhere on the gentle problems (the linear and
+  // near-linear ones whose stability limit the ladder respects; the stiff scenes, the orbit
+  // at eccentricity 0.9 and the contact problems are past some method's limit on purpose).
   for (const auto& p : default_study().problems) {
-    if (p.problem->name() == "stiff_spring" || p.problem->name() == "spring_chain") continue;
+    const auto name = p.problem->name();
+    if (name != "constant_acceleration" && name != "projectile" && name != "damped_spring" && name != "pendulum")
+      continue;
     for (const auto& ms : p.methods) {
       if (ms.info.name == "euler" || ms.info.origin != method_origin::ours) continue;
       for (const auto& row : ms.rows)

@@ -2,15 +2,13 @@
 // reason, the cost switch between time and force evaluations, the stability margin, the
 // baseline shown but never the answer, the Pareto front; and `stepbench advise` reading
 // it back from a real study file written by the sweep.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-
-#include <fmt/format.h>
 
 #include "core/work_precision.hpp"
 #include "study/advise.hpp"
@@ -36,8 +34,8 @@ wp_method method(std::string name, std::vector<wp_row> rows, method_origin origi
 std::vector<wp_method> untimed() {
   return {method("first", {row(0.4, 10, 0.4), row(0.2, 20, 0.2), row(0.1, 40, 0.1), row(0.05, 80, 0.05)}),
           method("second", {row(0.4, 20, 1e-1), row(0.2, 40, 2.5e-2), row(0.1, 80, 6e-3), row(0.05, 160, 1.5e-3)}),
-          method("fourth", {row(0.4, 40, 0, NAN, false, true), row(0.2, 80, 1e-3), row(0.1, 160, 6e-5),
-                            row(0.05, 320, 4e-6)})};
+          method("fourth",
+                 {row(0.4, 40, 0, NAN, false, true), row(0.2, 80, 1e-3), row(0.1, 160, 6e-5), row(0.05, 320, 4e-6)})};
 }
 
 const wp_exclusion* excluded(const cheapest_result& r, const std::vector<wp_method>& ms, std::string_view name) {
@@ -136,7 +134,8 @@ TEST(work_precision, the_baseline_is_never_the_answer) {
 }
 
 TEST(work_precision, adaptive_methods_report_a_tolerance) {
-  const std::vector<wp_method> ms{method("cvode_bdf", {row(1e-4, 300, 2e-3), row(1e-6, 900, 3e-5), row(1e-8, 2000, 4e-7)},
+  const std::vector<wp_method> ms{method("cvode_bdf",
+                                         {row(1e-4, 300, 2e-3), row(1e-6, 900, 3e-5), row(1e-8, 2000, 4e-7)},
                                          method_origin::peer, method_kind::adaptive)};
   const auto r = cheapest(ms, 1e-4, false, "err_pos_max", "m");
   ASSERT_EQ(r.ranked.size(), 1u);
@@ -151,8 +150,8 @@ TEST(work_precision, pareto_front) {
   // 160 (fourth 6e-5), 320 (fourth 4e-6).
   std::vector<std::pair<std::string, double>> got;
   for (const auto& p : front) got.emplace_back(ms[p.method].name, p.error);
-  const std::vector<std::pair<std::string, double>> want{{"first", 0.4},    {"second", 0.1},    {"second", 2.5e-2},
-                                                         {"fourth", 1e-3},  {"fourth", 6e-5},   {"fourth", 4e-6}};
+  const std::vector<std::pair<std::string, double>> want{{"first", 0.4},   {"second", 0.1},  {"second", 2.5e-2},
+                                                         {"fourth", 1e-3}, {"fourth", 6e-5}, {"fourth", 4e-6}};
   EXPECT_EQ(got, want);
 }
 
@@ -173,7 +172,8 @@ TEST(advise, reads_a_study_file) {
   double best_evals = INFINITY;
   std::string best_name;
   for (const auto& ms : s.problems.front().methods) {
-    const auto it = std::find_if(a.methods.begin(), a.methods.end(), [&](const auto& m) { return m.name == ms.info.name; });
+    const auto it =
+        std::find_if(a.methods.begin(), a.methods.end(), [&](const auto& m) { return m.name == ms.info.name; });
     ASSERT_NE(it, a.methods.end()) << ms.info.name;
     ASSERT_EQ(it->rows.size(), ms.rows.size());
     for (std::size_t k = 0; k < ms.rows.size(); ++k) {

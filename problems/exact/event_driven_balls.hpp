@@ -120,6 +120,7 @@
 // conserved here to 1e-12 relative, measured 3e-16), momentum in ball-ball contacts,
 // counts and rates of contacts, the time for all balls to come to rest (k_r < 1), or
 // distributions (height, speed) over the run.
+#include <Eigen/Core>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -131,8 +132,6 @@
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace stepbench::exact {
 

@@ -5,6 +5,9 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 
 from . import figures, render, tables
+from . import energy_runs as energy_section
+from . import loop as loop_section
+from . import substeps as substeps_section
 from .tables import fmt_num
 
 TITLE = "stepbench report: accuracy, stability and cost of time integrators"
@@ -36,9 +39,15 @@ def _figure_jobs(study, figdir):
     if study.timed:
         jobs.append(("wp", "time", os.path.join(figdir, "work_precision_time.png")))
     jobs.append(("energy", None, os.path.join(figdir, "energy_drift.png")))
+    if study.energy_runs is not None:
+        jobs.append(("energy_runs", None, os.path.join(figdir, "energy_long_runs.png")))
     jobs += [("convergence", p.name, os.path.join(figdir, f"convergence_{p.name}.png")) for p in study.problems]
     if study.stability is not None:
         jobs.append(("stability", None, os.path.join(figdir, "stability_regions.png")))
+    if study.substeps is not None:
+        jobs.append(("substeps", None, os.path.join(figdir, substeps_section.FIGURE)))
+    if study.loop is not None:
+        jobs.append(("loop", None, os.path.join(figdir, "loop_shown_error.png")))
     return jobs
 
 
@@ -63,6 +72,12 @@ def _draw(job):
             return None
     elif kind == "stability":
         figures.stability(study.stability, styles, path)
+    elif kind == "loop":
+        loop_section.figure(study.loop, styles, path)
+    elif kind == "energy_runs":
+        energy_section.figure(study.energy_runs, styles, path)
+    elif kind == "substeps":
+        substeps_section.figure(study.substeps, styles, path)
     return path
 
 
@@ -98,13 +113,9 @@ def document(study, figs):
     _convergence(doc, study, figs)
     _work_precision(doc, study)
     _stability(doc, study, figs)
+    substeps_section.section(doc, study, figs)
     _energy(doc, study, figs)
-    doc.h(2, "Game loop")
-    gl = study.optional.get("game_loop")
-    if gl:
-        _generic_section(doc, gl)
-    else:
-        doc.note("Game-loop figures: absent (this study has no game-loop data).")
+    loop_section.section(doc, study, figs)
     _references(doc, study)
     return doc
 
@@ -264,13 +275,8 @@ def _stability(doc, study, figs):
 
 def _energy(doc, study, figs):
     doc.h(2, "Energy")
-    runs = study.optional.get("energy_runs")
-    if runs:
-        doc.h(3, runs["title"])
-        _generic_section(doc, runs)
-    else:
-        doc.note("Energy drift over time on long runs: absent (this study has no long runs). Shown instead: the "
-                 "energy error at the horizon of every run of our fixed-step methods.")
+    energy_section.section(doc, study, figs)
+    doc.h(3, "Energy at the horizon of every study run")
     if "energy_drift.png" in figs:
         doc.img("fig/energy_drift.png", "energy drift at the horizon")
 

@@ -13,6 +13,10 @@ from dataclasses import dataclass, field
 import h5py
 import numpy as np
 
+from . import energy_runs as energy_section
+from . import loop as loop_section
+from . import substeps as substeps_section
+
 FORMAT_VERSION = 2  # the only format_version this report reads
 
 # What docs/study-format.md documents, and the report reads, at each level.
@@ -58,13 +62,13 @@ LIMIT_FIELDS = ("integrator", "test", "measured", "theory", "rel_difference", "u
                 "unconditionally_stable", "run_confirms", "step_failed_at", "note")
 STABILITY_TESTS = ("oscillator", "decay")
 
-# Root groups that later issues will add (long energy runs, game-loop figures). Their
-# layout is not defined yet; when a root group of one of these names exists the report
-# shows a generic section for it.
+# Root groups that later issues will add (long energy runs). Their layout is not defined
+# yet; when a root group of one of these names exists the report shows a generic section
+# for it. (The game loop's is: /loop, read by loop.py.)
 OPTIONAL_SECTIONS = {
     "energy_runs": "Energy drift over time (long runs)",
-    "game_loop": "Game-loop figures",
 }
+# (The long-run energy study is /energy, read by energy_runs.py.)
 
 
 class StudyError(Exception):
@@ -189,6 +193,9 @@ class Study:
     optional: dict  # hook name -> {"title", "attrs", "datasets"}; see OPTIONAL_SECTIONS
     gaps: list = field(default_factory=list)  # what a complete study would have and this one lacks
     stability: Stability = None  # None only in a file that lacks /stability (a gap)
+    loop: object = None  # loop.Loop: /loop, the game-loop study; None when the study has none
+    energy_runs: object = None  # energy_runs.EnergyRuns: /energy, the long-run energy study; None when absent
+    substeps: object = None  # substeps.Substeps: /substeps, small steps or one implicit step; None when absent
 
     @property
     def timed(self):
@@ -341,7 +348,8 @@ class _Reader:
         if stability is None:
             gaps.append("no /stability group (the stability limits and regions)")
         return Study(path=str(self.path), attrs=attrs, problems=problems, optional=optional, gaps=gaps,
-                     stability=stability)
+                     stability=stability, loop=loop_section.read(self, f),
+                     energy_runs=energy_section.read(self, f), substeps=substeps_section.read(self, f))
 
 
 def load(path):

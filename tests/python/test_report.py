@@ -15,6 +15,7 @@ import subprocess
 import h5py
 import numpy as np
 import pytest
+from conftest import run_study
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 REPORT = os.path.join(ROOT, "scripts", "report")
@@ -88,7 +89,7 @@ def snapshot(folder):
 
 @pytest.mark.parametrize("shape", ["plain", "timed"])
 def test_outputs_exist_and_images_resolve(reports, shape):
-    _, folder = reports[shape]
+    study, folder = reports[shape]
     md = report_text(folder)
     html = (folder / "index.html").read_text()
     assert len(md) > 1000 and len(html) > 1000
@@ -103,10 +104,12 @@ def test_outputs_exist_and_images_resolve(reports, shape):
     # The tables are HTML tables, and the contents link to the sections.
     assert html.count("<table>") == md.count("\n|---")
     assert '<a href="#summary-cheapest-method-per-error-target">' in html
-    expected = {"convergence_constant_acceleration.png", "convergence_damped_spring.png", "convergence_pendulum.png",
-                "convergence_projectile.png", "convergence_stiff_spring.png", "convergence_spring_chain.png",
-                "work_precision_force_evals.png", "stability_regions.png",
-                "energy_drift.png"}
+    with h5py.File(study, "r") as f:
+        problems = list(f["problems"])
+    assert "kepler" in problems and "bouncing_balls" in problems
+    expected = {f"convergence_{p}.png" for p in problems} | {
+        "work_precision_force_evals.png", "stability_regions.png", "energy_drift.png", "energy_long_runs.png",
+        "loop_shown_error.png", "substeps_equal_cost.png"}
     if shape == "timed":
         expected.add("work_precision_time.png")
     assert set(os.path.basename(i) for i in images) == expected
@@ -203,7 +206,7 @@ def test_cheapest_tables_equal_equal_error(reports, shape, metric):
                 base = at[at["origin"].astype(str) == "baseline"]
                 if "baseline_rk4" in g["methods"]:
                     cell = row["hand-written floor (baseline, for scale)"]
-                    assert cell.startswith("baseline_rk4") if len(base) else cell == "does not reach it"
+                    assert cell.startswith("baseline_") if len(base) else cell == "does not reach it"
 
 
 def test_timed_summary_ranks_by_time(reports):
@@ -260,7 +263,8 @@ def test_stability_table_is_the_files(reports, shape):
     table = {(r[0], r[1]): dict(zip(head, r)) for r in rows}
     with h5py.File(study) as f:
         limits = f["stability/limits"][()]
-    assert len(table) == len(limits) == 20
+        integrators = len(f["stability/regions"])
+    assert len(table) == len(limits) == 2 * integrators and integrators >= 13
     for r in limits:
         row = table[(text(r["integrator"]), text(r["test"]))]
         for col, field in (("largest stable y, from M(y)", "theory"), ("from long runs", "measured")):
@@ -299,8 +303,66 @@ def test_a_study_without_stability_is_incomplete(plain_study, tmp_path):
 def test_absent_sections_are_named(reports):
     _, folder = reports["plain"]
     md = report_text(folder)
-    assert "Energy drift over time on long runs: absent" in md
-    assert "Game-loop figures: absent" in md
+    assert "Long-run energy: absent" not in md and "Energy over 10^4 periods" in md  # the default study has it
+    assert "## Game loop" in md and "Game loop: absent" not in md  # the default study has one (test_loop.py)
+    assert "## Small steps or one implicit step?" in md and "Small steps or one implicit step: absent" not in md
+
+
+def section_lines(md, heading):
+    """The non-empty lines under `heading`, up to the next heading."""
+    lines = md.splitlines()
+    out = []
+    for line in lines[lines.index(heading) + 1:]:
+        if line.startswith("#"):
+            break
+        if line.strip():
+            out.append(line)
+    return out
+
+
+@pytest.mark.parametrize("shape", ["plain", "timed"])
+def test_substeps_verdicts_are_the_files(reports, shape):
+    """The verdict lines of the small-steps section are /substeps/<scene>/verdict's
+    `summary` strings as stepbench wrote them, in order; the table has a row per run."""
+    study, folder = reports[shape]
+    md = report_text(folder)
+    assert md.index("## Stability") < md.index("## Small steps or one implicit step?") < md.index("## Energy")
+    assert "fig/substeps_equal_cost.png" in md
+    with h5py.File(study, "r") as f:
+        g = f["substeps"]
+        assert set(g) == {"stiff_spring", "spring_chain"}
+        for scene, sg in g.items():
+            summaries = [text(v) for v in sg["verdict"]["summary"]]
+            assert summaries and all(v.startswith(f"{scene}: ") for v in summaries)
+            assert section_lines(md, f"#### {scene}: verdict at equal cost") == summaries
+            head, rows = md_table(md, f"### {scene}: substeps against one implicit step")
+            assert head[:3] == ["scene", "method", "substeps a frame"]
+            runs = {m: mg["runs"][()] for m, mg in sg["methods"].items()}
+            assert len(rows) == sum(len(r) for r in runs.values())
+            for cells in rows:
+                r = dict(zip(head, cells))
+                method = r["method"].split(" ")[0]
+                match = runs[method][runs[method]["substeps"] == int(r["substeps a frame"])]
+                assert len(match) == 1 and r["scene"] == scene
+                if match[0]["diverged"]:
+                    assert r["max position error"] == "diverged"
+                else:
+                    assert float(r["max position error"]) == pytest.approx(match[0]["err_pos_max"], rel=5e-3)
+                if np.isfinite(match[0]["extra_damping"]):
+                    assert float(r["artificial damping"]) == pytest.approx(match[0]["extra_damping"], rel=5e-3)
+
+
+def test_a_study_without_substeps_reports_it_absent(plain_study, tmp_path):
+    cut = tmp_path / "cut.h5"
+    edit(plain_study, cut, lambda f: f.__delitem__("substeps"))
+    out = tmp_path / "report"
+    p = run_report(cut, out)
+    assert p.returncode == 0, p.stderr
+    assert p.stderr == ""  # an optional study: not a gap
+    md = report_text(out)
+    assert "Small steps or one implicit step: absent (" in md
+    assert "verdict at equal cost" not in md
+    assert not (out / "fig" / "substeps_equal_cost.png").exists()
 
 
 # --- files the report refuses -----------------------------------------------------------------
@@ -488,8 +550,8 @@ def test_advise_cut_rows_are_too_slow(stepbench, bench, tmp_path):
     """A time budget that cuts every row but the coarsest: rk4 reaches 1e-6 only at rows
     that were cut, so it is "too slow", not "too inaccurate"."""
     study = tmp_path / "cut.h5"
-    subprocess.run([bench, "--quick", "--case_budget=1e-9", "--benchmark_filter=^pendulum/rk4/",
-                    f"--study_out={study}"], check=True, capture_output=True)
+    run_study([bench, "--quick", "--case_budget=1e-9", "--benchmark_filter=^pendulum/rk4/", f"--study_out={study}"],
+              capture_output=True)
     p = advise(stepbench, study, "--problem", "pendulum", "--tol", "1e-6", "--json")
     reasons = {e["method"]: e["reason"] for e in json.loads(p.stdout)["excluded"]}
     assert reasons["rk4"].startswith("too slow: cut by the time budget"), reasons

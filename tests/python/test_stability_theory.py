@@ -267,7 +267,8 @@ def test_regions_match_the_steps_on_the_complex_damper(stability, name):
     _, v1 = step(name, True)(np.zeros_like(z), np.ones_like(z), 1.0, lambda x, v: z * v)
     grid = stability["regions"][name]
     assert grid.shape == z.shape
-    assert np.allclose(grid, abs(v1), rtol=1e-12, atol=1e-14), name
+    # The regions are stored as float32 (a figure's resolution): equal to float32 rounding.
+    assert np.allclose(grid, abs(v1), rtol=2 ** -23, atol=1e-14), name
 
 
 def test_the_command_prints_the_files_limits(stepbench, stability):
@@ -275,7 +276,7 @@ def test_the_command_prints_the_files_limits(stepbench, stability):
     does not apply, the same figures as the study file's /stability/limits."""
     out = json.loads(subprocess.run([stepbench, "stability", "--json"], check=True, capture_output=True,
                                     text=True).stdout)
-    assert len(out) == len(stability["limits"]) == 20
+    assert len(out) == len(stability["limits"]) == 2 * len(stability["regions"])
     for rec in out:
         r = file_row(stability, rec["integrator"], rec["test"])
         for key in ("theory", "measured"):

@@ -1,0 +1,114 @@
+// `stepbench energy [--json]`: the long-run energy study (study/energy.hpp): every
+// fixed-step integrator of ours on pendulum and kepler for 10^4 periods at a stated dt,
+// its largest energy error, its drift per period, bounded or drifting (with the sign),
+// and on kepler the angular momentum. The study file carries the same under /energy.
+#include "study/energy.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "cli/commands.hpp"
+#include "core/parse.hpp"
+
+namespace stepbench::cli {
+namespace {
+
+using json = nlohmann::json;
+
+struct energy_args {
+  bool json = false;
+  double periods = 1e4;
+  std::vector<std::string> problems;
+  std::vector<std::string> sets;
+};
+
+json number_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+std::string sci(double v) { return std::isfinite(v) ? fmt::format("{:.2e}", v) : "-"; }
+
+int run_energy(const energy_args& a) {
+  energy_options opts;
+  opts.periods = a.periods;
+  if (!a.problems.empty()) {
+    std::vector<energy_scene> chosen;
+    for (const auto& name : a.problems) {
+      bool found = false;
+      for (const auto& s : opts.scenes)
+        if (s.problem == name) chosen.push_back(s), found = true;
+      if (!found)
+        throw std::invalid_argument(fmt::format("the energy study runs on pendulum and kepler, not {}", name));
+    }
+    opts.scenes = chosen;
+  }
+  std::map<std::string, std::map<std::string, double>> overrides;
+  std::vector<std::string> names;
+  for (const auto& s : opts.scenes) names.push_back(s.problem);
+  for (const auto& s : a.sets) add_override(overrides, s, names);
+  opts.progress = !a.json;
+  const energy_study s = run_energy_study(opts, overrides);
+  if (a.json) {
+    json out = json::array();
+    for (const auto& p : s.problems)
+      for (const auto& r : p.runs)
+        out.push_back({{"problem", p.problem},
+                       {"method", r.info.name},
+                       {"symplectic", r.info.traits.symplectic},
+                       {"dt", r.dt},
+                       {"steps_per_period", p.steps_per_period},
+                       {"periods", opts.periods},
+                       {"steps", r.steps},
+                       {"force_evals", r.force_evals},
+                       {"completed", r.completed},
+                       {"max_rel_err", number_or_null(r.max_rel_err)},
+                       {"final_rel_err", number_or_null(r.final_rel_err)},
+                       {"drift_per_period", number_or_null(r.drift_per_period)},
+                       {"verdict", r.verdict},
+                       {"drift_sign", r.drift_sign},
+                       {"angmom_max_rel_err", number_or_null(r.angmom_max_rel_err)},
+                       {"angmom_drift_per_period", number_or_null(r.angmom_drift_per_period)},
+                       {"note", r.note}});
+    std::cout << out.dump(2) << "\n";
+    return 0;
+  }
+  for (const auto& p : s.problems) {
+    fmt::print("{}: {:g} periods of {:.6g} s, dt = {:.6g} s ({} steps a period); E0 = {:.6g}{}\n", p.problem,
+               opts.periods, p.period, p.dt, p.steps_per_period, p.e0,
+               std::isfinite(p.l0) ? fmt::format(", L0 = {:.6g}", p.l0) : "");
+    fmt::print("  {:<20} {:>10} {:>12} {:>12}  {:<15} {:>10} {:>12}\n", "method", "max |dE|/E", "final dE/E",
+               "drift/period", "verdict", "max |dL|/L", "dL drift/per");
+    for (const auto& r : p.runs) {
+      const std::string verdict = !r.completed       ? "failed: " + r.note
+                                  : r.drift_sign > 0 ? "drifting, gains"
+                                  : r.drift_sign < 0 ? "drifting, loses"
+                                                     : r.verdict;
+      fmt::print("  {:<20} {:>10} {:>12} {:>12}  {:<15} {:>10} {:>12}\n", r.info.name, sci(r.max_rel_err),
+                 std::isfinite(r.final_rel_err) ? fmt::format("{:+.2e}", r.final_rel_err) : "-",
+                 std::isfinite(r.drift_per_period) ? fmt::format("{:+.2e}", r.drift_per_period) : "-", verdict,
+                 sci(r.angmom_max_rel_err),
+                 std::isfinite(r.angmom_drift_per_period) ? fmt::format("{:+.2e}", r.angmom_drift_per_period) : "-");
+    }
+  }
+  fmt::print(
+      "bounded: the largest |dE|/E over the last tenth of the run is at most {:g} x that over the first tenth, "
+      "and below {:g}; drifting otherwise.\n",
+      opts.bounded_growth, opts.lost);
+  fmt::print(stderr, "energy study in {:.2f} s\n", s.wall_seconds);
+  return 0;
+}
+
+}  // namespace
+
+command add_energy(CLI::App& app) {
+  auto a = std::make_shared<energy_args>();
+  auto* sub = app.add_subcommand("energy", "long-run energy of the fixed-step integrators on pendulum and kepler");
+  sub->add_flag("--json", a->json, "print JSON: one record per problem and integrator");
+  sub->add_option("--periods", a->periods, "periods to run (whole number)")->capture_default_str();
+  sub->add_option("--problem", a->problems, "pendulum and/or kepler (repeatable; default both)");
+  sub->add_option("--set", a->sets, "override a parameter, problem.name=value (repeatable)");
+  return {sub, [a] { return run_energy(*a); }};
+}
+
+}  // namespace stepbench::cli

@@ -1,0 +1,285 @@
+// `stepbench loop`: the game loop around an integrator (study/loop.hpp). Two forms:
+//   loop --problem P --integrator I [--out FILE]
+//     the whole loop study of the pair (every design, clock, physics rate, clamp on and
+//     off for the stall), with the pair's accuracy sweep, into a study file;
+//   loop --problem P --integrator I --design D [--display-hz H] [--physics-hz H]
+//        [--clamp S|off] [--jitter SEED] [--stall-at T] [--step-cost NS] [--json]
+//     one configuration: its figures, printed.
+#include "study/loop.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <charconv>
+#include <cmath>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "cli/commands.hpp"
+#include "core/parse.hpp"
+#include "study/study_file.hpp"
+#include "study/sweep.hpp"
+
+namespace stepbench::cli {
+namespace {
+
+using json = nlohmann::json;
+
+struct loop_args {
+  std::string problem, method, out, design;
+  std::string display_hz, physics_hz, clamp, jitter, stall_at, step_cost, horizon;
+  std::vector<std::string> sets;
+  bool json = false, quiet = false;
+};
+
+json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+loop_design parse_design(const std::string& text) {
+  for (loop_design d : all_loop_designs)
+    if (to_string(d) == text) return d;
+  throw std::invalid_argument(
+      fmt::format("unknown --design '{}' (known: variable, fixed, interpolated, substeps)", text));
+}
+
+std::uint64_t parse_seed(const std::string& text) {
+  std::uint64_t v = 0;
+  const char* end = text.data() + text.size();
+  auto [ptr, ec] = std::from_chars(text.data(), end, v);
+  if (text.empty() || ec != std::errc() || ptr != end)
+    throw std::invalid_argument(fmt::format("--jitter must be a seed (a whole number >= 0), got '{}'", text));
+  return v;
+}
+
+const method_info& loop_method_info(const std::string& name) {
+  const method_info& m = find_method(name);
+  if (m.origin != method_origin::ours || m.kind != method_kind::fixed_step)
+    throw std::invalid_argument(fmt::format(
+        "the game loop runs our fixed-step integrators; {} is {}", name,
+        m.origin == method_origin::ours ? std::string("adaptive") : fmt::format("a {} method", to_string(m.origin))));
+  return m;
+}
+
+std::string g3(double v) { return std::isfinite(v) ? fmt::format("{:.3g}", v) : "n/a"; }
+
+int run_one(const loop_args& a) {
+  if (!a.out.empty()) throw std::invalid_argument("--out writes the whole loop study: leave out --design");
+  auto problem = make_problem(a.problem);
+  loop_method_info(a.method);
+  for (const auto& s : a.sets) {
+    const auto [name, value] = parse_assignment(s);
+    problem->set(name, value);
+  }
+  if (auto err = problem->validate(); !err.empty())
+    throw std::invalid_argument(fmt::format("problem {}: {}", a.problem, err));
+  const loop_options opts;
+  loop_config c;
+  c.design = parse_design(a.design);
+  c.clamp_s = opts.clamp_s;
+  c.jitter = opts.jitter;
+  c.stall_s = opts.stall_s;
+  if (!a.display_hz.empty()) c.display_hz = parse_number(a.display_hz, "--display-hz");
+  if (!a.physics_hz.empty()) c.physics_hz = parse_number(a.physics_hz, "--physics-hz");
+  if (!a.clamp.empty()) {
+    c.clamp_s = a.clamp == "off" ? 0.0 : parse_number(a.clamp, "--clamp");
+    if (a.clamp != "off" && !(c.clamp_s > 0.0))
+      throw std::invalid_argument(fmt::format("--clamp must be a time > 0 or off, got {}", a.clamp));
+  }
+  if (!a.jitter.empty()) c.jitter_seed = parse_seed(a.jitter);
+  if (!a.stall_at.empty()) c.stall_at_s = parse_number(a.stall_at, "--stall-at");
+  c.horizon = problem->horizon();
+  if (!a.horizon.empty()) {
+    c.horizon = parse_number(a.horizon, "--horizon");
+    if (!(c.horizon > 0.0)) throw std::invalid_argument(fmt::format("--horizon must be > 0, got {}", a.horizon));
+  }
+  double cost_ns = opts.stated_step_cost_ns;
+  if (!a.step_cost.empty()) {
+    cost_ns = parse_number(a.step_cost, "--step-cost");
+    if (!(cost_ns >= 0.0)) throw std::invalid_argument(fmt::format("--step-cost must be >= 0 ns, got {}", a.step_cost));
+  }
+  if (auto err = loop_config_error(c); !err.empty()) throw std::invalid_argument(err);
+
+  const loop_row r = run_loop_config(*problem, a.method, c, opts);
+  const loop_cost cost = cost_verdict(c, cost_ns, "stated");
+  const int dim = problem->dim();
+  auto part = [&](const std::vector<double>& y, int offset) {
+    return std::vector<double>(y.begin() + offset, y.begin() + offset + dim);
+  };
+  const bool variable = c.design == loop_design::variable;
+  const bool trusted = r.note.rfind("no trusted truth", 0) != 0;
+  const std::string unit(problem->position_unit());
+  if (a.json) {
+    json out = {{"problem", a.problem},
+                {"integrator", a.method},
+                {"design", to_string(c.design)},
+                {"clock", r.clock},
+                {"display_hz", c.display_hz},
+                {"physics_hz", variable ? json(nullptr) : json(c.physics_hz)},
+                {"dt", uses_accumulator(c.design) ? json(c.dt()) : json(nullptr)},
+                {"substeps", c.design == loop_design::substeps ? json(c.substeps()) : json(nullptr)},
+                {"clamp_s", c.clamp_s > 0.0 ? json(c.clamp_s) : json(nullptr)},
+                {"jitter_seed", c.jitter_seed ? json(*c.jitter_seed) : json(nullptr)},
+                {"jitter", c.jitter_seed ? json(c.jitter) : json(nullptr)},
+                {"stall_at_s", number(c.stall_at_s)},
+                {"stall_s", c.stalls() ? json(c.stall_s) : json(nullptr)},
+                {"horizon", c.horizon},
+                {"position_unit", unit},
+                {"frames", r.frames},
+                {"physics_steps", r.physics_steps},
+                {"force_evals", r.force_evals},
+                {"final_physics_t", r.physics_t},
+                {"final_physics_position", part(r.final_physics, 0)},
+                {"final_physics_velocity", part(r.final_physics, dim)},
+                {"final_shown_position", part(r.final_shown, 0)},
+                {"shown_err_max", number(r.shown_err_max)},
+                {"shown_err_rms", number(r.shown_err_rms)},
+                {"final_shown_err", number(r.final_shown_err)},
+                {"reference_display_hz", opts.reference_display_hz},
+                {"clock_dependence", number(r.clock_dependence)},
+                {"physics_clock_dependence", number(r.physics_clock_dependence)},
+                {"judder", number(r.judder)},
+                {"lag_s", number(r.lag_s)},
+                {"lag_clock_s", number(r.lag_clock_s)},
+                {"steps_per_frame_mean", number(r.steps_per_frame_mean)},
+                {"steps_per_frame_max", r.steps_per_frame_max},
+                {"stall_burst_steps", r.stall_burst_steps},
+                {"clamp_hits", r.clamp_hits},
+                {"alpha_min", number(r.alpha_min)},
+                {"alpha_max", number(r.alpha_max)},
+                {"diverged", r.diverged},
+                {"note", r.note},
+                {"cost",
+                 {{"step_cost_ns", cost.step_cost_ns},
+                  {"source", a.step_cost.empty() ? "stated (default)" : "stated"},
+                  {"frame_budget_ns", cost.schedule.frame_budget_s * 1e9},
+                  {"worst_frame_work_ns", cost.schedule.worst_work_s * 1e9},
+                  {"late_frames", cost.schedule.late_frames},
+                  {"physics_load", cost.schedule.load},
+                  {"wall_s", cost.schedule.wall_s},
+                  {"outcome", to_string(cost.schedule.outcome)},
+                  {"outcome_without_clamp", to_string(cost.without_clamp)},
+                  {"clamp_prevented_spiral", cost.clamp_prevented_spiral}}}};
+    std::cout << out.dump(2) << "\n";
+    return trusted ? 0 : 1;
+  }
+  std::string clock = fmt::format("{:g} Hz display", c.display_hz);
+  if (c.jitter_seed) clock += fmt::format(", frame times jittered +-{:g} % (seed {})", 100 * c.jitter, *c.jitter_seed);
+  if (c.stalls()) clock += fmt::format(", a {:g} s stall at {:g} s", c.stall_s, c.stall_at_s);
+  std::string physics = variable ? "dt = the frame time"
+                        : c.design == loop_design::substeps
+                            ? fmt::format("{} substeps a frame", c.substeps())
+                            : fmt::format("physics {:g} Hz (dt {:.6g} s)", c.physics_hz, c.dt());
+  fmt::print("{} with {}, {} loop: {}, {}, clamp {}, to t = {:g} s\n", a.problem, a.method, to_string(c.design), clock,
+             physics, c.clamp_s > 0.0 ? fmt::format("{:g} s", c.clamp_s) : "off", c.horizon);
+  fmt::print("  frames {}, physics steps {} (mean {:.3g}, max {} a frame), force evaluations {}\n", r.frames,
+             r.physics_steps, r.steps_per_frame_mean, r.steps_per_frame_max, r.force_evals);
+  fmt::print("  shown error        max {} {}, rms {} {}, at the horizon {} {}\n", g3(r.shown_err_max), unit,
+             g3(r.shown_err_rms), unit, g3(r.final_shown_err), unit);
+  fmt::print("  clock dependence   {} {} shown, {} {} physics, against the {:g} Hz display at the horizon\n",
+             g3(r.clock_dependence), unit, g3(r.physics_clock_dependence), unit, opts.reference_display_hz);
+  fmt::print("  judder             {} {}/s (std of shown - exact velocity)\n", g3(r.judder), unit);
+  fmt::print("  lag                {} s measured ({} s from the loop's clocks)\n", g3(r.lag_s), g3(r.lag_clock_s));
+  if (uses_accumulator(c.design)) fmt::print("  alpha              [{:.4g}, {:.4g}]\n", r.alpha_min, r.alpha_max);
+  if (c.stalls())
+    fmt::print("  stall              {} steps in the stall frame, {} frame{} clamped\n", r.stall_burst_steps,
+               r.clamp_hits, r.clamp_hits == 1 ? "" : "s");
+  fmt::print(
+      "  cost model         {:g} ns a step{}: worst frame {:.3g} ns of a {:.3g} ns budget, load {:.3g}, {} "
+      "late frame{}: {} (without the clamp: {})\n",
+      cost.step_cost_ns, a.step_cost.empty() ? " (stated default)" : "", cost.schedule.worst_work_s * 1e9,
+      cost.schedule.frame_budget_s * 1e9, cost.schedule.load, cost.schedule.late_frames,
+      cost.schedule.late_frames == 1 ? "" : "s", to_string(cost.schedule.outcome), to_string(cost.without_clamp));
+  fmt::print("  final physics      t = {:.10g} s, position {::.12g}\n", r.physics_t, part(r.final_physics, 0));
+  if (!r.note.empty()) fmt::print("  {}: {}\n", r.diverged ? "DIVERGED" : "NOTE", r.note);
+  return trusted ? 0 : 1;
+}
+
+int run_study(const loop_args& a) {
+  const std::string out = a.out.empty() ? "results/loop.h5" : a.out;
+  sweep_options so;
+  so.problems = {a.problem};
+  make_problem(a.problem);  // names an unknown problem first
+  so.methods = {loop_method_info(a.method).name};
+  for (const auto& s : a.sets) add_override(so.overrides, s, so.problems);
+  so.substeps.enabled = false;
+  so.loop.problems = so.problems;
+  so.loop.methods = so.methods;
+  so.progress = !a.quiet;
+  validate(so);
+  check_writable(out);
+  const study s = run_sweep(so);
+  write_study(s, out);
+  if (!a.quiet && !s.loop.problems.empty()) {
+    const auto& lp = s.loop.problems.front();
+    const auto& m = lp.methods.front();
+    const auto& o = s.loop.options;
+    fmt::print("{} with {}: max shown error [{}] at a {:g} Hz display (constant clock, clamp {:g} s)\n", lp.name,
+               m.info.name, lp.position_unit, o.reference_display_hz, o.clamp_s);
+    fmt::print("{:>12}", "physics Hz");
+    for (loop_design d : all_loop_designs) fmt::print(" {:>13}", to_string(d));
+    fmt::print("\n");
+    for (double ph : o.physics_hz) {
+      fmt::print("{:>12g}", ph);
+      for (loop_design d : all_loop_designs)
+        for (const auto& r : m.rows)
+          if (r.clock == "constant" && r.config.display_hz == o.reference_display_hz && r.config.design == d &&
+              (d == loop_design::variable || r.config.physics_hz == ph))
+            fmt::print(" {:>13.3g}", r.shown_err_max);
+      fmt::print("\n");
+    }
+    for (const auto& c : cheapest_designs(m, o))
+      if (c.display_hz == o.reference_display_hz)
+        fmt::print("cheapest under {:g} {}: {}\n", c.target, lp.position_unit,
+                   c.found ? fmt::format("{}{} ({:.3g} steps a frame, error {:.3g})", c.design,
+                                         std::isfinite(c.physics_hz) ? fmt::format(" at {:g} Hz", c.physics_hz) : "",
+                                         c.steps_per_frame_mean, c.shown_err_max)
+                           : std::string("none of the designs at these physics rates"));
+  }
+  std::fflush(stdout);
+  fmt::print(stderr, "wrote {} (the loop study of {} with {}, {:.2f} s)\n", out, a.problem, a.method,
+             s.loop.wall_seconds);
+  return report_study_outcome(s, "stepbench");
+}
+
+int run_loop_command(const loop_args& a) {
+  if (!a.design.empty()) return run_one(a);
+  for (const auto& [given, name] : {std::pair{&a.display_hz, "--display-hz"},
+                                    {&a.physics_hz, "--physics-hz"},
+                                    {&a.clamp, "--clamp"},
+                                    {&a.jitter, "--jitter"},
+                                    {&a.stall_at, "--stall-at"},
+                                    {&a.step_cost, "--step-cost"},
+                                    {&a.horizon, "--horizon"}})
+    if (!given->empty())
+      throw std::invalid_argument(fmt::format("{} applies to one configuration: give --design", name));
+  if (a.json) throw std::invalid_argument("--json applies to one configuration: give --design");
+  return run_study(a);
+}
+
+}  // namespace
+
+command add_loop(CLI::App& app) {
+  auto a = std::make_shared<loop_args>();
+  auto* sub = app.add_subcommand(
+      "loop", "the game loop around an integrator: what each loop design shows at each displayed frame");
+  sub->add_option("--problem", a->problem, "problem name (see list)")->required();
+  sub->add_option("--integrator,--method", a->method, "one of our fixed-step integrators")->required();
+  sub->add_option("--set", a->sets, "override a parameter, name=value (repeatable)");
+  sub->add_option("--out", a->out, "the whole loop study of the pair into this study file (default results/loop.h5)");
+  sub->add_option("--design", a->design, "one configuration: variable, fixed, interpolated or substeps");
+  sub->add_option("--display-hz", a->display_hz, "display rate [Hz] (default 60)");
+  sub->add_option("--physics-hz", a->physics_hz,
+                  "physics rate [Hz]: dt = 1 / rate; substeps: ceil(rate / display) a frame (default 60)");
+  sub->add_option("--clamp", a->clamp, "frame-time clamp [s], or off (default 0.25)");
+  sub->add_option("--jitter", a->jitter, "jitter the frame times +-25 %, from this seed");
+  sub->add_option("--stall-at", a->stall_at, "a 1 s stall of the frame that begins at this wall time [s]");
+  sub->add_option("--step-cost", a->step_cost, "cost model: wall time of one physics step [ns] (default 1000)");
+  sub->add_option("--horizon", a->horizon, "end time [s] (default: the problem's)");
+  sub->add_flag("--json", a->json, "print JSON (one configuration)");
+  sub->add_flag("--quiet", a->quiet, "study form: print only the summary line");
+  sub->footer(
+      "exit codes: 0 done; 1 a file error, or no trusted truth; 2 bad usage; 3 the study was written but a "
+      "case of its sweep failed\n");
+  return {sub, [a] { return run_loop_command(*a); }};
+}
+
+}  // namespace stepbench::cli

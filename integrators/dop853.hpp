@@ -1,0 +1,162 @@
+#pragma once
+// DOP853, adaptive: the explicit Runge-Kutta method of order 8 of Dormand & Prince with
+// error estimators of orders 5 and 3 and a dense output of order 7 (Hairer, Norsett &
+// Wanner, Solving ODEs I, 2nd ed. (HNW I), sec. II.6 and II.10; Hairer's dop853.f).
+// Coefficients from integrators/tableaus.hpp (dop853_extended), proved in
+// tests/test_tableaus.cpp; the stages are integrators/unrolled_rk.hpp's.
+//  - Step: 12 stages; on acceptance f(t + h, y_1) is evaluated, the next step's first
+//    stage (12 evaluations a step, as dop853.f).
+//  - Error (dop853.f after label 35): with the components of [x; v] scaled by
+//    sc = tol + tol max(|y0|, |y1|), E5 = ||sum e5_i k_i / sc||^2, E3 the same with
+//    e3 = b - b_hat3, over n = 2 dim components,
+//      err = |h| E5 / sqrt(n (E5 + 0.01 E3)),
+//    which is O(h^8). The step-size control is dop853.f's with its defaults (no PI term,
+//    beta = 0): h_new = h / clamp(err^(1/8) / 0.9, 1/6, 1/0.333), after a rejection
+//    h / min(1/0.333, err^(1/8) / 0.9), and no growth right after a rejection. err^(1/8)
+//    is three square roots: the next step's coefficients wait for it, and pow() would
+//    cost a fifth of a step here.
+//  - Dense output of order 7 for the sample times, interpolated inside the steps. Its
+//    three extra stages cost three evaluations, paid only in a step that holds a sample
+//    time (computed at the first interpolation inside the step, not at every step as
+//    dop853.f does when dense output is requested).
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "core/concepts.hpp"
+#include "integrators/step_control.hpp"
+#include "integrators/tableaus.hpp"
+#include "integrators/unrolled_rk.hpp"
+
+namespace stepbench {
+
+namespace dop853_detail {
+// dop853.f's step-size controller with its default constants (SAFE = 0.9, FAC1 = 0.333,
+// FAC2 = 6, BETA = 0).
+struct controller {
+  static constexpr double safe = 0.9, fac_max = 1.0 / 0.333, fac_min = 1.0 / 6.0;
+  bool rejected_last = false;
+  double next(double h, double err) {
+    const double fac11 = std::sqrt(std::sqrt(std::sqrt(err)));  // err^(1/8)
+    if (err <= 1.0) {
+      double h_new = h / std::clamp(fac11 / safe, fac_min, fac_max);
+      if (rejected_last) h_new = std::min(h_new, h);
+      rejected_last = false;
+      return h_new;
+    }
+    rejected_last = true;
+    return h / (std::isfinite(err) ? std::min(fac_max, fac11 / safe) : fac_max);
+  }
+};
+
+// The error weights over the 16 stages of dop853_extended (zero beyond stage 12).
+inline constexpr std::array<double, 16> e5 = [] {
+  std::array<double, 16> e{};
+  for (int i = 0; i < 12; ++i) e[i] = dop853_e5[i];
+  return e;
+}();
+inline constexpr std::array<double, 16> e3 = [] {
+  std::array<double, 16> e{};
+  for (int i = 0; i < 12; ++i) e[i] = dop853_extended.b[i] - dop853_b_hat3[i];
+  return e;
+}();
+inline constexpr std::array<double, 16> b = dop853_extended.b;
+}  // namespace dop853_detail
+
+struct dop853 {
+  static constexpr std::string_view name = "dop853";
+  static constexpr std::string_view description = "Dormand-Prince 8(5,3) (DOP853), 7th-order dense output";
+  static constexpr int order = 8;
+  static constexpr capabilities traits{.reuses_last_force = true, .error_estimate = true, .dense_output = true};
+  static constexpr int force_evals_per_step = 12;
+  double tol = 1e-6;
+  explicit dop853(double tolerance) : tol(tolerance) {}
+
+  template <class Sys>
+  struct stepper {
+    using Vec = typename Sys::vec;
+    double tol;
+    dop853_detail::controller control;
+    unrolled_rk<dop853_extended, Sys> k;
+    Vec x1, v1, ex5, ev5, ex3, ev3, rx, rv;  // new state, error estimates, reciprocal scales
+    // The last accepted step, for dense output.
+    Vec x0, v0;
+    const Sys* sys_last = nullptr;
+    double t_last = 0.0, h_last = 0.0, h_im_last = 0.0;
+    bool dense_ready = false;
+
+    explicit stepper(const dop853& m) : tol(m.tol) {}
+    void resize(const Sys&, const Vec& like) {
+      k.resize(like);
+      size_like(like, x1, v1, ex5, ev5, ex3, ev3, rx, rv, x0, v0);
+    }
+
+    double initial_dt(const Sys& sys, double t, step_state<Vec>& s, double horizon) {
+      const Vec& f0 = current_force(sys, t, s);
+      return starting_step(sys, t, s.x, s.v, f0, order, tol, horizon, x1, v1, ex5);
+    }
+
+    step_attempt try_step(const Sys& sys, double t, step_state<Vec>& s, double h) {
+      const double h_im = h * inverse_mass(sys);
+      k.F[0] = current_force(sys, t, s);
+      k.template compute<1, 12>(sys, t, s.x, s.v, h, h_im);
+      k.template combine<dop853_detail::b>(x1, v1, s.x, s.v, h, h_im);
+      k.template difference<dop853_detail::e5>(ex5, ev5, s.v, h, h_im);
+      k.template difference<dop853_detail::e3>(ex3, ev3, s.v, h, h_im);
+      const double err = error(s);
+      const double h_next = control.next(h, err);
+      if (!(err <= 1.0)) return {false, 0.0, h_next};
+      x0 = s.x;
+      v0 = s.v;
+      sys_last = &sys;
+      t_last = t;
+      h_last = h;
+      h_im_last = h_im;
+      dense_ready = false;
+      s.x = x1;
+      s.v = v1;
+      sys.force(t + h, s.x, s.v, s.f);  // the next step's first stage, and stage 13 of the dense output
+      s.f_current = true;
+      k.F[12] = s.f;
+      return {true, h, h_next};
+    }
+
+    // dop853.f's err: |h| E5 / sqrt(n (E5 + 0.01 E3)); ex, ev include the factor h.
+    double error(const step_state<Vec>& s) {
+      // One division per component: the reciprocal scales, then products.
+      rx = (tol + tol * s.x.cwiseAbs().cwiseMax(x1.cwiseAbs()).array()).inverse().matrix();
+      rv = (tol + tol * s.v.cwiseAbs().cwiseMax(v1.cwiseAbs()).array()).inverse().matrix();
+      const double e5 = (ex5.array() * rx.array()).square().sum() + (ev5.array() * rv.array()).square().sum();
+      const double e3 = (ex3.array() * rx.array()).square().sum() + (ev3.array() * rv.array()).square().sum();
+      double deno = e5 + dop853_err3_weight * e3;
+      if (!(deno > 0.0)) deno = 1.0;
+      return e5 / std::sqrt(static_cast<double>(2 * s.x.size()) * deno);
+    }
+
+    // The state at t_n + theta h of the last accepted step (0 <= theta <= 1), from the
+    // order-7 continuous extension (dop853_dense_weights over the 16 stages).
+    void interpolate(double theta, Vec& x, Vec& v) {
+      if (!dense_ready) {
+        // Stage velocities from the forces (the Nystrom form does not keep them), then
+        // the three extra stages 14-16 in the velocity form.
+        // (Row 13 of dop853_extended is b: stage 13 is the new state, its velocity v1.)
+        if constexpr (unrolled_rk<dop853_extended, Sys>::nystrom)
+          k.template velocities<0, 13>(v0, h_im_last);
+        else
+          k.V[12] = v1;
+        k.template compute<13, 16, false>(*sys_last, t_last, x0, v0, h_last, h_im_last);
+        dense_ready = true;
+      }
+      const std::array<double, 16> w = dop853_dense_weights(theta);
+      x = x0;
+      v = v0;
+      for (int i = 0; i < 16; ++i) {
+        if (w[i] == 0.0) continue;
+        x += (h_last * w[i]) * k.V[i];
+        v += (h_im_last * w[i]) * k.F[i];
+      }
+    }
+  };
+};
+
+}  // namespace stepbench

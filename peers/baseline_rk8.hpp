@@ -1,0 +1,126 @@
+#pragma once
+// Hand-written eighth-order Runge-Kutta (DOP853's 12-stage step, integrators/tableaus.hpp)
+// on plain doubles: the speed-of-light baseline of rk8, for scale only (origin
+// "baseline", like baseline_rk4). One scalar degree of freedom, the acceleration with the
+// problem's constants folded (peers/baseline_rk4.hpp), no Eigen, no counting wrapper;
+// the loops over the constant tableau are unrolled by the compiler, which folds the
+// coefficients and drops the zero ones. The same latency ordering as ours: every sum
+// adds its newest term last, and for a position-only acceleration (the pendulum) the
+// stage positions come from the accelerations directly (the Nystrom form,
+// integrators/unrolled_rk.hpp), so that consecutive stages overlap.
+#include <cmath>
+#include <span>
+
+#include "core/drive.hpp"
+#include "core/method.hpp"
+#include "integrators/tableaus.hpp"
+#include "integrators/unrolled_rk.hpp"
+#include "peers/baseline_rk4.hpp"
+
+namespace stepbench::peers {
+
+namespace baseline_rk8_detail {
+inline constexpr auto& tab = dop853_tableau;
+inline constexpr auto a2 = rk_detail::square<12>(dop853_tableau.a);
+inline constexpr auto ba = rk_detail::times<12>(dop853_tableau.b, dop853_tableau.a);
+}  // namespace baseline_rk8_detail
+
+struct baseline_rk8 {
+  static method_info info() {
+    return {"baseline_rk8",
+            "hand-written eighth-order RK (the DOP853 step) on plain doubles, fully inlined: the speed-of-light step, "
+            "for scale",
+            method_origin::baseline,
+            method_kind::fixed_step,
+            8.0,
+            {},
+            "hand-written"};
+  }
+  template <problem P>
+  static constexpr bool applies = requires(const P& p) {
+    baseline_acceleration(p)(0.0, 0.0);
+  };
+
+  template <problem P>
+  static auto prepare(const P& p, double dt, double horizon, std::span<const double> times, const run_limits&) {
+    return [p, dt, horizon, plan = plan_records(horizon, dt, times)] { return run(p, dt, horizon, plan); };
+  }
+
+  // One step of h from (x, v).
+  template <bool Velocity, class Accel>
+  [[gnu::always_inline]] static inline void step(double& x, double& v, double h, const Accel& accel) {
+    using namespace baseline_rk8_detail;
+    double a[12], vs[12];
+    a[0] = accel(x, v);
+    vs[0] = v;
+    const double hh = h * h;
+#pragma GCC unroll 12
+    for (int i = 1; i < 12; ++i) {
+      double xi = x, vi = v;
+      if constexpr (Velocity) {
+#pragma GCC unroll 12
+        for (int j = 0; j < i; ++j)
+          if (tab.a[i][j] != 0.0) xi += (h * tab.a[i][j]) * vs[j];
+#pragma GCC unroll 12
+        for (int j = 0; j < i; ++j)
+          if (tab.a[i][j] != 0.0) vi += (h * tab.a[i][j]) * a[j];
+        vs[i] = vi;
+      } else {
+        double c = 0.0;
+#pragma GCC unroll 12
+        for (int j = 0; j < i; ++j) c += tab.a[i][j];
+        xi += (c * h) * v;
+#pragma GCC unroll 12
+        for (int j = 0; j < i; ++j)
+          if (a2[i][j] != 0.0) xi += (hh * a2[i][j]) * a[j];
+      }
+      a[i] = accel(xi, vi);
+    }
+    double x1 = x, v1 = v;
+    if constexpr (Velocity) {
+#pragma GCC unroll 12
+      for (int i = 0; i < 12; ++i)
+        if (tab.b[i] != 0.0) x1 += (h * tab.b[i]) * vs[i];
+    } else {
+      double total = 0.0;
+#pragma GCC unroll 12
+      for (int i = 0; i < 12; ++i) total += tab.b[i];
+      x1 += (total * h) * v;
+#pragma GCC unroll 12
+      for (int i = 0; i < 12; ++i)
+        if (ba[i] != 0.0) x1 += (hh * ba[i]) * a[i];
+    }
+#pragma GCC unroll 12
+    for (int i = 0; i < 12; ++i)
+      if (tab.b[i] != 0.0) v1 += (h * tab.b[i]) * a[i];
+    x = x1;
+    v = v1;
+  }
+
+  template <problem P>
+  [[gnu::flatten]] static drive_result<typename P::vec> run(const P& p, double dt, double horizon,
+                                                            std::span<const record_point> plan) {
+    using vec = typename P::vec;
+    constexpr bool velocity = P::force_depends_on_velocity;
+    const auto accel = baseline_acceleration(p);
+    const auto s0 = p.initial();
+    double x = s0.x[0], v = s0.v[0];
+    drive_result<vec> out;
+    out.start(1, plan.size());
+    const loop_end end = fixed_step_loop(
+        dt, horizon, plan, [&](double, double h) { step<velocity>(x, v, h, accel); }, [](double) {},
+        [&](double t) {
+          if (!std::isfinite(x) || !std::isfinite(v)) return out.non_finite = true, false;
+          out.record(t, vec(x), vec(v));
+          return true;
+        });
+    out.steps = end.steps;
+    out.t_final = end.t;
+    out.work.force_evals = 12 * end.steps;
+    out.non_finite = out.non_finite || !std::isfinite(x) || !std::isfinite(v);
+    out.final_state = {vec(x), vec(v)};
+    return out;
+  }
+};
+
+}  // namespace stepbench::peers

@@ -1,0 +1,210 @@
+#pragma once
+// A block on an incline with the lecture's friction (digest section 3): normal force
+// |F_n| = m g cos(theta), kinetic friction mu_k |F_n| against the motion while it slides,
+// static friction up to mu_s |F_n| at rest. Pushed up the slope with v0, it decelerates
+// at g (sin theta + mu_k cos theta), stops, and then either stays (static friction holds:
+// tan theta <= mu_s) or slides back down at g (sin theta - mu_k cos theta). The coordinate
+// s is along the slope, positive up; the closed form is piecewise
+// (problems/exact/sliding_block.hpp, which also treats mu_s < tan theta <= mu_k as rest).
+//
+// The force is the lecture's, a function of the state: -m g sin theta - sign(v) mu_k
+// |F_n| while moving; at v = 0 exactly, 0 if static friction holds, else the sliding
+// force. A time-stepper never lands on v = 0 by itself: the step in which the block stops
+// carries it past the stop with the reversed kinetic friction. Where static friction
+// holds, the stop is therefore a contact in the drive loop's sense (core/concepts.hpp):
+// the gap is v along the first motion, and the response sets v = 0 (the block sticks),
+// in either contact mode (`locate`: at the stop time found inside the step). Without
+// it a block with mu_k < tan theta <= mu_s (steel on steel at 30 degrees) would slide
+// back down forever. Where static friction cannot hold there is no event: the block
+// turns back, and the kink of the force inside a step is left to the integrator.
+//
+// Friction coefficients: `mu_s`, `mu_k`, or a material pair of the lecture's table
+// (problems/exact/friction_table.hpp) by `material` (its row, 1..33, or its name:
+// `--set sliding_block.material=steel_on_steel`), `lubricated` choosing the column.
+// Two scenes: `sliding_block`, the lecture's worked example (30 degrees, mu = 0.5: it
+// slides back with a = 0.656 m/s^2), and `sliding_block_stick`, steel on steel (dry) at
+// 30 degrees, where static friction holds and kinetic friction alone would not.
+#include <fmt/format.h>
+
+#include <Eigen/Core>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "core/concepts.hpp"
+#include "problems/exact/friction_table.hpp"
+#include "problems/exact/sliding_block.hpp"
+
+namespace stepbench {
+
+// The row (1-based, as `stepbench list` numbers them) of a named material pair; 0 when
+// there is none.
+constexpr int friction_row(std::string_view name) {
+  for (std::size_t i = 0; i < exact::friction_table.size(); ++i)
+    if (exact::has_name(exact::friction_table[i], name)) return static_cast<int>(i) + 1;
+  return 0;
+}
+
+template <class Scene>
+struct incline_block {
+  static constexpr std::string_view name = Scene::name;
+  static constexpr std::string_view description = Scene::description;
+  static constexpr std::string_view position_unit = "m";
+  static constexpr bool force_depends_on_velocity = true;
+  static constexpr int dim() { return 1; }
+  using vec = Eigen::Matrix<double, 1, 1>;
+  using jacobian_matrix = Eigen::Matrix<double, 1, 1>;
+
+  double angle_deg = Scene::angle_deg;
+  double v0 = Scene::v0;
+  double mass_kg = 10.0;  // the lecture's block
+  double gravity = 9.8;
+  double material = Scene::material;
+  double lubricated = 0.0;
+  double mu_s = Scene::mu_s;
+  double mu_k = Scene::mu_k;
+  double locate = 0.0;
+  double duration = 2.0;
+
+  static constexpr auto parameters() {
+    using p = param<incline_block>;
+    return std::array{
+        p{"angle_deg", &incline_block::angle_deg, "deg", "incline angle"},
+        p{"v0", &incline_block::v0, "m/s", "initial speed along the slope, positive up"},
+        p{"mass_kg", &incline_block::mass_kg, "kg", "mass"},
+        p{"gravity", &incline_block::gravity, "m/s^2", "gravitational acceleration"},
+        p{"material", &incline_block::material, "1",
+          "friction pair of the lecture's table: its row or its name (0: none, mu_s and mu_k apply)"},
+        p{"lubricated", &incline_block::lubricated, "1", "0: the table's dry column, 1: lubricated"},
+        p{"mu_s", &incline_block::mu_s, "1", "static friction coefficient (material 0)"},
+        p{"mu_k", &incline_block::mu_k, "1", "kinetic friction coefficient (material 0)"},
+        p{"locate", &incline_block::locate, "1", "contact mode: 0 end_of_step, 1 locate"},
+        p{"duration", &incline_block::duration, "s", "default horizon"},
+    };
+  }
+
+  // `material` by name: every pair of the lecture's table, with its coefficients.
+  static std::vector<named_value> named_values(std::string_view param) {
+    if (param != "material") return {};
+    auto cell = [](const std::optional<double>& c) { return c ? fmt::format("{:g}", *c) : std::string("-"); };
+    std::vector<named_value> out{{"none", 0.0, "mu_s and mu_k apply"}};
+    for (std::size_t i = 0; i < exact::friction_table.size(); ++i) {
+      const auto& r = exact::friction_table[i];
+      out.push_back({exact::friction_name(r), static_cast<double>(i + 1),
+                     fmt::format("dry {} / {}, lubricated {} / {} (mu_s / mu_k)", cell(r.mu_s_dry), cell(r.mu_k_dry),
+                                 cell(r.mu_s_lubricated), cell(r.mu_k_lubricated))});
+    }
+    return out;
+  }
+
+  const exact::friction_record* record() const {
+    return material >= 1 ? &exact::friction_table[static_cast<std::size_t>(material) - 1] : nullptr;
+  }
+  // The coefficients in force: the table's (material > 0) or the parameters'.
+  double static_coefficient() const {
+    if (const auto* r = record()) return *(lubricated != 0.0 ? r->mu_s_lubricated : r->mu_s_dry);
+    return mu_s;
+  }
+  double kinetic_coefficient() const {
+    if (const auto* r = record()) return *(lubricated != 0.0 ? r->mu_k_lubricated : r->mu_k_dry);
+    return mu_k;
+  }
+
+  std::string validate() const {
+    if (!(angle_deg >= 0.0 && angle_deg < 90.0)) return "angle_deg must be in [0, 90)";
+    for (auto err : {require_positive("mass_kg", mass_kg), require_positive("gravity", gravity),
+                     require_positive("duration", duration), require_finite("v0", v0)})
+      if (!err.empty()) return err;
+    if (!(lubricated == 0.0 || lubricated == 1.0)) return "lubricated must be 0 or 1";
+    if (!(locate == 0.0 || locate == 1.0)) return "locate must be 0 (end_of_step) or 1 (locate)";
+    const double rows = static_cast<double>(exact::friction_table.size());
+    if (!(material >= 0.0 && material <= rows && material == std::floor(material)))
+      return fmt::format("material must be a row of the friction table, 1 to {} (or 0: none)", rows);
+    if (const auto* r = record()) {
+      if (mu_s != Scene::mu_s || mu_k != Scene::mu_k) return "give either material or mu_s and mu_k, not both";
+      const bool lub = lubricated != 0.0;
+      const auto& s = lub ? r->mu_s_lubricated : r->mu_s_dry;
+      const auto& k = lub ? r->mu_k_lubricated : r->mu_k_dry;
+      if (!s || !k)
+        return fmt::format(
+            "the lecture's table has no {} coefficient for {} ({}); choose another pair or give mu_s "
+            "and mu_k",
+            !s ? "static" : "kinetic", exact::friction_name(*r), lub ? "lubricated" : "dry");
+    }
+    if (!(std::isfinite(mu_s) && mu_s >= 0.0)) return "mu_s must be finite and >= 0";
+    if (!(std::isfinite(mu_k) && mu_k >= 0.0)) return "mu_k must be finite and >= 0";
+    return {};
+  }
+
+  double theta() const { return angle_deg * (std::numbers::pi / 180.0); }
+  exact::sliding_block motion() const { return {gravity, theta(), static_coefficient(), kinetic_coefficient(), v0}; }
+  // Once at rest, the block stays (static friction holds; see the exact motion for the
+  // case mu_s < tan theta <= mu_k).
+  bool holds() const { return motion().stays_at_rest(); }
+
+  double mass() const { return mass_kg; }
+  double horizon() const { return duration; }
+  void force(double, const vec&, const vec& v, vec& f) const {
+    const double w = mass_kg * gravity, along = w * std::sin(theta()),
+                 kinetic = kinetic_coefficient() * w * std::cos(theta());
+    if (v[0] > 0.0)
+      f[0] = -along - kinetic;
+    else if (v[0] < 0.0)
+      f[0] = -along + kinetic;
+    else
+      f[0] = holds() ? 0.0 : -(along - kinetic);
+  }
+  // The force is piecewise constant in v (its jump at v = 0 is the stop event's): both
+  // derivatives are zero. Given, so that no implicit method differences across the jump.
+  jacobian_matrix make_jacobian() const { return jacobian_matrix::Zero(); }
+  void jacobian(double, const vec&, const vec&, jacobian_matrix& dfdx, jacobian_matrix& dfdv) const {
+    dfdx.setZero();
+    dfdv.setZero();
+  }
+  phase<vec> initial() const { return {vec(0.0), vec(v0)}; }
+  phase<vec> exact(double t) const {
+    const auto s = motion().at(t);
+    return {vec(s.s), vec(s.v)};
+  }
+  double energy(const vec& x, const vec& v) const {
+    return 0.5 * mass_kg * v.squaredNorm() + mass_kg * gravity * std::sin(theta()) * x[0];
+  }
+
+  // The stop as a contact, where static friction holds: v along the first motion.
+  bool has_stop() const { return v0 != 0.0 && holds(); }
+  double contact_gap(double, const vec&, const vec& v) const {
+    return has_stop() ? std::copysign(1.0, v0) * v[0] : 1.0;
+  }
+  contact_outcome resolve_contacts(double, vec&, vec& v) const {
+    contact_outcome c;
+    if (has_stop() && std::copysign(1.0, v0) * v[0] < 0.0) {
+      v[0] = 0.0;  // static friction holds it
+      c.resolved = 1;
+      c.changed = true;
+    }
+    return c;
+  }
+  bool locate_contacts() const { return locate != 0.0; }
+};
+
+// The lecture's worked example (digest section 3): 30 degrees, mu_k = 0.5 (and mu_s = 0.5,
+// its static example's): tan 30 = 0.577 > 0.5, so the block stops and slides back.
+struct sliding_block_scene {
+  static constexpr std::string_view name = "sliding_block";
+  static constexpr std::string_view description = "block pushed up a 30 deg incline, mu = 0.5: stops, slides back";
+  static constexpr double angle_deg = 30.0, v0 = 5.0, material = 0.0, mu_s = 0.5, mu_k = 0.5;
+};
+using sliding_block = incline_block<sliding_block_scene>;
+
+// Steel on steel, dry (mu_s 0.74, mu_k 0.57), at 30 degrees: mu_k < tan 30 = 0.577 <=
+// mu_s, so the block sticks where it stops, and kinetic friction alone would let it creep
+// back at 0.06 m/s^2.
+struct sliding_block_stick_scene {
+  static constexpr std::string_view name = "sliding_block_stick";
+  static constexpr std::string_view description = "block pushed up a 30 deg incline, steel on steel: stops and sticks";
+  static constexpr double angle_deg = 30.0, v0 = 5.0, material = friction_row("steel_on_steel"), mu_s = 0.5, mu_k = 0.5;
+};
+using sliding_block_stick = incline_block<sliding_block_stick_scene>;
+
+}  // namespace stepbench

@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# Rewrites results/baseline.h5, the accuracy baseline CI gates on (`stepbench compare`),
+# from the quick study of the present build. Run it deliberately, when a change is meant
+# to change the accuracy tables (a new method, a corrected step), after reading what
+# `stepbench compare results/baseline.h5 <new quick study>` reports, and commit the new
+# file with the reason in the commit message.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${STEPBENCH_BUILD_DIR:-$root/build}
+[ -x "$build/stepbench_bench" ] || "$root/scripts/build.sh"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+"$build/stepbench_bench" --quick --study_out="$tmp/quick.h5" >/dev/null
+if [ -f "$root/results/baseline.h5" ]; then
+  "$build/stepbench" compare "$root/results/baseline.h5" "$tmp/quick.h5" --allow-removed || true
+fi
+mv "$tmp/quick.h5" "$root/results/baseline.h5"
+echo "wrote results/baseline.h5; commit it with the reason"

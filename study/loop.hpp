@@ -1,0 +1,153 @@
+#pragma once
+// The game-loop study (issue 11): what the player sees. Each configuration (problem,
+// integrator, loop design, display clock, physics rate, clamp) is simulated whole by
+// core/game_loop.hpp, and the state shown at every displayed frame is compared with the
+// exact state (closed form, or the references' solution) at that frame's display time.
+//
+// Measured per configuration:
+//   shown error      max and RMS over the frames of |shown position - exact position|
+//   frame-rate independence
+//                    |state at the horizon - the same configuration's on the reference
+//                    clock (constant, 60 Hz)|, for the physics state and the shown one
+//   judder           the standard deviation over the frames of (shown velocity - exact
+//                    velocity), both as finite differences of positions over display time
+//   lag              the time the shown state trails the display time, measured: the
+//                    tau that best fits shown(t) = exact(t - tau) (least squares,
+//                    tau = -sum (shown - exact) . v / sum |v|^2); beside it the lag the
+//                    loop's clocks imply (display time - simulated time of the shown state)
+//   steps per frame  mean, max, the catch-up burst of the stall frame, the frames the
+//                    clamp cut
+//   cost model       core/game_loop.hpp's schedule_loop at a cost per step: measured
+//                    (the benchmark's median ns per step of this integrator on this
+//                    problem, in a timed study) or stated (`stated_step_cost_ns`)
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/game_loop.hpp"
+#include "core/measure.hpp"
+#include "core/method.hpp"
+#include "core/problem_instance.hpp"
+
+namespace H5 {
+class Group;
+}
+
+namespace stepbench {
+
+struct study;
+struct problem_study;
+
+struct loop_options {
+  bool enabled = true;
+  std::vector<std::string> problems{"pendulum", "damped_spring"};
+  std::vector<std::string> methods{"semi_implicit_euler", "rk4"};
+  std::vector<double> display_hz{30, 60, 75, 144, 165, 240};  // constant clocks
+  std::vector<double> physics_hz{50, 60, 100, 120};
+  // The clock frame-rate independence is measured against, and the nominal rate of the
+  // jittered and the stalling clocks.
+  double reference_display_hz = 60.0;
+  std::uint64_t jitter_seed = 1;
+  double jitter = 0.25;
+  double clamp_s = 0.25;  // the lecture's; the stalling clock runs with it and without
+  double stall_s = 1.0;
+  double stall_at_fraction = 0.5;  // of the horizon, on the wall clock
+  double target = 1e-3;            // the cheapest design keeps its shown error at or under this (1 mm, 1 mrad)
+  // The cost of a step where the study has no timing: 1 us, ten times and more what our
+  // steps cost on these small problems (tens of ns), so a verdict of "keeps up" at this
+  // cost also holds at the measured one.
+  double stated_step_cost_ns = 1000.0;
+  bool progress = false;
+};
+
+// One configuration, measured.
+struct loop_row {
+  loop_config config;
+  std::string clock;  // "constant", "jitter" or "stall"
+  long frames = 0;
+  long physics_steps = 0;
+  long force_evals = 0;
+  double shown_err_max = 0.0, shown_err_rms = 0.0, final_shown_err = 0.0;
+  double clock_dependence = 0.0, physics_clock_dependence = 0.0;
+  double judder = 0.0;
+  double lag_s = 0.0, lag_clock_s = 0.0;
+  double steps_per_frame_mean = 0.0;
+  long steps_per_frame_max = 0, stall_burst_steps = 0, clamp_hits = 0;
+  double alpha_min = 0.0, alpha_max = 0.0;  // NaN for variable and substeps
+  double physics_t = 0.0;                   // simulated time of final_physics
+  std::vector<double> final_physics;        // [x; v] after the last whole physics step
+  std::vector<double> final_shown;          // [x; v] shown at the horizon
+  bool diverged = false;
+  std::string note;
+};
+
+struct loop_method {
+  method_info info;
+  std::vector<loop_row> rows;
+};
+
+struct loop_problem {
+  std::string name, position_unit, truth_source;
+  double horizon = 0.0;
+  std::vector<loop_method> methods;
+};
+
+struct loop_study {
+  loop_options options;
+  std::vector<loop_problem> problems;
+  double wall_seconds = 0.0;
+};
+
+// The exact state at the frames' display times: the closed form, or the references
+// (build_truth) where there is none.
+truth_table loop_truth(const problem_instance& problem, const loop_result& run);
+
+// Measures a simulated run against the truth at its display times; `reference` is the
+// same configuration on the reference clock (nullptr: frame-rate independence NaN).
+loop_row measure_loop(const loop_config& config, std::string clock, const loop_result& run, const truth_table& truth,
+                      const loop_result* reference);
+
+// One configuration as `stepbench loop --design` runs it: simulated, its reference clock
+// simulated, measured. Throws std::invalid_argument for bad input.
+loop_row run_loop_config(const problem_instance& problem, std::string_view method, const loop_config& config,
+                         const loop_options& opts);
+
+// Every configuration of the study for one integrator on one problem.
+loop_method run_loop_method(const problem_instance& problem, const method_info& method, const loop_options& opts);
+
+// The loop study of the problems of `s` that the options name (with their overrides).
+loop_study run_loop_study(const study& s, const loop_options& opts);
+
+// The cost verdict of a configuration at a step cost.
+struct loop_cost {
+  double step_cost_ns = 0.0;
+  std::string source;  // "measured" or "stated"
+  loop_schedule schedule;
+  loop_outcome without_clamp = loop_outcome::keeps_up;  // the same configuration, clamp off
+  bool clamp_prevented_spiral = false;                  // with the clamp no spiral, without it one
+};
+loop_cost cost_verdict(const loop_config& config, double step_cost_ns, std::string source);
+
+// The benchmark's median ns per step of `method` on the problem (its timed rows that
+// completed); NaN when the study has no timing for it.
+double measured_step_cost_ns(const problem_study& ps, std::string_view method);
+
+// The cheapest design at a constant display rate whose shown error stays at or under
+// the target: fewest physics steps per frame, then the smaller error, then the designs
+// that do not depend on the frame rate first (fixed, interpolated, substeps, variable).
+struct loop_cheapest {
+  double display_hz = 0.0;
+  double target = 0.0;
+  bool found = false;
+  std::string design;
+  double physics_hz = 0.0;  // NaN for variable
+  double steps_per_frame_mean = 0.0;
+  double shown_err_max = 0.0;
+};
+std::vector<loop_cheapest> cheapest_designs(const loop_method& m, const loop_options& opts);
+
+// /loop (docs/study-format.md), when the study holds a loop study.
+void write_loop(H5::Group& root, const study& s);
+
+}  // namespace stepbench

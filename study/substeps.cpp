@@ -47,9 +47,9 @@ std::string damping_text(double d) {
 std::string describe(const substep_verdict& v) {
   const bool by_time = v.cost_kind == "time_ns";
   auto cost = [&](double c) { return by_time ? format_time_ns(c) : fmt::format("{:.0f} force evaluations", c); };
-  std::string s =
-      fmt::format("{}: one {} step a frame costs {} for a max position error of {:.3g} and {}; ", v.problem,
-                  v.implicit_method, cost(v.implicit_cost), v.implicit_error, damping_text(v.implicit_damping));
+  std::string s = fmt::format(
+      "{}: one {} step a frame costs {} over the run for a max position error of {:.3g} and {}; ", v.problem,
+      v.implicit_method, cost(v.implicit_cost), v.implicit_error, damping_text(v.implicit_damping));
   if (v.substeps_at_equal_cost == 0) {
     s += fmt::format("even one {} step costs more", v.explicit_method);
   } else if (!std::isfinite(v.explicit_error)) {

@@ -36,8 +36,8 @@ struct substep_verdict {
 };
 std::vector<substep_verdict> substep_verdicts(const substep_study& s, bool timed);
 
-// /substeps/<problem>: attributes frame_dt, frames; methods/<m>/runs (the study's row
-// fields plus `substeps` and `extra_damping`); `verdict` (a table of substep_verdict).
+// /substeps/<problem>: attribute frame_dt (frames = the problem's horizon / frame_dt); methods/<m>/runs (the study's
+// row fields plus `substeps` and `extra_damping`); `verdict` (a table of substep_verdict).
 void write_substeps(H5::Group& root, const std::vector<substep_study>& studies, bool timed);
 
 }  // namespace stepbench

@@ -294,7 +294,7 @@ def section(doc, study, figs):
     kinds = {s.cost_kind for s in data.scenes}
     by_time = kinds == {"time_ns"}
     doc.p("Macklin et al. (Small Steps in Physics Simulation, SCA 2019) found that n small explicit steps a frame "
-          f"beat one implicit step with n solver iterations on stiff systems. Measured here on springs "
+          "beat one implicit step with n solver iterations on stiff systems. Measured here on springs "
           f"({', '.join(s.name for s in data.scenes)}): one step a frame of {_names(data, True)} (a Newton solve "
           f"a step) against n substeps of the frame, n = {', '.join(str(n) for n in _counts(data))}, of "
           f"{_names(data, False)}, each run measured like every study row (max position error over the run "

@@ -66,9 +66,17 @@ def test_every_problem_and_method(plain, listing):
         assert g.attrs["horizon"] == pytest.approx(p["horizon"])
         assert g.attrs["position_unit"] == p["position_unit"]
         assert set(g["reference"]) == {"gsl_rk8pd", "cvode_bdf", "cvode_adams", "arkode_erk8"}
-        for ref in g["reference"].values():
-            assert ref.attrs["status"] == "ok"
-            assert ref["position"].shape == (p["dim"],) and ref["velocity"].shape == (p["dim"],)
+        for src, ref in g["reference"].items():
+            status = ref.attrs["status"]
+            # Where a closed form is the truth a reference may fail, disagree or not apply (no
+            # root finding to stop at contacts); on these scenes every one agrees.
+            if p["name"] in ("constant_acceleration", "projectile", "damped_spring", "pendulum", "stiff_spring",
+                             "spring_chain"):
+                assert status == "ok", (p["name"], src)
+            else:
+                assert status in ("ok", "disagrees", "failed", "unsupported"), (p["name"], src, status)
+            if status in ("ok", "disagrees"):
+                assert ref["position"].shape == (p["dim"],) and ref["velocity"].shape == (p["dim"],)
             for stat in ["steps", "failed_steps", "rhs_evals", "lin_rhs_evals", "rhs_evals_counted"]:
                 assert stat in ref.attrs
         assert set(g["methods"]) == set(p["methods"])

@@ -22,7 +22,10 @@ options take_own_flags(int& argc, char** argv, std::vector<std::string>& extra) 
       if (assignment.find('.') == std::string::npos || assignment.find('.') > assignment.find('='))
         throw std::invalid_argument("--set=" + assignment + ": name the problem, --set=problem.name=value");
       add_override(o.overrides, assignment, {});
-    } else if (a == "--study_out" || a == "--case_budget" || a == "--set") {
+    } else if (a.rfind("--problem=", 0) == 0) {
+      o.problems.push_back(a.substr(10));  // checked by run_sweep's validate()
+      if (o.problems.back().empty()) throw std::invalid_argument("--problem needs a problem name");
+    } else if (a == "--study_out" || a == "--case_budget" || a == "--set" || a == "--problem") {
       throw std::invalid_argument(a + " takes its value after '=': " + a + "=VALUE");
     } else if (a.rfind("--study_out=", 0) == 0) {
       o.study_out = a.substr(12);

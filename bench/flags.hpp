@@ -22,6 +22,10 @@ struct options {
   int repetitions = 2;
   bool list_only = false;
   std::map<std::string, std::map<std::string, double>> overrides;  // problem -> parameter -> value
+  // --problem=NAME (repeatable): sweep and time only these problems (the study file then
+  // holds only them); empty: every problem. A narrow --benchmark_filter still sweeps
+  // every problem, since the cases are the sweep's rows.
+  std::vector<std::string> problems;
 };
 
 // Removes our flags from argv (argc updated) and appends Google Benchmark flags for the

@@ -40,6 +40,7 @@ int main(int argc, char** argv) {
       sopts.tolerances = tolerance_ladder(true);
     }
     sopts.overrides = opts.overrides;  // checked by run_sweep's validate()
+    sopts.problems = opts.problems;
     sopts.progress = !opts.list_only;
     const auto start = std::chrono::steady_clock::now();
     study s = run_sweep(sopts);

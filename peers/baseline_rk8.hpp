@@ -105,21 +105,8 @@ struct baseline_rk8 {
     const auto accel = baseline_acceleration(p);
     const auto s0 = p.initial();
     double x = s0.x[0], v = s0.v[0];
-    drive_result<vec> out;
-    out.start(1, plan.size());
-    const loop_end end = fixed_step_loop(
-        dt, horizon, plan, [&](double, double h) { step<velocity>(x, v, h, accel); }, [](double) {},
-        [&](double t) {
-          if (!std::isfinite(x) || !std::isfinite(v)) return out.non_finite = true, false;
-          out.record(t, vec(x), vec(v));
-          return true;
-        });
-    out.steps = end.steps;
-    out.t_final = end.t;
-    out.work.force_evals = 12 * end.steps;
-    out.non_finite = out.non_finite || !std::isfinite(x) || !std::isfinite(v);
-    out.final_state = {vec(x), vec(v)};
-    return out;
+    return run_scalar_baseline<vec>(x, v, dt, horizon, plan, 12,
+                                    [&](double, double h) { step<velocity>(x, v, h, accel); });
   }
 };
 

@@ -15,7 +15,8 @@ study=${STUDY_OUT:-$(mktemp --suffix=.h5)}
 [ -n "${STUDY_OUT:-}" ] || trap 'rm -f "$study"' EXIT
 # stepbench_bench exits 3 when some case failed (recorded in the file with its reason): the
 # ratios are still worth printing, so only a missing file stops here.
-"$build/stepbench_bench" --benchmark_filter='^(damped_spring|pendulum|kepler)/' --study_out="$study" "$@" \
+"$build/stepbench_bench" --problem=damped_spring --problem=pendulum --problem=kepler \
+  --benchmark_filter='^(damped_spring|pendulum|kepler)/' --study_out="$study" "$@" \
   >/dev/null 2>"$study.log" || status=$?
 if [ ! -s "$study" ]; then
   cat "$study.log" >&2

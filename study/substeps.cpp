@@ -51,7 +51,11 @@ std::string describe(const substep_verdict& v) {
       "{}: one {} step a frame costs {} over the run for a max position error of {:.3g} and {}; ", v.problem,
       v.implicit_method, cost(v.implicit_cost), v.implicit_error, damping_text(v.implicit_damping));
   if (v.substeps_at_equal_cost == 0) {
-    s += fmt::format("even one {} step costs more", v.explicit_method);
+    // By time, a run that diverged has no time (it is not timed), so "none costs as
+    // little" may mean that the cheap counts diverged.
+    s += by_time ? fmt::format("no timed {} run costs as little (the substep counts that diverge are not timed)",
+                               v.explicit_method)
+                 : fmt::format("even one {} step costs more", v.explicit_method);
   } else if (!std::isfinite(v.explicit_error)) {
     s += fmt::format("at that cost {} affords {} substep{}, which diverge{}", v.explicit_method,
                      v.substeps_at_equal_cost, v.substeps_at_equal_cost == 1 ? "" : "s",

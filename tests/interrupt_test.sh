@@ -59,7 +59,7 @@ interrupt_throughout() {
 
 echo "previous results" >"$work/study.h5"
 interrupt_throughout "$work/scratch.h5" "$work/study.h5" "$stepbench" sweep --quick --quiet --problem pendulum --problem spring_chain --out __TARGET__
-interrupt_throughout "$work/scratch.h5" "$work/study.h5" "$bench" --quick --benchmark_filter=pendulum --study_out=__TARGET__
+interrupt_throughout "$work/scratch.h5" "$work/study.h5" "$bench" --quick --problem=pendulum --benchmark_filter=pendulum --study_out=__TARGET__
 rm -f "$work/scratch.h5"
 # Unless a run finished before its signal (and rightly replaced it), the file is the first one.
 [ "$finished" -gt 0 ] || { [ "$(cat "$work/study.h5")" = "previous results" ] && ok || bad "the previous study file was touched"; }

@@ -64,21 +64,21 @@ def test_lists_a_case_for_every_completed_row(bench, plain_study):
 
 
 def test_filter_selects_one_family(bench):
-    names = listed(bench, "--benchmark_filter=^pendulum/rk4/")
+    names = listed(bench, "--problem=pendulum", "--benchmark_filter=^pendulum/rk4/")
     assert len(names) == 8 and all(n.startswith("pendulum/rk4/dt:") for n in names)
 
 
 def test_json_format_is_clean_json_on_stdout(bench):
     """--benchmark_format=json: stdout is the JSON document and nothing else; the sweep's
     progress and the summary go to stderr."""
-    done = run_bench(bench, f"--benchmark_filter={ONE_CASE}", "--benchmark_format=json", check=True)
+    done = run_bench(bench, "--problem=pendulum", f"--benchmark_filter={ONE_CASE}", "--benchmark_format=json", check=True)
     doc = json.loads(done.stdout)
     assert [b["name"] for b in doc["benchmarks"]] == ["pendulum/rk4/dt:0.0430546/real_time"]
     assert "swept pendulum" in done.stderr and "stepbench_bench:" in done.stderr
 
 
 def test_csv_format_is_clean_csv_on_stdout(bench):
-    done = run_bench(bench, f"--benchmark_filter={ONE_CASE}", "--benchmark_format=csv", check=True)
+    done = run_bench(bench, "--problem=pendulum", f"--benchmark_filter={ONE_CASE}", "--benchmark_format=csv", check=True)
     rows = list(csv.DictReader(io.StringIO(done.stdout)))
     assert [r["name"] for r in rows] == ["pendulum/rk4/dt:0.0430546/real_time"]
     assert float(rows[0]["err_pos_max"]) > 0 and int(float(rows[0]["force_evals"])) == 512
@@ -86,7 +86,7 @@ def test_csv_format_is_clean_csv_on_stdout(bench):
 
 
 def test_counters_tabular_prints_a_header(bench):
-    done = run_bench(bench, "--benchmark_filter=^pendulum/(rk4|cvode_bdf)/", "--benchmark_counters_tabular=true",
+    done = run_bench(bench, "--problem=pendulum", "--benchmark_filter=^pendulum/(rk4|cvode_bdf)/", "--benchmark_counters_tabular=true",
                      check=True)
     header = next(line for line in done.stdout.splitlines() if line.startswith("Benchmark"))
     for column in ["Time", "Iterations", "err_pos_final", "err_pos_max", "force_evals", "steps"]:
@@ -95,7 +95,7 @@ def test_counters_tabular_prints_a_header(bench):
 
 def test_one_case_agrees_with_stepbench_run(bench, stepbench, tmp_path):
     out = tmp_path / "case.json"
-    run_bench(bench, "--benchmark_filter=^damped_spring/rk4/dt:0.0390625/", f"--benchmark_out={out}",
+    run_bench(bench, "--problem=damped_spring", "--benchmark_filter=^damped_spring/rk4/dt:0.0390625/", f"--benchmark_out={out}",
               "--benchmark_out_format=json", check=True)
     runs = [b for b in json.loads(out.read_text())["benchmarks"] if b["run_type"] == "iteration"]
     assert [r["name"] for r in runs] == ["damped_spring/rk4/dt:0.0390625/real_time"]
@@ -159,6 +159,8 @@ def test_quick_timed_study(timed_study, stepbench):
     (["--case_budget=0"], "--case_budget must be > 0"),
     (["--study_out=/nonexistent/dir/study.h5"], "cannot write results file"),
     (["--no_such_flag"], "unrecognized command-line flag"),
+    (["--problem=nope"], "unknown problem 'nope'"),
+    (["--problem="], "--problem needs a problem name"),
 ])
 def test_bad_flags(bench, args, message):
     done = run_bench(bench, *args)
@@ -171,7 +173,7 @@ def test_time_budget_cuts_and_marks_the_fine_end(bench, tmp_path):
     """A budget far below one iteration's time: each family's first (coarsest) case runs,
     every finer one is cut, and the study file says so instead of holding a number."""
     path = tmp_path / "cut.h5"
-    run_bench(bench, "--case_budget=1e-9", "--benchmark_filter=^pendulum/(rk4|cvode_bdf)/", f"--study_out={path}",
+    run_bench(bench, "--problem=pendulum", "--case_budget=1e-9", "--benchmark_filter=^pendulum/(rk4|cvode_bdf)/", f"--study_out={path}",
               check=True)
     with h5py.File(path, "r") as f:
         assert f.attrs["benchmark_case_budget_s"] == 1e-9
@@ -193,7 +195,7 @@ def test_two_json_outputs_compare_with_google_benchmarks_compare_py(bench, tmp_p
     outs = []
     for name in ["a.json", "b.json"]:
         out = tmp_path / name
-        run_bench(bench, "--benchmark_filter=^damped_spring/(rk4|gsl_rk4)/", f"--benchmark_out={out}",
+        run_bench(bench, "--problem=damped_spring", "--benchmark_filter=^damped_spring/(rk4|gsl_rk4)/", f"--benchmark_out={out}",
                   "--benchmark_out_format=json", check=True)
         outs.append(str(out))
     done = subprocess.run(["/usr/bin/python3", compare, "benchmarks", *outs], capture_output=True, text=True,
@@ -207,7 +209,7 @@ def test_set_reaches_the_timed_cases_and_the_study(bench, stepbench, tmp_path):
     """--set changes the scene for the sweep and for the timed loop alike: the study
     records the parameter, and a timed case's counters equal `stepbench run --set`."""
     path, out = tmp_path / "set.h5", tmp_path / "set.json"
-    run_bench(bench, "--set=damped_spring.k_d=3", "--benchmark_filter=^damped_spring/rk4/dt:0.0390625/",
+    run_bench(bench, "--problem=damped_spring", "--set=damped_spring.k_d=3", "--benchmark_filter=^damped_spring/rk4/dt:0.0390625/",
               f"--benchmark_out={out}", "--benchmark_out_format=json", f"--study_out={path}", check=True)
     with h5py.File(path, "r") as f:
         assert f["problems/damped_spring"].attrs["k_d"] == 3.0

@@ -554,7 +554,8 @@ def test_advise_cut_rows_are_too_slow(stepbench, bench, tmp_path):
     """A time budget that cuts every row but the coarsest: rk4 reaches 1e-6 only at rows
     that were cut, so it is "too slow", not "too inaccurate"."""
     study = tmp_path / "cut.h5"
-    run_study([bench, "--quick", "--case_budget=1e-9", "--benchmark_filter=^pendulum/rk4/", f"--study_out={study}"],
+    run_study([bench, "--quick", "--problem=pendulum", "--case_budget=1e-9", "--benchmark_filter=^pendulum/rk4/",
+               f"--study_out={study}"],
               capture_output=True)
     p = advise(stepbench, study, "--problem", "pendulum", "--tol", "1e-6", "--json")
     reasons = {e["method"]: e["reason"] for e in json.loads(p.stdout)["excluded"]}

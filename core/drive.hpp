@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "core/concepts.hpp"
+#include "core/flatten.hpp"
 #include "core/system.hpp"
 
 namespace stepbench {
@@ -289,8 +290,8 @@ template <class Advance, class AfterStep, class Record>
 // expression templates) is inlined into it whatever the optimisation level; at -O2 GCC's
 // inliner otherwise stops a few calls deep and a step costs ~1.8x more.
 template <problem P, integrator I>
-[[gnu::flatten]] drive_result<typename P::vec> drive(const P& problem, const I& method, double dt, double horizon,
-                                                     std::span<const record_point> plan) {
+STEPBENCH_FLATTEN drive_result<typename P::vec> drive(const P& problem, const I& method, double dt, double horizon,
+                                                      std::span<const record_point> plan) {
   using Vec = typename P::vec;
   counted_system<P> sys{problem};
   step_state<Vec> s = start_state(problem);
@@ -331,8 +332,8 @@ template <problem P, integrator I>
 // small that the run could not finish, and often its error estimate would sink into
 // round-off first).
 template <problem P, adaptive_integrator I>
-[[gnu::flatten]] drive_result<typename P::vec> drive_adaptive(const P& problem, const I& method, double horizon,
-                                                              std::span<const double> times, long max_steps) {
+STEPBENCH_FLATTEN drive_result<typename P::vec> drive_adaptive(const P& problem, const I& method, double horizon,
+                                                               std::span<const double> times, long max_steps) {
   using Vec = typename P::vec;
   counted_system<P> sys{problem};
   step_state<Vec> s = start_state(problem);

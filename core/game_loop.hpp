@@ -46,6 +46,7 @@
 
 #include "core/concepts.hpp"
 #include "core/drive.hpp"
+#include "core/flatten.hpp"
 #include "core/system.hpp"
 
 namespace stepbench {
@@ -302,7 +303,7 @@ std::vector<double> joined(const Vec& x, const Vec& v) {
 // The run of one design. flatten, as drive(): the step, the force model and Eigen's
 // expressions inline into the frame loop.
 template <loop_design D, problem P, integrator I>
-[[gnu::flatten]] loop_result simulate_loop_design(const P& problem, const I& method, const loop_config& cfg) {
+STEPBENCH_FLATTEN loop_result simulate_loop_design(const P& problem, const I& method, const loop_config& cfg) {
   using Vec = typename P::vec;
   counted_system<P> sys{problem};
   step_state<Vec> s = start_state(problem);

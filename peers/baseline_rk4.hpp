@@ -9,6 +9,7 @@
 #include <span>
 
 #include "core/drive.hpp"
+#include "core/flatten.hpp"
 #include "core/method.hpp"
 #include "problems/damped_spring.hpp"
 #include "problems/pendulum.hpp"
@@ -72,8 +73,8 @@ struct baseline_rk4 {
   }
 
   template <problem P>
-  [[gnu::flatten]] static drive_result<typename P::vec> run(const P& p, double dt, double horizon,
-                                                            std::span<const record_point> plan) {
+  STEPBENCH_FLATTEN static drive_result<typename P::vec> run(const P& p, double dt, double horizon,
+                                                             std::span<const record_point> plan) {
     using vec = typename P::vec;
     const auto accel = baseline_acceleration(p);
     const auto s0 = p.initial();

@@ -98,8 +98,8 @@ struct baseline_rk8 {
   }
 
   template <problem P>
-  [[gnu::flatten]] static drive_result<typename P::vec> run(const P& p, double dt, double horizon,
-                                                            std::span<const record_point> plan) {
+  STEPBENCH_FLATTEN static drive_result<typename P::vec> run(const P& p, double dt, double horizon,
+                                                             std::span<const record_point> plan) {
     using vec = typename P::vec;
     constexpr bool velocity = P::force_depends_on_velocity;
     const auto accel = baseline_acceleration(p);

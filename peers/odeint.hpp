@@ -9,6 +9,7 @@
 
 #include "core/drive.hpp"
 #include "core/first_order.hpp"
+#include "core/flatten.hpp"
 #include "core/method.hpp"
 
 #if STEPBENCH_HAVE_ODEINT
@@ -50,8 +51,8 @@ struct odeint_rk4 {
   }
 
   template <problem P>
-  [[gnu::flatten]] static drive_result<typename P::vec> run(const P& p, double dt, double horizon,
-                                                            std::span<const record_point> plan) {
+  STEPBENCH_FLATTEN static drive_result<typename P::vec> run(const P& p, double dt, double horizon,
+                                                             std::span<const record_point> plan) {
     using vec = typename P::vec;
     constexpr int d = vec::RowsAtCompileTime;
     using state = std::array<double, 2 * d>;
@@ -103,8 +104,8 @@ struct odeint_velocity_verlet {
   }
 
   template <problem P>
-  [[gnu::flatten]] static drive_result<typename P::vec> run(const P& p, double dt, double horizon,
-                                                            std::span<const record_point> plan) {
+  STEPBENCH_FLATTEN static drive_result<typename P::vec> run(const P& p, double dt, double horizon,
+                                                             std::span<const record_point> plan) {
     using vec = typename P::vec;
     constexpr int d = vec::RowsAtCompileTime;
     using coord = std::array<double, d>;

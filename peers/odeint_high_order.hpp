@@ -23,6 +23,7 @@
 
 #include "core/drive.hpp"
 #include "core/first_order.hpp"
+#include "core/flatten.hpp"
 #include "core/method.hpp"
 
 #if STEPBENCH_HAVE_ODEINT
@@ -151,8 +152,8 @@ struct odeint_adaptive {
   }
 
   template <problem P>
-  [[gnu::flatten]] static drive_result<typename P::vec> run(const P& p, double tol, double horizon,
-                                                            std::span<const double> times, long max_steps) {
+  STEPBENCH_FLATTEN static drive_result<typename P::vec> run(const P& p, double tol, double horizon,
+                                                             std::span<const double> times, long max_steps) {
     namespace odeint = boost::numeric::odeint;
     using state = odeint_detail::state<P>;
     long calls = 0;
@@ -230,8 +231,8 @@ struct odeint_rkf78 {
   }
 
   template <problem P>
-  [[gnu::flatten]] static drive_result<typename P::vec> run(const P& p, double dt, double horizon,
-                                                            std::span<const record_point> plan) {
+  STEPBENCH_FLATTEN static drive_result<typename P::vec> run(const P& p, double dt, double horizon,
+                                                             std::span<const record_point> plan) {
     using state = odeint_detail::state<P>;
     long calls = 0;
     const first_order_form<P> rhs(p);

@@ -10,9 +10,11 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "default_study.hpp"
 #include "study/sweep.hpp"
 
 using namespace stepbench;
+using stepbench::test_support::default_study;
 
 namespace {
 
@@ -20,11 +22,6 @@ nlohmann::json fixture() {
   std::ifstream in(STEPBENCH_TEST_DATA "/accuracy_before_issue7.json");
   EXPECT_TRUE(in.good()) << "cannot open the fixture";
   return nlohmann::json::parse(in, nullptr, true, /*ignore_comments=*/false);
-}
-
-const study& default_study() {
-  static const study s = run_sweep(sweep_options{});
-  return s;
 }
 
 const method_study* find(const std::string& key) {

@@ -231,5 +231,4 @@ TEST(energy, symplectic_bounded_others_drift) {
     }
     EXPECT_LT(find("rk4").drift_per_period, 0.0) << ep.problem;
   }
-  EXPECT_LT(s.wall_seconds, 60.0);
 }

@@ -5,16 +5,13 @@
 #include <cmath>
 
 #include "core/drive.hpp"
+#include "default_study.hpp"
 #include "study/sweep.hpp"
 
 using namespace stepbench;
+using stepbench::test_support::default_study;
 
 namespace {
-
-const study& default_study() {
-  static const study s = run_sweep(sweep_options{});
-  return s;
-}
 
 const problem_study& find(const study& s, std::string_view name) {
   for (const auto& p : s.problems)

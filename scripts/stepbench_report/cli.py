@@ -56,6 +56,7 @@ def main(argv=None, start=None):
         raise KeyboardInterrupt(f"signal {signum}")
     signal.signal(signal.SIGTERM, interrupted)
     old = moved_aside = None
+    swapped = False  # the new report is in place: from here on nothing can be lost
     try:
         # matplotlib is imported only now: a file the report refuses is refused at once.
         from . import report
@@ -72,7 +73,7 @@ def main(argv=None, start=None):
             moved_aside = os.path.join(old, "report")
             os.rename(out, moved_aside)
         os.rename(tmp, out)
-        moved_aside = None
+        moved_aside, swapped = None, True
         if old:
             shutil.rmtree(old, ignore_errors=True)
     except BaseException as e:  # one line, and nothing half-written left behind or lost
@@ -82,7 +83,8 @@ def main(argv=None, start=None):
         if old:
             shutil.rmtree(old, ignore_errors=True)
         if isinstance(e, KeyboardInterrupt):
-            print("report: error: interrupted; the previous report is unchanged", file=sys.stderr)
+            print(f"report: error: interrupted after the new report was in place: '{args.out}' is complete"
+                  if swapped else "report: error: interrupted; the previous report is unchanged", file=sys.stderr)
             return 130
         if os.environ.get("STEPBENCH_REPORT_DEBUG"):
             raise

@@ -27,9 +27,7 @@
 namespace stepbench {
 namespace {
 
-struct arkode_callback_state : detail::callback_state {
-  std::string last_message;
-};
+using arkode_callback_state = detail::callback_state;
 
 int arkode_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) noexcept {
   auto& st = *static_cast<arkode_callback_state*>(user_data);
@@ -37,26 +35,9 @@ int arkode_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) noexce
   if (st.error || st.non_finite) return -1;
   const auto n = static_cast<std::size_t>(st.sys->n);
   double* dydt = N_VGetArrayPointer(ydot);
-  try {
-    st.sys->rhs(t, std::span<const double>(N_VGetArrayPointer(y), n), std::span<double>(dydt, n));
-  } catch (...) {
-    st.error = std::current_exception();
-    return -1;  // unrecoverable (ARKRhsFn, user guide 5.x)
-  }
-  for (std::size_t i = 0; i < n; ++i)
-    if (!std::isfinite(dydt[i])) {
-      st.non_finite = true;
-      st.non_finite_t = t;
-      return -1;
-    }
+  // -1: unrecoverable (ARKRhsFn, user guide 5.x).
+  if (!st.evaluate(t, std::span<const double>(N_VGetArrayPointer(y), n), std::span<double>(dydt, n))) return -1;
   return 0;
-}
-
-void arkode_error_handler(int error_code, const char* module, const char* function, char* msg,
-                          void* user_data) noexcept {
-  if (error_code == ARK_WARNING) return;
-  auto& st = *static_cast<arkode_callback_state*>(user_data);
-  st.last_message = std::string(module) + "/" + function + ": " + msg;
 }
 
 struct arkode_handles {
@@ -162,7 +143,8 @@ reference_solution solve_arkode_erk(const ode_system& sys, std::span<const doubl
   std::copy(sys.y0.begin(), sys.y0.end(), N_VGetArrayPointer(h.y));
   h.mem = ERKStepCreate(&arkode_rhs, 0.0, h.y, h.ctx);
   if (!h.mem) throw std::runtime_error(source + ": ERKStepCreate returned null");
-  check("ERKStepSetErrHandlerFn", ERKStepSetErrHandlerFn(h.mem, &arkode_error_handler, &st));
+  check("ERKStepSetErrHandlerFn",
+        ERKStepSetErrHandlerFn(h.mem, &detail::keep_sundials_message<arkode_callback_state, ARK_WARNING>, &st));
   check("ERKStepSetUserData", ERKStepSetUserData(h.mem, &st));
   check("ERKStepSetOrder", ERKStepSetOrder(h.mem, order));
   check("ERKStepSStolerances", ERKStepSStolerances(h.mem, tol.rtol, tol.atol));

@@ -30,7 +30,6 @@ namespace stepbench {
 namespace {
 
 struct cvode_callback_state : detail::callback_state {
-  std::string last_message;  // from the error handler, instead of CVODE printing to stderr
   // Interleaved layout (band solver): CVODE's y[2c] = x_c, y[2c+1] = v_c; the system's
   // own layout is [x; v]. These hold the system's view.
   bool interleaved = false;
@@ -67,27 +66,13 @@ int cvode_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) noexcep
   if (st.error || st.non_finite) return -1;
   const auto n = static_cast<std::size_t>(st.sys->n);
   double* dydt = N_VGetArrayPointer(ydot);
-  try {
-    if (st.interleaved) {
-      st.sys->rhs(t, st.plain(N_VGetArrayPointer(y)), st.dydt_plain);
-      to_solver_layout(st, st.dydt_plain, dydt);
-    } else {
-      st.sys->rhs(t, std::span<const double>(N_VGetArrayPointer(y), n), std::span<double>(dydt, n));
-    }
-  } catch (...) {
-    st.error = std::current_exception();
-    return -1;  // negative: unrecoverable, CVODE stops (user guide 6.x, CVRhsFn)
+  // A failure is unrecoverable: negative, CVODE stops (user guide 6.x, CVRhsFn).
+  if (st.interleaved) {
+    if (!st.evaluate(t, st.plain(N_VGetArrayPointer(y)), st.dydt_plain)) return -1;
+    to_solver_layout(st, st.dydt_plain, dydt);
+    return 0;
   }
-  // A non-finite derivative is a broken model, not a step that is too large: fail at once
-  // (unrecoverable) rather than let CVODE shrink the step towards the bad point.
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!std::isfinite(dydt[i])) {
-      st.non_finite = true;
-      st.non_finite_t = t;
-      return -1;
-    }
-  }
-  return 0;
+  return st.evaluate(t, std::span<const double>(N_VGetArrayPointer(y), n), std::span<double>(dydt, n)) ? 0 : -1;
 }
 
 // The first-order Jacobian in the interleaved layout: d(x_c)'/d(v_c) = 1,
@@ -123,15 +108,6 @@ int cvode_contact_root(sunrealtype t, N_Vector y, sunrealtype* gout, void* user_
     return -1;
   }
   return 0;
-}
-
-// Replaces CVODE's default handler, which prints to stderr; the message goes into the
-// exception instead (CVodeSetErrHandlerFn, user guide 6.x).
-void cvode_error_handler(int error_code, const char* module, const char* function, char* msg,
-                         void* user_data) noexcept {
-  if (error_code == CV_WARNING) return;
-  auto& st = *static_cast<cvode_callback_state*>(user_data);
-  st.last_message = std::string(module) + "/" + function + ": " + msg;
 }
 
 // Owns every SUNDIALS handle; members are freed in reverse order of creation on every path.
@@ -207,7 +183,8 @@ reference_solution solve_cvode(const ode_system& sys, std::span<const double> ti
 
   h.mem = CVodeCreate(method == cvode_method::bdf ? CV_BDF : CV_ADAMS, h.ctx);
   check_ptr("CVodeCreate", h.mem);
-  check("CVodeSetErrHandlerFn", CVodeSetErrHandlerFn(h.mem, &cvode_error_handler, &st));
+  check("CVodeSetErrHandlerFn",
+        CVodeSetErrHandlerFn(h.mem, &detail::keep_sundials_message<cvode_callback_state, CV_WARNING>, &st));
   check("CVodeInit", CVodeInit(h.mem, &cvode_rhs, 0.0, h.y));
   check("CVodeSStolerances", CVodeSStolerances(h.mem, tol.rtol, tol.atol));
   check("CVodeSetUserData", CVodeSetUserData(h.mem, &st));

@@ -1,5 +1,6 @@
 #pragma once
-// Shared by the GSL and CVODE wrappers; not part of the interface (reference.hpp).
+// Shared by the GSL, CVODE and ARKODE wrappers; not part of the interface (reference.hpp).
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <span>
@@ -30,6 +31,39 @@ struct callback_state {
   std::exception_ptr error;
   bool non_finite = false;
   double non_finite_t = 0.0;
+  std::string last_message;  // SUNDIALS' error handler's, instead of its printing to stderr
+
+  // The system's f(t, y) into dydt, for a library callback: false when it threw (the
+  // exception is stashed) or gave a non-finite derivative (recorded with its time). A
+  // reference must never silently return NaN, and a non-finite derivative is a broken
+  // model, not a step that is too large: each callback then returns its library's
+  // unrecoverable failure, so the library stops at once rather than shrinking the step
+  // towards the bad point (GSL's y_new control would even accept a NaN error ratio:
+  // GSL 2.7.1 ode-initval2/cstd.c takes rmax = GSL_MAX_DBL(r, rmax), which drops a NaN).
+  bool evaluate(double t, std::span<const double> y, std::span<double> dydt) noexcept {
+    try {
+      sys->rhs(t, y, dydt);
+    } catch (...) {
+      error = std::current_exception();
+      return false;
+    }
+    for (const double d : dydt)
+      if (!std::isfinite(d)) {
+        non_finite = true;
+        non_finite_t = t;
+        return false;
+      }
+    return true;
+  }
 };
+
+// SUNDIALS' error handler (CVodeSetErrHandlerFn, ERKStepSetErrHandlerFn): keeps the
+// message for the exception the wrapper throws; warnings (code `Warning`) are dropped.
+template <class State, int Warning>
+void keep_sundials_message(int error_code, const char* module, const char* function, char* msg,
+                           void* user_data) noexcept {
+  if (error_code == Warning) return;
+  static_cast<State*>(user_data)->last_message = std::string(module) + "/" + function + ": " + msg;
+}
 
 }  // namespace stepbench::detail

@@ -35,13 +35,10 @@ def read(reader, f):
         return None
     attrs = reader.need_attrs(g, ENERGY_ATTRS)
     problems = []
-    for name, pg in g.items():
-        if not hasattr(pg, "items"):
-            continue
+    for name, pg in reader.subgroups(g):
         pattrs = reader.need_attrs(pg, ENERGY_PROBLEM_ATTRS)
         summary = reader.need_table(pg, "summary", SUMMARY_FIELDS)
-        for v in summary["verdict"]:
-            reader.need_value(pg["summary"], "verdict", v, VERDICTS)
+        reader.need_column(pg, "summary", summary, "verdict", VERDICTS)
         series = {}
         sg = reader.need_group(pg, "series")
         for method, mg in sg.items():

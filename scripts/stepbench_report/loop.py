@@ -80,19 +80,14 @@ def read(reader, f):
         return None
     attrs = reader.need_attrs(g, LOOP_ATTRS)
     problems = []
-    for pname, pg in g.items():
-        if not hasattr(pg, "items"):
-            continue
+    for pname, pg in reader.subgroups(g):
         pattrs = reader.need_attrs(pg, LOOP_PROBLEM_ATTRS)
         methods = []
-        for mname, mg in pg.items():
-            if not hasattr(mg, "items"):
-                continue
+        for mname, mg in reader.subgroups(pg):
             mattrs = reader.need_attrs(mg, LOOP_METHOD_ATTRS)
             runs = reader.need_table(mg, "runs", LOOP_RUN_FIELDS)
             for field, allowed in (("design", DESIGNS), ("clock", CLOCKS), ("outcome", OUTCOMES)):
-                for v in runs[field]:
-                    reader.need_value(mg["runs"], field, v, allowed)
+                reader.need_column(mg, "runs", runs, field, allowed)
             methods.append(LoopMethod(mname, mattrs, runs, reader.need_table(mg, "cheapest", LOOP_CHEAPEST_FIELDS)))
         problems.append(LoopProblem(pname, pattrs, methods))
     return Loop(attrs, problems)

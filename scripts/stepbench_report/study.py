@@ -62,13 +62,8 @@ LIMIT_FIELDS = ("integrator", "test", "measured", "theory", "rel_difference", "u
                 "unconditionally_stable", "run_confirms", "step_failed_at", "note")
 STABILITY_TESTS = ("oscillator", "decay")
 
-# Root groups that later issues will add (long energy runs). Their layout is not defined
-# yet; when a root group of one of these names exists the report shows a generic section
-# for it. (The game loop's is: /loop, read by loop.py.)
-OPTIONAL_SECTIONS = {
-    "energy_runs": "Energy drift over time (long runs)",
-}
-# (The long-run energy study is /energy, read by energy_runs.py.)
+# The optional root groups have their own readers: /loop (loop.py), /energy
+# (energy_runs.py), /substeps (substeps.py).
 
 
 class StudyError(Exception):
@@ -190,7 +185,6 @@ class Study:
     path: str
     attrs: dict
     problems: list
-    optional: dict  # hook name -> {"title", "attrs", "datasets"}; see OPTIONAL_SECTIONS
     gaps: list = field(default_factory=list)  # what a complete study would have and this one lacks
     stability: Stability = None  # None only in a file that lacks /stability (a gap)
     loop: object = None  # loop.Loop: /loop, the game-loop study; None when the study has none
@@ -243,6 +237,18 @@ class _Reader:
     def need_value(self, obj, key, value, allowed):
         if value not in allowed:
             raise self.error(f"{obj.name}: {key} is '{value}', not one of {', '.join(map(str, allowed))}")
+
+    def need_column(self, parent, table, rows, field, allowed):
+        """Every value of column `field` of the table `parent`/`table` (read as `rows`) is
+        one of `allowed`."""
+        for v in rows[field]:
+            self.need_value(parent[table], field, v, allowed)
+
+    @staticmethod
+    def subgroups(g):
+        """(name, group) for each group directly under `g`; datasets and attributes beside
+        them are not entries."""
+        return [(name, sub) for name, sub in g.items() if isinstance(sub, h5py.Group)]
 
     def method(self, g, timed):
         attrs = self.need_attrs(g, METHOD_ATTRS)
@@ -340,14 +346,11 @@ class _Reader:
                     if isinstance(g, h5py.Group)]
         if not problems:
             raise self.error("/problems holds no problem")
-        optional = {name: {"title": title, "attrs": {k: _text(v) for k, v in f[name].attrs.items()},
-                           "datasets": {k: v.shape for k, v in f[name].items() if isinstance(v, h5py.Dataset)}}
-                    for name, title in OPTIONAL_SECTIONS.items() if isinstance(f.get(name), h5py.Group)}
         stability = self.stability()
         gaps = _gaps(problems)
         if stability is None:
             gaps.append("no /stability group (the stability limits and regions)")
-        return Study(path=str(self.path), attrs=attrs, problems=problems, optional=optional, gaps=gaps,
+        return Study(path=str(self.path), attrs=attrs, problems=problems, gaps=gaps,
                      stability=stability, loop=loop_section.read(self, f),
                      energy_runs=energy_section.read(self, f), substeps=substeps_section.read(self, f))
 

@@ -79,24 +79,20 @@ def read(reader, f):
     timed = int(f.attrs["timing"]) == 1
     problems = reader.need_group(f, "problems")
     scenes = []
-    for name, pg in g.items():
-        if not hasattr(pg, "items"):
-            continue
+    for name, pg in reader.subgroups(g):
         attrs = reader.need_attrs(pg, SUBSTEP_ATTRS)
         pattrs = reader.need_attrs(reader.need_group(problems, name), ("horizon", "position_unit"))
         frames = int(round(float(pattrs["horizon"]) / float(attrs["frame_dt"])))
         methods = []
-        for mname, mg in reader.need_group(pg, "methods").items():
-            if not hasattr(mg, "items"):
-                continue
+        for mname, mg in reader.subgroups(reader.need_group(pg, "methods")):
             mattrs = reader.need_attrs(mg, SUBSTEP_METHOD_ATTRS)
             reader.need_value(mg, "origin", mattrs["origin"], ORIGINS)
             runs = reader.need_table(mg, "runs", SUBSTEP_RUN_FIELDS + (TIMED_RUN_FIELDS if timed else ()))
             methods.append(SubstepMethod(mname, mattrs, np.sort(runs, order="substeps")))
         verdict = reader.need_table(pg, "verdict", VERDICT_FIELDS)
         names = {m.name for m in methods}
+        reader.need_column(pg, "verdict", verdict, "cost_kind", COST_KINDS)
         for v in verdict:
-            reader.need_value(pg["verdict"], "cost_kind", v["cost_kind"], COST_KINDS)
             for col in ("implicit_method", "explicit_method"):
                 if v[col] not in names:
                     raise reader.error(f"{pg.name}/verdict names {v[col]}, which {pg.name}/methods lacks")

@@ -21,13 +21,15 @@ snapshot() { (cd "$work" && find . -type f -not -name err -print0 | sort -z | xa
 
 # interrupt SIGNAL DELAY_S CMD...: starts CMD, sends SIGNAL after DELAY_S; when the run was
 # interrupted, the folder must be exactly as before (a run that finished first is not a
-# test), unless the signal came after the rename: then nothing temporary is left and the
-# command in `complete` (set per run below) confirms the new target is whole.
+# test), unless the signal came after the rename. That case passes only when the folder
+# holds the same names as before (nothing temporary or stray), the target changed, and
+# the command in `complete` (set per run below) confirms the new target is whole.
 interrupted=0 finished=0 replaced=0
 complete=(false)
+names() { (cd "$work" && find . -not -name err | sort); }
 interrupt() {
   local sig=$1 delay=$2; shift 2
-  local before; before=$(snapshot)
+  local before before_names; before=$(snapshot) before_names=$(names)
   "$@" >/dev/null 2>"$work/err" &
   local pid=$!
   sleep "$delay"
@@ -40,7 +42,7 @@ interrupt() {
   fi
   interrupted=$((interrupted + 1))
   [ "$before" = "$(snapshot)" ] && { ok; return; }
-  if [ -z "$(find "$work" -name '*.tmp*' -o -name '*.old*')" ] && "${complete[@]}" >/dev/null 2>&1; then
+  if [ "$before_names" = "$(names)" ] && "${complete[@]}" >/dev/null 2>&1; then
     replaced=$((replaced + 1))
     ok
     return
@@ -69,6 +71,7 @@ interrupt_throughout() {
 
 echo "previous results" >"$work/study.h5"
 complete=("$stepbench" compare "$work/study.h5" "$work/study.h5")  # exit 0: a whole study file
+# (the snapshot says study.h5 changed; the names say nothing else did)
 interrupt_throughout "$work/scratch.h5" "$work/study.h5" "$stepbench" sweep --quick --quiet --problem pendulum --problem spring_chain --out __TARGET__
 interrupt_throughout "$work/scratch.h5" "$work/study.h5" "$bench" --quick --problem=pendulum --benchmark_filter=pendulum --study_out=__TARGET__
 rm -f "$work/scratch.h5"
@@ -79,7 +82,8 @@ rm -f "$work/scratch.h5"
 # The report: a previous report folder survives an interrupted run whole.
 "$stepbench" sweep --quick --quiet --problem pendulum --problem damped_spring --out "$work/good.h5" 2>/dev/null || [ $? -eq 3 ] || bad "quick sweep for the report failed"
 /usr/bin/python3 "$report" "$work/good.h5" --out "$work/report" >/dev/null 2>&1 || bad "report failed"
-complete=(test -f "$work/report/REPORT.md")
+# The report says so itself when the signal came after its swap (a whole new folder).
+complete=(grep -q "after the new report was in place" "$work/err")
 interrupt_throughout "$work/scratch_report" "$work/report" /usr/bin/python3 "$report" "$work/good.h5" --out __TARGET__
 rm -rf "$work/scratch_report"
 [ -f "$work/report/REPORT.md" ] && ok || bad "the previous report folder is gone"

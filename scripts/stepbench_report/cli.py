@@ -56,7 +56,6 @@ def main(argv=None, start=None):
         raise KeyboardInterrupt(f"signal {signum}")
     signal.signal(signal.SIGTERM, interrupted)
     old = moved_aside = None
-    swapped = False  # the new report is in place: from here on nothing can be lost
     try:
         # matplotlib is imported only now: a file the report refuses is refused at once.
         from . import report
@@ -73,10 +72,17 @@ def main(argv=None, start=None):
             moved_aside = os.path.join(old, "report")
             os.rename(out, moved_aside)
         os.rename(tmp, out)
-        moved_aside, swapped = None, True
+        moved_aside = None
         if old:
             shutil.rmtree(old, ignore_errors=True)
+        # The new report is in place: the run has done its work, and a signal now would
+        # only turn a success into an error status.
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
     except BaseException as e:  # one line, and nothing half-written left behind or lost
+        # Nothing removes the temporary folder before the rename, so its absence means the
+        # new report is in place (the signal came after the rename).
+        swapped = not os.path.lexists(tmp)
         if moved_aside and not os.path.lexists(out):
             os.rename(moved_aside, out)  # interrupted between the two renames: the old report goes back
         shutil.rmtree(tmp, ignore_errors=True)

@@ -27,7 +27,6 @@ namespace stepbench::peers {
 
 #if STEPBENCH_HAVE_ODEINT
 namespace odeint_detail {
-namespace odeint = boost::numeric::odeint;
 
 template <problem P>
 inline constexpr bool fixed_size = P::vec::RowsAtCompileTime != Eigen::Dynamic;
@@ -44,15 +43,19 @@ state<P> initial_state(const P& p) {
   return y;
 }
 
-// (Copied coordinate by coordinate: GCC 12 misreads Eigen's packet copy from a Map of
-// the second half of the std::array as reading past it, -Wstringop-overread.)
+// The state at a record point, copied into the result; false (and the run marked
+// non-finite) when a coordinate is NaN or infinite, which ends the run there. (Copied
+// coordinate by coordinate: GCC 12 misreads Eigen's packet copy from a Map of the second
+// half of the std::array as reading past it, -Wstringop-overread.)
 template <problem P>
-void record(drive_result<typename P::vec>& out, double t, const state<P>& y) {
+bool record_if_finite(drive_result<typename P::vec>& out, double t, const state<P>& y) {
+  if (!std::all_of(y.begin(), y.end(), [](double c) { return std::isfinite(c); })) return out.non_finite = true, false;
   using vec = typename P::vec;
   constexpr int d = vec::RowsAtCompileTime;
   vec x, v;
   for (int i = 0; i < d; ++i) x[i] = y[i], v[i] = y[d + i];
   out.record(t, x, v);
+  return true;
 }
 
 template <problem P>
@@ -118,12 +121,7 @@ struct odeint_fixed {
     out.start(p.dim(), plan.size());
     const loop_end end = fixed_step_loop(
         dt, horizon, plan, [&](double t, double h) { stepper.do_step(system, y, t, h); }, [](double) {},
-        [&](double t) {
-          if (!std::all_of(y.begin(), y.end(), [](double v) { return std::isfinite(v); }))
-            return out.non_finite = true, false;
-          odeint_detail::record<P>(out, t, y);
-          return true;
-        });
+        [&](double t) { return odeint_detail::record_if_finite<P>(out, t, y); });
     out.steps = end.steps;
     odeint_detail::finish<P>(out, y, end.t, calls);
     return out;

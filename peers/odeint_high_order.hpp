@@ -153,11 +153,7 @@ struct odeint_adaptive {
           }
         }
       }
-      if (!std::all_of(y.begin(), y.end(), [](double v) { return std::isfinite(v); })) {
-        out.non_finite = true;
-        break;
-      }
-      odeint_detail::record<P>(out, t, y);
+      if (!odeint_detail::record_if_finite<P>(out, t, y)) break;
     }
     odeint_detail::finish<P>(out, y, t, calls);
     return out;

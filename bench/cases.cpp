@@ -12,7 +12,7 @@ namespace stepbench::bench {
 
 void case_book::add(const problem_study& ps, const method_info& info, method_row& row, std::string name,
                     std::string family) {
-  if (row.metrics.diverged || row.metrics.failed || row.metrics.skipped) return;
+  if (!row.metrics.completed()) return;
   auto c = std::make_unique<timed_case>();
   c->name = std::move(name);
   c->family = std::move(family);

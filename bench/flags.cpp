@@ -5,7 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "core/parse.hpp"
+#include "cli/args.hpp"
 
 namespace stepbench::bench {
 
@@ -13,15 +13,13 @@ options take_own_flags(int& argc, char** argv, std::vector<std::string>& extra) 
   options o;
   bool min_time_given = false, reps_given = false, budget_given = false;
   int out = 1;
+  std::vector<std::string> sets;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--quick") {
       o.quick = true;
     } else if (a.rfind("--set=", 0) == 0) {
-      const std::string assignment = a.substr(6);
-      if (assignment.find('.') == std::string::npos || assignment.find('.') > assignment.find('='))
-        throw std::invalid_argument("--set=" + assignment + ": name the problem, --set=problem.name=value");
-      add_override(o.overrides, assignment, {});
+      sets.push_back(a.substr(6));  // resolved below, once every --problem is known
     } else if (a.rfind("--problem=", 0) == 0) {
       o.problems.push_back(a.substr(10));  // checked by run_sweep's validate()
       if (o.problems.back().empty()) throw std::invalid_argument("--problem needs a problem name");
@@ -51,6 +49,7 @@ options take_own_flags(int& argc, char** argv, std::vector<std::string>& extra) 
     }
   }
   argc = out;
+  for (const auto& text : sets) add_override(o.overrides, text, o.problems);
   if (o.quick) {
     if (!min_time_given) o.min_time_s = 0.002;
     if (!reps_given) o.repetitions = 1;

@@ -3,12 +3,16 @@
 //   --quick              short minimum time, 8-level ladder, thinned tolerances (CI)
 //   --study_out=PATH     write the study file with each timing next to its accuracy row
 //   --case_budget=S      cut a family's finer cases once one iteration would exceed S s
-//   --set=P.NAME=VALUE   a problem parameter, as `stepbench sweep --set` (repeatable)
+//   --set=P.NAME=VALUE   a problem parameter, as every `stepbench` command's --set: a
+//                        number or a name the parameter takes; NAME=VALUE alone with
+//                        exactly one --problem (repeatable)
 // Quick and full mode supply defaults for --benchmark_min_time and
 // --benchmark_repetitions unless those are given.
 #include <map>
 #include <string>
 #include <vector>
+
+#include "cli/args.hpp"
 
 namespace stepbench::bench {
 
@@ -21,7 +25,7 @@ struct options {
   // cases) within 3 minutes on the 2-core machine (three took 3 min 39 s).
   int repetitions = 2;
   bool list_only = false;
-  std::map<std::string, std::map<std::string, double>> overrides;  // problem -> parameter -> value
+  parameter_overrides overrides;
   // --problem=NAME (repeatable): sweep and time only these problems (the study file then
   // holds only them); empty: every problem. A narrow --benchmark_filter still sweeps
   // every problem, since the cases are the sweep's rows.

@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
-#include "core/parse.hpp"
+#include "cli/args.hpp"
 
 namespace stepbench::cli {
 namespace {

@@ -23,10 +23,6 @@ command add_compare(CLI::App& app);
 command add_stability(CLI::App& app);
 command add_loop(CLI::App& app);
 command add_energy(CLI::App& app);
-
-// Turns `[problem.]param=name` into `[problem.]param=<value>` where the parameter takes
-// that name (a material pair: core/concepts.hpp's named_value), so every command's --set
-// accepts names; anything else is returned unchanged for the command to judge.
-std::string resolve_named_value(std::string assignment);
+command add_schema(CLI::App& app);
 
 }  // namespace stepbench::cli

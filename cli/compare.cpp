@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
-#include "core/parse.hpp"
+#include "cli/args.hpp"
 #include "core/work_precision.hpp"
 
 namespace stepbench::cli {

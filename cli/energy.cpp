@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
-#include "core/parse.hpp"
+#include "cli/args.hpp"
 
 namespace stepbench::cli {
 namespace {
@@ -43,7 +43,7 @@ int run_energy(const energy_args& a) {
     }
     opts.scenes = chosen;
   }
-  std::map<std::string, std::map<std::string, double>> overrides;
+  parameter_overrides overrides;
   std::vector<std::string> names;
   for (const auto& s : opts.scenes) names.push_back(s.problem);
   for (const auto& s : a.sets) add_override(overrides, s, names);
@@ -107,7 +107,7 @@ command add_energy(CLI::App& app) {
   sub->add_flag("--json", a->json, "print JSON: one record per problem and integrator");
   sub->add_option("--periods", a->periods, "periods to run (whole number)")->capture_default_str();
   sub->add_option("--problem", a->problems, "pendulum and/or kepler (repeatable; default both)");
-  sub->add_option("--set", a->sets, "override a parameter, problem.name=value (repeatable)");
+  sub->add_option("--set", a->sets, "override a parameter, problem.name=value, or name=value with one --problem (repeatable)");
   return {sub, [a] { return run_energy(*a); }};
 }
 

@@ -1,8 +1,10 @@
 // `stepbench list [--json]`: the problems with their parameters, and every method (ours,
 // the peers, the baseline) with its order and capabilities.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
@@ -26,8 +28,18 @@ int run_list(bool as_json) {
   for (const auto& name : problem_names()) {
     auto p = make_problem(name);
     json params = json::array();
-    for (const auto& q : p->params())
-      params.push_back({{"name", q.name}, {"default", q.value}, {"unit", q.unit}, {"description", q.description}});
+    for (const auto& q : p->params()) {
+      json names = json::array();
+      for (const auto& n : q.names)
+        names.push_back({{"name", n.name}, {"value", n.value}, {"description", n.description}});
+      params.push_back({{"name", q.name},
+                        {"default", q.default_value},
+                        {"unit", q.unit},
+                        {"description", q.description},
+                        {"kind", q.kind()},
+                        {"allowed", q.allowed.text()},
+                        {"names", names}});
+    }
     json methods = json::array();
     for (const auto& m : p->methods()) methods.push_back(m.name);
     out["problems"].push_back({{"name", name},
@@ -55,14 +67,34 @@ int run_list(bool as_json) {
     std::cout << out.dump(2) << "\n";
     return 0;
   }
+  std::map<std::string, json> long_lists;
   fmt::print("problems:\n");
   for (const auto& p : out["problems"]) {
     fmt::print("  {:<22} {} (dim {}, horizon {:.6g} s{})\n", p["name"].get<std::string>(),
                p["description"].get<std::string>(), p["dim"].get<int>(), p["horizon"].get<double>(),
                p["closed_form"].get<bool>() ? ", closed form" : "");
-    for (const auto& q : p["parameters"])
-      fmt::print("      {:<14} = {:<10g} [{}] {}\n", q["name"].get<std::string>(), q["default"].get<double>(),
-                 q["unit"].get<std::string>(), q["description"].get<std::string>());
+    for (const auto& q : p["parameters"]) {
+      const auto& names = q["names"];
+      // A long list of names (the lecture's friction table) is printed once, below.
+      std::string allowed = q["allowed"].get<std::string>();
+      if (!names.empty() && names.size() <= 4) {
+        std::vector<std::string> options;
+        for (const auto& n : names)
+          options.push_back(fmt::format("{:g} {}", n["value"].get<double>(), n["name"].get<std::string>()));
+        allowed = fmt::format("{}", fmt::join(options, ", "));
+      } else if (!names.empty()) {
+        allowed += fmt::format(", or one of the {} names below", names.size());
+        long_lists.try_emplace(q["name"].get<std::string>(), names);
+      }
+      fmt::print("      {:<14} = {:<10g} [{}] {} ({})\n", q["name"].get<std::string>(), q["default"].get<double>(),
+                 q["unit"].get<std::string>(), q["description"].get<std::string>(), allowed);
+    }
+  }
+  for (const auto& [param, names] : long_lists) {
+    fmt::print("names {} takes:\n", param);
+    for (const auto& n : names)
+      fmt::print("  {:>4g}  {:<40} {}\n", n["value"].get<double>(), n["name"].get<std::string>(),
+                 n["description"].get<std::string>());
   }
   for (const auto origin : {method_origin::ours, method_origin::peer, method_origin::baseline}) {
     fmt::print("{}:\n", origin == method_origin::ours   ? "integrators (ours)"

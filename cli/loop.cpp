@@ -15,8 +15,8 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "cli/args.hpp"
 #include "cli/commands.hpp"
-#include "core/parse.hpp"
 #include "study/study_file.hpp"
 #include "study/sweep.hpp"
 
@@ -61,17 +61,8 @@ const method_info& loop_method_info(const std::string& name) {
 
 std::string g3(double v) { return std::isfinite(v) ? fmt::format("{:.3g}", v) : "n/a"; }
 
-int run_one(const loop_args& a) {
-  if (!a.out.empty()) throw std::invalid_argument("--out writes the whole loop study: leave out --design");
-  auto problem = make_problem(a.problem);
-  loop_method_info(a.method);
-  for (const auto& s : a.sets) {
-    const auto [name, value] = parse_assignment(s);
-    problem->set(name, value);
-  }
-  if (auto err = problem->validate(); !err.empty())
-    throw std::invalid_argument(fmt::format("problem {}: {}", a.problem, err));
-  const loop_options opts;
+// The loop a --design run asks for: the study's defaults, then the command's options.
+loop_config one_loop_config(const loop_args& a, const problem_instance& problem, const loop_options& opts) {
   loop_config c;
   c.design = parse_design(a.design);
   c.clamp_s = opts.clamp_s;
@@ -86,81 +77,93 @@ int run_one(const loop_args& a) {
   }
   if (!a.jitter.empty()) c.jitter_seed = parse_seed(a.jitter);
   if (!a.stall_at.empty()) c.stall_at_s = parse_number(a.stall_at, "--stall-at");
-  c.horizon = problem->horizon();
+  c.horizon = problem.horizon();
   if (!a.horizon.empty()) {
     c.horizon = parse_number(a.horizon, "--horizon");
     if (!(c.horizon > 0.0)) throw std::invalid_argument(fmt::format("--horizon must be > 0, got {}", a.horizon));
   }
-  double cost_ns = opts.stated_step_cost_ns;
-  if (!a.step_cost.empty()) {
-    cost_ns = parse_number(a.step_cost, "--step-cost");
-    if (!(cost_ns >= 0.0)) throw std::invalid_argument(fmt::format("--step-cost must be >= 0 ns, got {}", a.step_cost));
-  }
   if (auto err = loop_config_error(c); !err.empty()) throw std::invalid_argument(err);
 
-  const loop_row r = run_loop_config(*problem, a.method, c, opts);
-  const loop_cost cost = cost_verdict(c, cost_ns, "stated");
-  const int dim = problem->dim();
-  auto part = [&](const std::vector<double>& y, int offset) {
-    return std::vector<double>(y.begin() + offset, y.begin() + offset + dim);
-  };
+  return c;
+}
+
+// The stated cost of one physics step for the cost model [ns].
+double stated_step_cost_ns(const loop_args& a, const loop_options& opts) {
+  if (a.step_cost.empty()) return opts.stated_step_cost_ns;
+  const double cost_ns = parse_number(a.step_cost, "--step-cost");
+  if (!(cost_ns >= 0.0)) throw std::invalid_argument(fmt::format("--step-cost must be >= 0 ns, got {}", a.step_cost));
+  return cost_ns;
+}
+
+// The position (offset 0) or velocity (offset dim) part of a state.
+std::vector<double> state_part(const std::vector<double>& y, int offset, int dim) {
+  return std::vector<double>(y.begin() + offset, y.begin() + offset + dim);
+}
+
+json one_loop_json(const loop_args& a, const problem_instance& problem, const loop_config& c, const loop_options& opts,
+                   const loop_row& r, const loop_cost& cost) {
+  const int dim = problem.dim();
+  auto part = [&](const std::vector<double>& y, int offset) { return state_part(y, offset, dim); };
   const bool variable = c.design == loop_design::variable;
-  const bool trusted = r.note.rfind("no trusted truth", 0) != 0;
-  const std::string unit(problem->position_unit());
-  if (a.json) {
-    json out = {{"problem", a.problem},
-                {"integrator", a.method},
-                {"design", to_string(c.design)},
-                {"clock", r.clock},
-                {"display_hz", c.display_hz},
-                {"physics_hz", variable ? json(nullptr) : json(c.physics_hz)},
-                {"dt", uses_accumulator(c.design) ? json(c.dt()) : json(nullptr)},
-                {"substeps", c.design == loop_design::substeps ? json(c.substeps()) : json(nullptr)},
-                {"clamp_s", c.clamp_s > 0.0 ? json(c.clamp_s) : json(nullptr)},
-                {"jitter_seed", c.jitter_seed ? json(*c.jitter_seed) : json(nullptr)},
-                {"jitter", c.jitter_seed ? json(c.jitter) : json(nullptr)},
-                {"stall_at_s", number(c.stall_at_s)},
-                {"stall_s", c.stalls() ? json(c.stall_s) : json(nullptr)},
-                {"horizon", c.horizon},
-                {"position_unit", unit},
-                {"frames", r.frames},
-                {"physics_steps", r.physics_steps},
-                {"force_evals", r.force_evals},
-                {"final_physics_t", r.physics_t},
-                {"final_physics_position", part(r.final_physics, 0)},
-                {"final_physics_velocity", part(r.final_physics, dim)},
-                {"final_shown_position", part(r.final_shown, 0)},
-                {"shown_err_max", number(r.shown_err_max)},
-                {"shown_err_rms", number(r.shown_err_rms)},
-                {"final_shown_err", number(r.final_shown_err)},
-                {"reference_display_hz", opts.reference_display_hz},
-                {"clock_dependence", number(r.clock_dependence)},
-                {"physics_clock_dependence", number(r.physics_clock_dependence)},
-                {"judder", number(r.judder)},
-                {"lag_s", number(r.lag_s)},
-                {"lag_clock_s", number(r.lag_clock_s)},
-                {"steps_per_frame_mean", number(r.steps_per_frame_mean)},
-                {"steps_per_frame_max", r.steps_per_frame_max},
-                {"stall_burst_steps", r.stall_burst_steps},
-                {"clamp_hits", r.clamp_hits},
-                {"alpha_min", number(r.alpha_min)},
-                {"alpha_max", number(r.alpha_max)},
-                {"diverged", r.diverged},
-                {"note", r.note},
-                {"cost",
-                 {{"step_cost_ns", cost.step_cost_ns},
-                  {"source", a.step_cost.empty() ? "stated (default)" : "stated"},
-                  {"frame_budget_ns", cost.schedule.frame_budget_s * 1e9},
-                  {"worst_frame_work_ns", cost.schedule.worst_work_s * 1e9},
-                  {"late_frames", cost.schedule.late_frames},
-                  {"physics_load", cost.schedule.load},
-                  {"wall_s", cost.schedule.wall_s},
-                  {"outcome", to_string(cost.schedule.outcome)},
-                  {"outcome_without_clamp", to_string(cost.without_clamp)},
-                  {"clamp_prevented_spiral", cost.clamp_prevented_spiral}}}};
-    std::cout << out.dump(2) << "\n";
-    return trusted ? 0 : 1;
-  }
+  const std::string unit(problem.position_unit());
+  return {{"problem", a.problem},
+          {"integrator", a.method},
+          {"design", to_string(c.design)},
+          {"clock", r.clock},
+          {"display_hz", c.display_hz},
+          {"physics_hz", variable ? json(nullptr) : json(c.physics_hz)},
+          {"dt", uses_accumulator(c.design) ? json(c.dt()) : json(nullptr)},
+          {"substeps", c.design == loop_design::substeps ? json(c.substeps()) : json(nullptr)},
+          {"clamp_s", c.clamp_s > 0.0 ? json(c.clamp_s) : json(nullptr)},
+          {"jitter_seed", c.jitter_seed ? json(*c.jitter_seed) : json(nullptr)},
+          {"jitter", c.jitter_seed ? json(c.jitter) : json(nullptr)},
+          {"stall_at_s", number(c.stall_at_s)},
+          {"stall_s", c.stalls() ? json(c.stall_s) : json(nullptr)},
+          {"horizon", c.horizon},
+          {"position_unit", unit},
+          {"frames", r.frames},
+          {"physics_steps", r.physics_steps},
+          {"force_evals", r.force_evals},
+          {"final_physics_t", r.physics_t},
+          {"final_physics_position", part(r.final_physics, 0)},
+          {"final_physics_velocity", part(r.final_physics, dim)},
+          {"final_shown_position", part(r.final_shown, 0)},
+          {"shown_err_max", number(r.shown_err_max)},
+          {"shown_err_rms", number(r.shown_err_rms)},
+          {"final_shown_err", number(r.final_shown_err)},
+          {"reference_display_hz", opts.reference_display_hz},
+          {"clock_dependence", number(r.clock_dependence)},
+          {"physics_clock_dependence", number(r.physics_clock_dependence)},
+          {"judder", number(r.judder)},
+          {"lag_s", number(r.lag_s)},
+          {"lag_clock_s", number(r.lag_clock_s)},
+          {"steps_per_frame_mean", number(r.steps_per_frame_mean)},
+          {"steps_per_frame_max", r.steps_per_frame_max},
+          {"stall_burst_steps", r.stall_burst_steps},
+          {"clamp_hits", r.clamp_hits},
+          {"alpha_min", number(r.alpha_min)},
+          {"alpha_max", number(r.alpha_max)},
+          {"diverged", r.diverged},
+          {"note", r.note},
+          {"cost",
+           {{"step_cost_ns", cost.step_cost_ns},
+            {"source", a.step_cost.empty() ? "stated (default)" : "stated"},
+            {"frame_budget_ns", cost.schedule.frame_budget_s * 1e9},
+            {"worst_frame_work_ns", cost.schedule.worst_work_s * 1e9},
+            {"late_frames", cost.schedule.late_frames},
+            {"physics_load", cost.schedule.load},
+            {"wall_s", cost.schedule.wall_s},
+            {"outcome", to_string(cost.schedule.outcome)},
+            {"outcome_without_clamp", to_string(cost.without_clamp)},
+            {"clamp_prevented_spiral", cost.clamp_prevented_spiral}}}};
+}
+
+void print_one_loop(const loop_args& a, const problem_instance& problem, const loop_config& c, const loop_options& opts,
+                    const loop_row& r, const loop_cost& cost) {
+  const int dim = problem.dim();
+  auto part = [&](const std::vector<double>& y, int offset) { return state_part(y, offset, dim); };
+  const bool variable = c.design == loop_design::variable;
+  const std::string unit(problem.position_unit());
   std::string clock = fmt::format("{:g} Hz display", c.display_hz);
   if (c.jitter_seed) clock += fmt::format(", frame times jittered +-{:g} % (seed {})", 100 * c.jitter, *c.jitter_seed);
   if (c.stalls()) clock += fmt::format(", a {:g} s stall at {:g} s", c.stall_s, c.stall_at_s);
@@ -190,6 +193,27 @@ int run_one(const loop_args& a) {
       cost.schedule.late_frames == 1 ? "" : "s", to_string(cost.schedule.outcome), to_string(cost.without_clamp));
   fmt::print("  final physics      t = {:.10g} s, position {::.12g}\n", r.physics_t, part(r.final_physics, 0));
   if (!r.note.empty()) fmt::print("  {}: {}\n", r.diverged ? "DIVERGED" : "NOTE", r.note);
+}
+
+int run_one(const loop_args& a) {
+  if (!a.out.empty()) throw std::invalid_argument("--out writes the whole loop study: leave out --design");
+  auto problem = make_problem(a.problem);
+  loop_method_info(a.method);
+  parameter_overrides overrides;
+  for (const auto& s : a.sets) add_override(overrides, s, std::vector{a.problem});
+  for (const auto& [name, value] : overrides[a.problem]) problem->set(name, value);
+  if (auto err = problem->validate(); !err.empty())
+    throw std::invalid_argument(fmt::format("problem {}: {}", a.problem, err));
+  const loop_options opts;
+  const loop_config c = one_loop_config(a, *problem, opts);
+  const double cost_ns = stated_step_cost_ns(a, opts);
+  const loop_row r = run_loop_config(*problem, a.method, c, opts);
+  const loop_cost cost = cost_verdict(c, cost_ns, "stated");
+  if (a.json)
+    std::cout << one_loop_json(a, *problem, c, opts, r, cost).dump(2) << "\n";
+  else
+    print_one_loop(a, *problem, c, opts, r, cost);
+  const bool trusted = r.note.rfind("no trusted truth", 0) != 0;
   return trusted ? 0 : 1;
 }
 
@@ -263,7 +287,7 @@ command add_loop(CLI::App& app) {
       "loop", "the game loop around an integrator: what each loop design shows at each displayed frame");
   sub->add_option("--problem", a->problem, "problem name (see list)")->required();
   sub->add_option("--integrator,--method", a->method, "one of our fixed-step integrators")->required();
-  sub->add_option("--set", a->sets, "override a parameter, name=value (repeatable)");
+  sub->add_option("--set", a->sets, "override a parameter, problem.name=value or name=value (repeatable)");
   sub->add_option("--out", a->out, "the whole loop study of the pair into this study file (default results/loop.h5)");
   sub->add_option("--design", a->design, "one configuration: variable, fixed, interpolated or substeps");
   sub->add_option("--display-hz", a->display_hz, "display rate [Hz] (default 60)");

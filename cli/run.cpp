@@ -9,7 +9,7 @@
 #include "cli/commands.hpp"
 #include "core/drive.hpp"
 #include "core/measure.hpp"
-#include "core/parse.hpp"
+#include "cli/args.hpp"
 #include "study/registry.hpp"
 
 namespace stepbench::cli {
@@ -26,10 +26,9 @@ struct run_args {
 int run_run(const run_args& a) {
   auto problem = make_problem(a.problem);
   const method_info& m = find_method(a.method);
-  for (const auto& s : a.sets) {
-    const auto [name, value] = parse_assignment(s);
-    problem->set(name, value);
-  }
+  parameter_overrides overrides;
+  for (const auto& s : a.sets) add_override(overrides, s, std::vector{a.problem});
+  for (const auto& [name, value] : overrides[a.problem]) problem->set(name, value);
   if (auto err = problem->validate(); !err.empty())
     throw std::invalid_argument(fmt::format("problem {}: {}", a.problem, err));
   const bool fixed = m.kind == method_kind::fixed_step;
@@ -122,7 +121,7 @@ command add_run(CLI::App& app) {
   sub->add_option("--dt", a->dt_text, "timestep [s] (fixed-step methods)");
   sub->add_option("--tol", a->tol_text, "relative tolerance (adaptive methods)");
   sub->add_option("--horizon", a->horizon_text, "end time [s] (default: the problem's)");
-  sub->add_option("--set", a->sets, "override a parameter, name=value (repeatable)");
+  sub->add_option("--set", a->sets, "override a parameter, problem.name=value or name=value (repeatable)");
   sub->add_flag("--json", a->json, "print JSON");
   return {sub, [a] { return run_run(*a); }};
 }

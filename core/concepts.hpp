@@ -16,16 +16,9 @@
 #include <string_view>
 #include <vector>
 
-namespace stepbench {
+#include "core/parameter.hpp"
 
-// A named, user-settable parameter (`--set name=value`), bound to a data member.
-template <class P>
-struct param {
-  std::string_view name;
-  double P::*member;
-  std::string_view unit;
-  std::string_view description;
-};
+namespace stepbench {
 
 // The state an integrator advances. `f` caches the force at (t, x, v) when `f_current`
 // is true, so a method whose last stage lands on the new state (velocity Verlet with a
@@ -58,13 +51,12 @@ concept problem = requires(const P& p, double t, const typename P::vec& x, typen
   { P::description } -> std::convertible_to<std::string_view>;
   { P::position_unit } -> std::convertible_to<std::string_view>;  // "m", or "rad" for an angle
   { P::force_depends_on_velocity } -> std::convertible_to<bool>;
-  {P::parameters()};
+  {P::parameters()};  // declared once: core/parameter.hpp (validate(p) derives from it)
   { p.dim() } -> std::convertible_to<int>;
   { p.mass() } -> std::convertible_to<double>;
   {p.force(t, x, x, f)};
   { p.initial() } -> std::same_as<phase<typename P::vec>>;
   { p.horizon() } -> std::convertible_to<double>;
-  { p.validate() } -> std::convertible_to<std::string>;  // empty when the parameters are valid
 };
 
 template <class P>
@@ -126,20 +118,6 @@ concept has_angular_momentum = requires(const P& p, const typename P::vec& x) {
 template <class P>
 concept has_period = requires(const P& p) {
   { p.period() } -> std::convertible_to<double>;
-};
-
-// A parameter that also takes a name (a material pair of the lecture's friction table):
-// `--set sliding_block.material=steel_on_steel` is the value of the entry named so. A
-// problem lists, per parameter, the names it understands with their values and a line
-// each (`stepbench list` prints them).
-struct named_value {
-  std::string name;
-  double value = 0.0;
-  std::string description;
-};
-template <class P>
-concept has_named_values = requires(std::string_view param) {
-  { P::named_values(param) } -> std::same_as<std::vector<named_value>>;
 };
 
 // A problem may give the force Jacobians dF/dx and dF/dv itself (in a matrix type of
@@ -288,16 +266,6 @@ inline const Vec& current_force(const Sys& sys, double t, step_state<Vec>& s) {
     s.f_current = true;
   }
   return s.f;
-}
-
-// Parameter checks shared by the problems; each returns "" or a one-line reason.
-inline std::string require_positive(std::string_view name, double value) {
-  if (std::isfinite(value) && value > 0.0) return {};
-  return std::string(name) + " must be a positive finite number";
-}
-inline std::string require_finite(std::string_view name, double value) {
-  if (std::isfinite(value)) return {};
-  return std::string(name) + " must be finite";
 }
 
 }  // namespace stepbench

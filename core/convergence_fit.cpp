@@ -28,7 +28,7 @@ fit_result fit_order(const fit_input& in) {
 
   bool all_roundoff = n > 0;
   for (int k = 0; k < n; ++k)
-    if (in.diverged[k] || !(in.error[k] <= roundoff_bound(in.steps[k], in.scale))) all_roundoff = false;
+    if (in.incomplete[k] || !(in.error[k] <= roundoff_bound(in.steps[k], in.scale))) all_roundoff = false;
   // The bound grows with n, so on a ladder of huge step counts a converging method can sit
   // under it too. Such errors fall as dt does and stand clearly above typical round-off
   // noise; an exact method's errors are noise (they may fall too, from 1e-17 relative
@@ -46,7 +46,7 @@ fit_result fit_order(const fit_input& in) {
   }
 
   auto usable = [&](int k) {
-    return !in.diverged[k] && std::isfinite(in.error[k]) &&
+    return !in.incomplete[k] && std::isfinite(in.error[k]) &&
            in.error[k] > 100.0 * roundoff_noise(in.steps[k], in.scale) && in.error[k] < 0.1 * in.scale;
   };
   auto slope = [&](int k) { return std::log(in.error[k] / in.error[k + 1]) / std::log(in.dt[k] / in.dt[k + 1]); };

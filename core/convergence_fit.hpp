@@ -26,7 +26,7 @@ struct fit_input {
   std::vector<double> dt;     // decreasing
   std::vector<double> error;  // the fitted metric at each level
   std::vector<long> steps;
-  std::vector<bool> diverged;
+  std::vector<bool> incomplete;  // the row did not complete (diverged, failed or skipped): not fitted
   double scale = 1.0;  // size of the motion in the metric's unit
 };
 

@@ -68,8 +68,8 @@ struct drive_result {
   long rejected_steps = 0;  // adaptive methods: attempts the error test rejected
   work_counters work{};
   bool non_finite = false;   // a NaN or Inf appeared: the run stopped there
-  std::string failure;       // why the run stopped early (step size underflow, ...), else empty
-  bool over_budget = false;  // stopped by the step budget (with the reason in `failure`): skipped, not failed
+  std::string stop_reason;   // why the run stopped early (step size underflow, the step budget), else empty
+  bool over_budget = false;  // stopped by the step budget (with the reason in `stop_reason`): skipped, not failed
   std::vector<double> sample_t;
   Eigen::MatrixXd samples;  // column j: [x; v] at sample_t[j]
   double t_final = 0.0;
@@ -354,7 +354,7 @@ STEPBENCH_FLATTEN drive_result<typename P::vec> drive_adaptive(const P& problem,
     const bool lands = t + 1.01 * h >= target;
     const double h_try = lands ? target - t : h;
     if (!(h_try > 4.0 * std::numeric_limits<double>::epsilon() * std::max(std::abs(t), horizon))) {
-      out.failure = "step size underflow at t = " + std::to_string(t);
+      out.stop_reason = "step size underflow at t = " + std::to_string(t);
       break;
     }
     // advance: attempts until one is accepted
@@ -362,7 +362,7 @@ STEPBENCH_FLATTEN drive_result<typename P::vec> drive_adaptive(const P& problem,
     h = a.dt_next;
     if ((horizon - t) / h > 10.0 * static_cast<double>(max_steps - out.steps)) {
       out.over_budget = true;
-      out.failure = "over the step budget of " + std::to_string(max_steps) + " steps: at t = " + std::to_string(t) +
+      out.stop_reason = "over the step budget of " + std::to_string(max_steps) + " steps: at t = " + std::to_string(t) +
                     " the step size " + fmt_g(h) + " would need about " + fmt_g((horizon - t) / h) + " more";
       break;
     }
@@ -440,7 +440,7 @@ STEPBENCH_FLATTEN drive_result<typename P::vec> drive_adaptive(const P& problem,
     }
     if (out.steps >= max_steps && t < horizon) {
       out.over_budget = true;
-      out.failure = "over the step budget of " + std::to_string(max_steps) + " steps at t = " + std::to_string(t);
+      out.stop_reason = "over the step budget of " + std::to_string(max_steps) + " steps at t = " + std::to_string(t);
       break;
     }
   }

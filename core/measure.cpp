@@ -184,12 +184,12 @@ run_metrics measure(const problem_instance& problem, const run_result& run, cons
   m.max_penetration = run.max_penetration;
   if (run.skipped) {
     m.skipped = true;
-    m.note = run.failure;
+    m.note = run.stop_reason;
     return all_nan();
   }
-  if (!run.failure.empty()) {
+  if (!run.stop_reason.empty()) {
     m.failed = true;
-    m.note = run.failure;
+    m.note = run.stop_reason;
     return all_nan();
   }
   if (run.non_finite) {

@@ -69,6 +69,11 @@ truth_table build_truth(const problem_instance& problem, std::span<const double>
 agreement compare(std::span<const std::vector<double>> a, std::span<const std::vector<double>> b, int dim,
                   double pos_scale, double vel_scale);
 
+// A row of a study completed: it neither diverged, nor failed, nor was skipped. The one
+// statement of the rule; the study file stores the three flags, and every reader (C++
+// and the report, through the schema `stepbench schema` prints) applies this.
+constexpr bool row_completed(bool diverged, bool failed, bool skipped) { return !diverged && !failed && !skipped; }
+
 struct run_metrics {
   double err_pos_final = 0.0;  // |x_N - x(T)|, Euclidean, in the problem's position unit
   double err_vel_final = 0.0;
@@ -90,6 +95,9 @@ struct run_metrics {
   bool failed = false;             // the method could not complete the run, or there is no trusted truth
   bool skipped = false;            // not run to the end: over the work budget
   std::string note;                // why diverged, failed or skipped
+
+  // The one "row completed" rule: run to the horizon, finite, not over the budget.
+  bool completed() const { return row_completed(diverged, failed, skipped); }
 };
 
 // Measures a run against the truth. The run's sample times must be the truth's

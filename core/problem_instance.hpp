@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/method.hpp"
+#include "core/parameter.hpp"
 #include "references/reference.hpp"
 
 namespace stepbench {
@@ -18,12 +19,6 @@ namespace stepbench {
 struct loop_config;  // core/game_loop.hpp
 struct loop_result;
 
-struct param_value {
-  std::string name;
-  std::string unit;
-  std::string description;
-  double value = 0.0;
-};
 
 class problem_instance {
  public:
@@ -32,15 +27,13 @@ class problem_instance {
   virtual std::string_view description() const = 0;
   virtual int dim() const = 0;
   virtual std::string_view position_unit() const = 0;
+  // The declared parameters (core/parameter.hpp) with their values, in declaration order.
   virtual std::vector<param_value> params() const = 0;
-  // Sets a parameter; throws std::invalid_argument naming an unknown parameter.
+  // Sets a parameter; throws std::invalid_argument naming an unknown parameter and
+  // listing the known ones. The value is checked by validate(), not here.
   virtual void set(std::string_view param, double value) = 0;
-  // Sets a parameter from text: a number, or a name the parameter understands (a
-  // material pair: named_values below); throws std::invalid_argument otherwise.
-  virtual void set_text(std::string_view param, std::string_view text) = 0;
-  // The names a parameter understands, with their values (empty for most).
-  virtual std::vector<named_value> named_values(std::string_view param) const = 0;
-  virtual std::string validate() const = 0;  // "" when valid
+  // "" when every parameter is admitted and the scene is consistent, else the reason.
+  virtual std::string validate() const = 0;
   virtual double horizon() const = 0;
   virtual bool has_closed_form() const = 0;
   virtual bool has_energy() const = 0;

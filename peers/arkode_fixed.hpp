@@ -20,17 +20,14 @@ template <int Order>
 struct arkode_fixed {
   static method_info info() {
     const arkode_erk_table_info table = arkode_erk_default_table(Order);
-    return {Order == 8 ? "arkode_erk8" : "arkode_erk5",
-            "ARKODE ERKStep at fixed dt (ERKStepSetFixedStep), default order-" + std::to_string(Order) + " table " +
-                table.name,
-            method_origin::peer,
-            method_kind::fixed_step,
-            static_cast<double>(table.q),
-            {},
-            "SUNDIALS ARKODE"};
+    return {.name = Order == 8 ? "arkode_erk8" : "arkode_erk5",
+            .description = "ARKODE ERKStep at fixed dt (ERKStepSetFixedStep), default order-" + std::to_string(Order) +
+                           " table " + table.name,
+            .origin = method_origin::peer,
+            .kind = method_kind::fixed_step,
+            .declared_order = static_cast<double>(table.q),
+            .library = "SUNDIALS ARKODE"};
   }
-  template <problem P>
-  static constexpr bool applies = true;
 
   template <problem P>
   static auto prepare(const P& p, double dt, double /*horizon*/, std::span<const double> times, const run_limits&) {

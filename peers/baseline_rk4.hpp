@@ -54,13 +54,12 @@ template <class Vec, class Step>
 
 struct baseline_rk4 {
   static method_info info() {
-    return {"baseline_rk4",
-            "hand-written RK4 on plain doubles, fully inlined: the speed-of-light step, for scale",
-            method_origin::baseline,
-            method_kind::fixed_step,
-            4.0,
-            {},
-            "hand-written"};
+    return {.name = "baseline_rk4",
+            .description = "hand-written RK4 on plain doubles, fully inlined: the speed-of-light step, for scale",
+            .origin = method_origin::baseline,
+            .kind = method_kind::fixed_step,
+            .declared_order = 4.0,
+            .library = "hand-written"};
   }
   template <problem P>
   static constexpr bool applies = requires(const P& p) {

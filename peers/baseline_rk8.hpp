@@ -27,14 +27,14 @@ inline constexpr auto ba = rk_detail::times<12>(dop853_tableau.b, dop853_tableau
 
 struct baseline_rk8 {
   static method_info info() {
-    return {"baseline_rk8",
-            "hand-written eighth-order RK (the DOP853 step) on plain doubles, fully inlined: the speed-of-light step, "
-            "for scale",
-            method_origin::baseline,
-            method_kind::fixed_step,
-            8.0,
-            {},
-            "hand-written"};
+    return {.name = "baseline_rk8",
+            .description =
+                "hand-written eighth-order RK (the DOP853 step) on plain doubles, fully inlined: the speed-of-light "
+                "step, for scale",
+            .origin = method_origin::baseline,
+            .kind = method_kind::fixed_step,
+            .declared_order = 8.0,
+            .library = "hand-written"};
   }
   template <problem P>
   static constexpr bool applies = requires(const P& p) {

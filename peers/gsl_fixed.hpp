@@ -61,16 +61,13 @@ struct gsl_fixed {
     // The order GSL declares for the stepper (gsl_odeiv2_step_order): the study fits what
     // it achieves and reports both (rk2 advances with the third-order member of its pair).
     std::unique_ptr<gsl_odeiv2_step, gsl_step_deleter> probe(gsl_odeiv2_step_alloc(Stepper::type(), 2));
-    return {Stepper::name,
-            Stepper::description,
-            method_origin::peer,
-            method_kind::fixed_step,
-            static_cast<double>(gsl_odeiv2_step_order(probe.get())),
-            {},
-            "GSL"};
+    return {.name = Stepper::name,
+            .description = Stepper::description,
+            .origin = method_origin::peer,
+            .kind = method_kind::fixed_step,
+            .declared_order = static_cast<double>(gsl_odeiv2_step_order(probe.get())),
+            .library = "GSL"};
   }
-  template <problem P>
-  static constexpr bool applies = true;
 
   template <problem P>
   static auto prepare(const P& p, double dt, double horizon, std::span<const double> times, const run_limits&) {

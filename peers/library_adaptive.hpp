@@ -97,11 +97,14 @@ struct library_adaptive {
   static method_info info() {
     double order = std::numeric_limits<double>::quiet_NaN();
     if constexpr (requires { Solver::declared_order(); }) order = Solver::declared_order();
-    return {Solver::name, Solver::description,      method_origin::peer, method_kind::adaptive,
-            order,        {.error_estimate = true}, Solver::library};
+    return {.name = Solver::name,
+            .description = Solver::description,
+            .origin = method_origin::peer,
+            .kind = method_kind::adaptive,
+            .declared_order = order,
+            .traits = {.error_estimate = true},
+            .library = Solver::library};
   }
-  template <problem P>
-  static constexpr bool applies = true;
 
   // The right-hand side is wrapped once; each run is the solver's whole run (set-up,
   // integration, output at the sample times), as a user would call it.

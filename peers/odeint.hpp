@@ -89,13 +89,12 @@ struct odeint_rkf78_step {
 template <class Tag>
 struct odeint_fixed {
   static method_info info() {
-    return {Tag::name,
-            Tag::description,
-            method_origin::peer,
-            method_kind::fixed_step,
-            static_cast<double>(Tag::template stepper<std::array<double, 2>>::order_value),
-            {},
-            "Boost.Odeint"};
+    return {.name = Tag::name,
+            .description = Tag::description,
+            .origin = method_origin::peer,
+            .kind = method_kind::fixed_step,
+            .declared_order = static_cast<double>(Tag::template stepper<std::array<double, 2>>::order_value),
+            .library = "Boost.Odeint"};
   }
   template <problem P>
   static constexpr bool applies = odeint_detail::fixed_size<P>;
@@ -136,13 +135,13 @@ using odeint_rkf78 = odeint_fixed<odeint_rkf78_step>;
 // second order; the study fits what it achieves and reports both.
 struct odeint_velocity_verlet {
   static method_info info() {
-    return {"odeint_velocity_verlet",
-            "Boost.Odeint velocity_verlet on std::array (declares order 1)",
-            method_origin::peer,
-            method_kind::fixed_step,
-            static_cast<double>(boost::numeric::odeint::velocity_verlet<std::array<double, 1>>::order_value),
-            {},
-            "Boost.Odeint"};
+    return {.name = "odeint_velocity_verlet",
+            .description = "Boost.Odeint velocity_verlet on std::array (declares order 1)",
+            .origin = method_origin::peer,
+            .kind = method_kind::fixed_step,
+            .declared_order =
+                static_cast<double>(boost::numeric::odeint::velocity_verlet<std::array<double, 1>>::order_value),
+            .library = "Boost.Odeint"};
   }
   template <problem P>
   static constexpr bool applies = odeint_detail::fixed_size<P>;

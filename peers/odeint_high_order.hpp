@@ -88,13 +88,13 @@ struct odeint_bulirsch_stoer_tag {
 template <class Tag>
 struct odeint_adaptive {
   static method_info info() {
-    return {Tag::name,
-            Tag::description,
-            method_origin::peer,
-            method_kind::adaptive,
-            Tag::template order<std::array<double, 2>>(),
-            {.error_estimate = true},
-            "Boost.Odeint"};
+    return {.name = Tag::name,
+            .description = Tag::description,
+            .origin = method_origin::peer,
+            .kind = method_kind::adaptive,
+            .declared_order = Tag::template order<std::array<double, 2>>(),
+            .traits = {.error_estimate = true},
+            .library = "Boost.Odeint"};
   }
   template <problem P>
   static constexpr bool applies = odeint_detail::fixed_size<P>;
@@ -128,7 +128,7 @@ struct odeint_adaptive {
         double h = std::min(dt, tout - t);
         const bool lands = h == tout - t;
         if (!(h > 4.0 * std::numeric_limits<double>::epsilon() * std::max(std::abs(t), horizon))) {
-          out.failure = "step size underflow at t = " + std::to_string(t);
+          out.stop_reason = "step size underflow at t = " + std::to_string(t);
           odeint_detail::finish<P>(out, y, t, calls);
           return out;
         }
@@ -139,7 +139,8 @@ struct odeint_adaptive {
           dt = std::max(dt, h);  // h now holds the proposed next step
           if (out.steps >= max_steps && t < horizon) {
             out.over_budget = true;
-            out.failure = "over the step budget of " + std::to_string(max_steps) + " steps at t = " + std::to_string(t);
+            out.stop_reason =
+                "over the step budget of " + std::to_string(max_steps) + " steps at t = " + std::to_string(t);
             odeint_detail::finish<P>(out, y, t, calls);
             return out;
           }

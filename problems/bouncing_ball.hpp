@@ -47,30 +47,17 @@ struct ground_ball {
   static constexpr auto parameters() {
     using p = param<ground_ball>;
     return std::array{
-        p{"height", &ground_ball::height, "m", "launch height"},
+        p{"height", &ground_ball::height, "m", "launch height", positive},
         p{"vx0", &ground_ball::vx0, "m/s", "horizontal launch speed"},
-        p{"restitution", &ground_ball::restitution, "1", "k_r: 1 elastic, 0 sticks"},
-        p{"friction", &ground_ball::friction, "1", "k_f: 1 stops the tangential motion, 0 none"},
-        p{"gravity", &ground_ball::gravity, "m/s^2", "gravitational acceleration"},
-        p{"mass_kg", &ground_ball::mass_kg, "kg", "mass"},
-        p{"locate", &ground_ball::locate, "1", "contact mode: 0 end_of_step, 1 locate"},
-        p{"duration", &ground_ball::duration, "s", "default horizon"},
+        p{"restitution", &ground_ball::restitution, "1", "k_r: 1 elastic, 0 sticks", in_closed(0.0, 1.0)},
+        p{"friction", &ground_ball::friction, "1", "k_f: 1 stops the tangential motion, 0 none", in_closed(0.0, 1.0)},
+        p{"gravity", &ground_ball::gravity, "m/s^2", "gravitational acceleration", positive},
+        p{"mass_kg", &ground_ball::mass_kg, "kg", "mass", positive},
+        p{"locate", &ground_ball::locate, "1", "contact mode", whole_from(0, 1), contact_mode_names},
+        p{"duration", &ground_ball::duration, "s", "default horizon", positive},
     };
   }
   exact::bouncing_ball motion() const { return {gravity, height, vx0, 0.0, restitution, friction}; }
-  std::string validate() const {
-    if (const auto why = motion().invalid_reason(); !why.empty()) {
-      if (why.starts_with("k_r")) return "restitution must be in [0, 1]";
-      if (why.starts_with("k_f")) return "friction must be in [0, 1]";
-      if (why.starts_with("h ")) return "height must be finite and > 0";
-      if (why.starts_with("g ")) return "gravity must be finite and > 0";
-      return "vx0 must be finite";
-    }
-    for (auto err : {require_positive("mass_kg", mass_kg), require_positive("duration", duration)})
-      if (!err.empty()) return err;
-    if (!(locate == 0.0 || locate == 1.0)) return "locate must be 0 (end_of_step) or 1 (locate)";
-    return {};
-  }
 
   double mass() const { return mass_kg; }
   double horizon() const { return duration; }

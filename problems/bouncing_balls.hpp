@@ -75,26 +75,19 @@ struct bouncing_balls {
   static constexpr auto parameters() {
     using p = param<bouncing_balls>;
     return std::array{
-        p{"balls", &bouncing_balls::balls, "1", "number of balls (the truth covers up to 64)"},
-        p{"seed", &bouncing_balls::seed, "1", "seed of the initial scene (std::mt19937_64)"},
-        p{"radius", &bouncing_balls::radius, "m", "radius of every ball"},
-        p{"restitution", &bouncing_balls::restitution, "1", "k_r: 1 elastic, 0 sticks"},
-        p{"friction", &bouncing_balls::friction, "1", "k_f: 1 stops the tangential motion, 0 none"},
-        p{"gravity", &bouncing_balls::gravity, "m/s^2", "gravitational acceleration, along -z"},
-        p{"mass_kg", &bouncing_balls::mass_kg, "kg", "mass of every ball"},
-        p{"duration", &bouncing_balls::duration, "s", "default horizon"},
+        p{"balls", &bouncing_balls::balls, "1", "number of balls (the truth covers up to 64)", whole_from(1, 1e7)},
+        p{"seed", &bouncing_balls::seed, "1", "seed of the initial scene (std::mt19937_64)", whole_from(0, 0x1p53)},
+        p{"radius", &bouncing_balls::radius, "m", "radius of every ball", positive},
+        p{"restitution", &bouncing_balls::restitution, "1", "k_r: 1 elastic, 0 sticks", in_closed(0.0, 1.0)},
+        p{"friction", &bouncing_balls::friction, "1", "k_f: 1 stops the tangential motion, 0 none",
+          in_closed(0.0, 1.0)},
+        p{"gravity", &bouncing_balls::gravity, "m/s^2", "gravitational acceleration, along -z", non_negative},
+        p{"mass_kg", &bouncing_balls::mass_kg, "kg", "mass of every ball", positive},
+        p{"duration", &bouncing_balls::duration, "s", "default horizon", positive},
     };
   }
-  std::string validate() const {
-    if (!(balls >= 1 && balls <= 1e7 && balls == std::floor(balls)))
-      return "balls must be a whole number from 1 to 1e7";
-    if (!(seed >= 0 && seed < 0x1p53 && seed == std::floor(seed))) return "seed must be a whole number from 0 to 2^53";
-    for (auto err : {require_positive("radius", radius), require_positive("mass_kg", mass_kg),
-                     require_positive("duration", duration)})
-      if (!err.empty()) return err;
-    if (!(restitution >= 0.0 && restitution <= 1.0)) return "restitution must be in [0, 1]";
-    if (!(friction >= 0.0 && friction <= 1.0)) return "friction must be in [0, 1]";
-    if (!(std::isfinite(gravity) && gravity >= 0.0)) return "gravity must be finite and >= 0";
+  // What no single parameter's constraint says: the balls fit the scene's grid.
+  std::string scene_check() const {
     const double cols = std::ceil(std::sqrt(2.0 * balls));
     if (!(std::min(width() / cols, height() / std::ceil(balls / cols)) > 2.0 * radius))
       return "radius too large: the balls do not fit the scene's grid";

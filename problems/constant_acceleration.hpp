@@ -27,17 +27,11 @@ struct constant_acceleration {
     using p = param<constant_acceleration>;
     return std::array{
         p{"force_n", &constant_acceleration::force_n, "N", "constant applied force"},
-        p{"mass_kg", &constant_acceleration::mass_kg, "kg", "mass"},
+        p{"mass_kg", &constant_acceleration::mass_kg, "kg", "mass", positive},
         p{"x0", &constant_acceleration::x0, "m", "initial position"},
         p{"v0", &constant_acceleration::v0, "m/s", "initial velocity"},
-        p{"duration", &constant_acceleration::duration, "s", "default horizon"},
+        p{"duration", &constant_acceleration::duration, "s", "default horizon", positive},
     };
-  }
-  std::string validate() const {
-    for (auto err : {require_positive("mass_kg", mass_kg), require_positive("duration", duration),
-                     require_finite("force_n", force_n), require_finite("x0", x0), require_finite("v0", v0)})
-      if (!err.empty()) return err;
-    return {};
   }
 
   double mass() const { return mass_kg; }

@@ -42,20 +42,13 @@ struct spring_damper {
   static constexpr auto parameters() {
     using p = param<spring_damper>;
     return std::array{
-        p{"k_s", &spring_damper::k_s, "N/m", "spring stiffness"},
-        p{"k_d", &spring_damper::k_d, "N s/m", "damping coefficient"},
-        p{"mass_kg", &spring_damper::mass_kg, "kg", "mass"},
+        p{"k_s", &spring_damper::k_s, "N/m", "spring stiffness", positive},
+        p{"k_d", &spring_damper::k_d, "N s/m", "damping coefficient", non_negative},
+        p{"mass_kg", &spring_damper::mass_kg, "kg", "mass", positive},
         p{"x0", &spring_damper::x0, "m", "initial displacement"},
         p{"v0", &spring_damper::v0, "m/s", "initial velocity"},
-        p{"duration", &spring_damper::duration, "s", "default horizon"},
+        p{"duration", &spring_damper::duration, "s", "default horizon", positive},
     };
-  }
-  std::string validate() const {
-    for (auto err : {require_positive("k_s", k_s), require_positive("mass_kg", mass_kg),
-                     require_positive("duration", duration), require_finite("x0", x0), require_finite("v0", v0)})
-      if (!err.empty()) return err;
-    if (!(std::isfinite(k_d) && k_d >= 0.0)) return "k_d must be finite and >= 0";
-    return {};
   }
 
   double mass() const { return mass_kg; }

@@ -33,18 +33,11 @@ struct falling_drag {
   static constexpr auto parameters() {
     using p = param<falling_drag>;
     return std::array{
-        p{"mass_kg", &falling_drag::mass_kg, "kg", "mass"},
-        p{"gravity", &falling_drag::gravity, "m/s^2", "gravitational acceleration"},
-        p{"drag", &falling_drag::drag, "kg/m", "drag coefficient c of F = -c |v| v (0: free fall)"},
-        p{"duration", &falling_drag::duration, "s", "default horizon"},
+        p{"mass_kg", &falling_drag::mass_kg, "kg", "mass", positive},
+        p{"gravity", &falling_drag::gravity, "m/s^2", "gravitational acceleration", positive},
+        p{"drag", &falling_drag::drag, "kg/m", "drag coefficient c of F = -c |v| v (0: free fall)", non_negative},
+        p{"duration", &falling_drag::duration, "s", "default horizon", positive},
     };
-  }
-  std::string validate() const {
-    for (auto err : {require_positive("mass_kg", mass_kg), require_positive("gravity", gravity),
-                     require_positive("duration", duration)})
-      if (!err.empty()) return err;
-    if (!(std::isfinite(drag) && drag >= 0.0)) return "drag must be finite and >= 0";
-    return {};
   }
 
   exact::falling_drag motion() const { return exact::falling_drag::from_mass_and_drag(gravity, mass_kg, drag); }

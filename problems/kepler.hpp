@@ -39,25 +39,14 @@ struct kepler {
   static constexpr auto parameters() {
     using p = param<kepler>;
     return std::array{
-        p{"eccentricity", &kepler::eccentricity, "1", "orbital eccentricity, [0, 1)"},
-        p{"semi_major_axis", &kepler::semi_major_axis, "m", "semi-major axis a"},
-        p{"gm", &kepler::gm, "m^3/s^2", "gravitational parameter G M of the fixed mass"},
-        p{"mass_kg", &kepler::mass_kg, "kg", "mass of the orbiting body"},
-        p{"orbits", &kepler::orbits, "1", "default horizon in orbital periods"},
+        p{"eccentricity", &kepler::eccentricity, "1", "orbital eccentricity", in_closed_open(0.0, 1.0)},
+        p{"semi_major_axis", &kepler::semi_major_axis, "m", "semi-major axis a", positive},
+        p{"gm", &kepler::gm, "m^3/s^2", "gravitational parameter G M of the fixed mass", positive},
+        p{"mass_kg", &kepler::mass_kg, "kg", "mass of the orbiting body", positive},
+        p{"orbits", &kepler::orbits, "1", "default horizon in orbital periods", positive},
     };
   }
   exact::kepler_orbit orbit() const { return {gm, semi_major_axis, eccentricity}; }
-  std::string validate() const {
-    if (const auto why = orbit().invalid_reason(); !why.empty()) {
-      // The exact orbit names its parameters gm, a, e.
-      if (why.starts_with("e ")) return "eccentricity must be in [0, 1)";
-      if (why.starts_with("a ")) return "semi_major_axis must be finite and > 0";
-      return std::string(why);
-    }
-    for (auto err : {require_positive("mass_kg", mass_kg), require_positive("orbits", orbits)})
-      if (!err.empty()) return err;
-    return {};
-  }
 
   double mass() const { return mass_kg; }
   double period() const { return orbit().period(); }

@@ -39,19 +39,12 @@ struct pendulum {
   static constexpr auto parameters() {
     using p = param<pendulum>;
     return std::array{
-        p{"gravity", &pendulum::gravity, "m/s^2", "gravitational acceleration"},
-        p{"length_m", &pendulum::length_m, "m", "rod length"},
-        p{"mass_kg", &pendulum::mass_kg, "kg", "bob mass"},
-        p{"theta0_deg", &pendulum::theta0_deg, "deg", "release angle from the bottom"},
-        p{"periods", &pendulum::periods, "1", "default horizon in exact periods"},
+        p{"gravity", &pendulum::gravity, "m/s^2", "gravitational acceleration", positive},
+        p{"length_m", &pendulum::length_m, "m", "rod length", positive},
+        p{"mass_kg", &pendulum::mass_kg, "kg", "bob mass", positive},
+        p{"theta0_deg", &pendulum::theta0_deg, "deg", "release angle from the bottom", in_open(0.0, 180.0)},
+        p{"periods", &pendulum::periods, "1", "default horizon in exact periods", positive},
     };
-  }
-  std::string validate() const {
-    for (auto err : {require_positive("gravity", gravity), require_positive("length_m", length_m),
-                     require_positive("mass_kg", mass_kg), require_positive("periods", periods)})
-      if (!err.empty()) return err;
-    if (!(theta0_deg > 0.0 && theta0_deg < 180.0)) return "theta0_deg must be in (0, 180)";
-    return {};
   }
 
   double theta0() const { return theta0_deg * std::numbers::pi / 180.0; }

@@ -26,18 +26,11 @@ struct projectile {
   static constexpr auto parameters() {
     using p = param<projectile>;
     return std::array{
-        p{"speed", &projectile::speed, "m/s", "launch speed"},
-        p{"angle_deg", &projectile::angle_deg, "deg", "elevation above +x"},
-        p{"gravity", &projectile::gravity, "m/s^2", "magnitude of g, along -z"},
-        p{"mass_kg", &projectile::mass_kg, "kg", "mass"},
+        p{"speed", &projectile::speed, "m/s", "launch speed", positive},
+        p{"angle_deg", &projectile::angle_deg, "deg", "elevation above +x (so the ball flies)", in_open(0.0, 180.0)},
+        p{"gravity", &projectile::gravity, "m/s^2", "magnitude of g, along -z", positive},
+        p{"mass_kg", &projectile::mass_kg, "kg", "mass", positive},
     };
-  }
-  std::string validate() const {
-    for (auto err :
-         {require_positive("speed", speed), require_positive("gravity", gravity), require_positive("mass_kg", mass_kg)})
-      if (!err.empty()) return err;
-    if (!(angle_deg > 0.0 && angle_deg < 180.0)) return "angle_deg must be in (0, 180) so the ball flies";
-    return {};
   }
 
   double angle_rad() const { return angle_deg * std::numbers::pi / 180.0; }

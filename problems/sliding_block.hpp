@@ -70,23 +70,23 @@ struct incline_block {
   static constexpr auto parameters() {
     using p = param<incline_block>;
     return std::array{
-        p{"angle_deg", &incline_block::angle_deg, "deg", "incline angle"},
+        p{"angle_deg", &incline_block::angle_deg, "deg", "incline angle", in_closed_open(0.0, 90.0)},
         p{"v0", &incline_block::v0, "m/s", "initial speed along the slope, positive up"},
-        p{"mass_kg", &incline_block::mass_kg, "kg", "mass"},
-        p{"gravity", &incline_block::gravity, "m/s^2", "gravitational acceleration"},
+        p{"mass_kg", &incline_block::mass_kg, "kg", "mass", positive},
+        p{"gravity", &incline_block::gravity, "m/s^2", "gravitational acceleration", positive},
         p{"material", &incline_block::material, "1",
-          "friction pair of the lecture's table: its row or its name (0: none, mu_s and mu_k apply)"},
-        p{"lubricated", &incline_block::lubricated, "1", "0: the table's dry column, 1: lubricated"},
-        p{"mu_s", &incline_block::mu_s, "1", "static friction coefficient (material 0)"},
-        p{"mu_k", &incline_block::mu_k, "1", "kinetic friction coefficient (material 0)"},
-        p{"locate", &incline_block::locate, "1", "contact mode: 0 end_of_step, 1 locate"},
-        p{"duration", &incline_block::duration, "s", "default horizon"},
+          "friction pair of the lecture's table: its row or its name (0: none, mu_s and mu_k apply)",
+          whole_from(0, static_cast<double>(exact::friction_table.size())), material_names},
+        p{"lubricated", &incline_block::lubricated, "1", "the table's column", whole_from(0, 1), lubrication_names},
+        p{"mu_s", &incline_block::mu_s, "1", "static friction coefficient (material 0)", non_negative},
+        p{"mu_k", &incline_block::mu_k, "1", "kinetic friction coefficient (material 0)", non_negative},
+        p{"locate", &incline_block::locate, "1", "contact mode", whole_from(0, 1), contact_mode_names},
+        p{"duration", &incline_block::duration, "s", "default horizon", positive},
     };
   }
 
   // `material` by name: every pair of the lecture's table, with its coefficients.
-  static std::vector<named_value> named_values(std::string_view param) {
-    if (param != "material") return {};
+  static std::vector<named_value> material_names() {
     auto cell = [](const std::optional<double>& c) { return c ? fmt::format("{:g}", *c) : std::string("-"); };
     std::vector<named_value> out{{"none", 0.0, "mu_s and mu_k apply"}};
     for (std::size_t i = 0; i < exact::friction_table.size(); ++i) {
@@ -96,6 +96,9 @@ struct incline_block {
                                  cell(r.mu_s_lubricated), cell(r.mu_k_lubricated))});
     }
     return out;
+  }
+  static std::vector<named_value> lubrication_names() {
+    return {{"dry", 0.0, "the table's dry column"}, {"lubricated", 1.0, "the table's lubricated column"}};
   }
 
   const exact::friction_record* record() const {
@@ -111,16 +114,9 @@ struct incline_block {
     return mu_k;
   }
 
-  std::string validate() const {
-    if (!(angle_deg >= 0.0 && angle_deg < 90.0)) return "angle_deg must be in [0, 90)";
-    for (auto err : {require_positive("mass_kg", mass_kg), require_positive("gravity", gravity),
-                     require_positive("duration", duration), require_finite("v0", v0)})
-      if (!err.empty()) return err;
-    if (!(lubricated == 0.0 || lubricated == 1.0)) return "lubricated must be 0 or 1";
-    if (!(locate == 0.0 || locate == 1.0)) return "locate must be 0 (end_of_step) or 1 (locate)";
-    const double rows = static_cast<double>(exact::friction_table.size());
-    if (!(material >= 0.0 && material <= rows && material == std::floor(material)))
-      return fmt::format("material must be a row of the friction table, 1 to {} (or 0: none)", rows);
+  // What no single parameter's constraint says: a material pair excludes mu_s and mu_k,
+  // and the table must hold both coefficients in the chosen column.
+  std::string scene_check() const {
     if (const auto* r = record()) {
       if (mu_s != Scene::mu_s || mu_k != Scene::mu_k) return "give either material or mu_s and mu_k, not both";
       const bool lub = lubricated != 0.0;
@@ -132,8 +128,6 @@ struct incline_block {
             "and mu_k",
             !s ? "static" : "kinetic", exact::friction_name(*r), lub ? "lubricated" : "dry");
     }
-    if (!(std::isfinite(mu_s) && mu_s >= 0.0)) return "mu_s must be finite and >= 0";
-    if (!(std::isfinite(mu_k) && mu_k >= 0.0)) return "mu_k must be finite and >= 0";
     return {};
   }
 

@@ -47,24 +47,14 @@ struct spring_chain {
   static constexpr auto parameters() {
     using p = param<spring_chain>;
     return std::array{
-        p{"masses", &spring_chain::masses, "1", "number of point masses (the first is pinned)"},
-        p{"rope_mass_kg", &spring_chain::rope_mass_kg, "kg", "total mass, shared equally"},
-        p{"rope_length_m", &spring_chain::rope_length_m, "m", "rest length of the whole rope"},
-        p{"k_s", &spring_chain::k_s, "N/m", "stiffness of each spring"},
-        p{"k_d", &spring_chain::k_d, "N s/m", "damping of each spring, along it"},
+        p{"masses", &spring_chain::masses, "1", "number of point masses (the first is pinned)", whole_from(2, 1 << 20)},
+        p{"rope_mass_kg", &spring_chain::rope_mass_kg, "kg", "total mass, shared equally", positive},
+        p{"rope_length_m", &spring_chain::rope_length_m, "m", "rest length of the whole rope", positive},
+        p{"k_s", &spring_chain::k_s, "N/m", "stiffness of each spring", positive},
+        p{"k_d", &spring_chain::k_d, "N s/m", "damping of each spring, along it", non_negative},
         p{"gravity", &spring_chain::gravity, "m/s^2", "magnitude of g, along -z"},
-        p{"duration", &spring_chain::duration, "s", "default horizon"},
+        p{"duration", &spring_chain::duration, "s", "default horizon", positive},
     };
-  }
-  std::string validate() const {
-    if (!(masses >= 2 && masses <= (1 << 20) && masses == std::floor(masses)))
-      return "masses must be a whole number from 2 to 1048576";
-    for (auto err :
-         {require_positive("rope_mass_kg", rope_mass_kg), require_positive("rope_length_m", rope_length_m),
-          require_positive("k_s", k_s), require_positive("duration", duration), require_finite("gravity", gravity)})
-      if (!err.empty()) return err;
-    if (!(std::isfinite(k_d) && k_d >= 0.0)) return "k_d must be finite and >= 0";
-    return {};
   }
 
   int count() const { return static_cast<int>(masses); }

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "study/h5.hpp"
+#include "study/study_file.hpp"
 #include "study/sweep.hpp"
 
 namespace stepbench {
@@ -51,8 +52,8 @@ energy_run run_one(const problem_instance& p, const method_info& m, const energy
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   out.steps = r.steps;
   out.force_evals = r.work.force_evals;
-  if (!r.failure.empty() || r.non_finite || r.sample_y.size() != times.size()) {
-    out.note = !r.failure.empty() ? r.failure : "non-finite state";
+  if (!r.stop_reason.empty() || r.non_finite || r.sample_y.size() != times.size()) {
+    out.note = !r.stop_reason.empty() ? r.stop_reason : "non-finite state";
     out.max_rel_err = out.final_rel_err = out.drift_per_period = out.angmom_max_rel_err = out.angmom_drift_per_period =
         out.first_tenth_max = out.last_tenth_max = out.last_tenth_mean = nan;
     return out;
@@ -137,7 +138,7 @@ energy_study run_energy_study(const energy_options& opts,
       throw std::invalid_argument(fmt::format("energy study: problem {} has no period or no energy", scene.problem));
     energy_problem ep;
     ep.problem = scene.problem;
-    for (const auto& q : p->params()) ep.params[q.name] = q.value;
+    ep.params = p->params();
     ep.period = p->period();
     ep.steps_per_period = scene.steps_per_period;
     ep.dt = ep.period / scene.steps_per_period;
@@ -177,7 +178,7 @@ void write_energy(H5::Group& root, const energy_study& s) {
   attr(g, "wall_seconds", s.wall_seconds);
   for (const auto& ep : s.problems) {
     H5::Group pg = g.createGroup(ep.problem);
-    for (const auto& [name, value] : ep.params) attr(pg, name, value);
+    parameters_table(ep.params).write(pg, "parameters", schema::find("parameters"));
     attr(pg, "period", ep.period);
     attr(pg, "dt", ep.dt);
     attr(pg, "steps_per_period", ep.steps_per_period);
@@ -209,7 +210,7 @@ void write_energy(H5::Group& root, const energy_study& s) {
     t.add("angmom_drift_per_period", col([](const energy_run& r) { return r.angmom_drift_per_period; }));
     t.add("seconds", col([](const energy_run& r) { return r.seconds; }));
     t.add("note", col([](const energy_run& r) { return r.note; }));
-    t.write(pg, "summary");
+    t.write(pg, "summary", schema::find("energy_summary"));
     H5::Group series = pg.createGroup("series");
     for (const auto& r : ep.runs) {
       if (!r.completed) continue;

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "core/method.hpp"
+#include "core/parameter.hpp"
 
 namespace stepbench {
 
@@ -70,7 +71,7 @@ struct energy_run {
 
 struct energy_problem {
   std::string problem;
-  std::map<std::string, double> params;
+  std::vector<param_value> params;  // the scene's, as declared
   double period = 0.0, dt = 0.0, horizon = 0.0, e0 = 0.0, l0 = 0.0;
   int steps_per_period = 0;
   std::vector<energy_run> runs;

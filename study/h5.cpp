@@ -89,7 +89,37 @@ void table::add(std::string name, std::vector<std::string> values) {
   columns_.emplace_back(std::move(name), std::move(values));
 }
 
-void table::write(H5::Group& g, const std::string& name) const {
+void table::check(const std::string& name, const schema::table& spec) const {
+  std::size_t c = 0;
+  auto type_of = [](const column& col) {
+    return std::visit(
+        [](const auto& v) {
+          using T = typename std::decay_t<decltype(v)>::value_type;
+          if constexpr (std::is_same_v<T, double>) return schema::field_type::f64;
+          if constexpr (std::is_same_v<T, std::int64_t>) return schema::field_type::i64;
+          if constexpr (std::is_same_v<T, std::int8_t>) return schema::field_type::i8;
+          return schema::field_type::str;
+        },
+        col);
+  };
+  for (const auto& group : spec.groups) {
+    const bool present = c < columns_.size() && columns_[c].first == group.fields.front().name;
+    if (!present && group.timed_only) continue;
+    for (const auto& f : group.fields) {
+      if (c >= columns_.size() || columns_[c].first != f.name || type_of(columns_[c].second) != f.type)
+        throw std::logic_error(fmt::format("table {}: column {} is not the schema's {} ({}) of table {}", name,
+                                           c < columns_.size() ? columns_[c].first : "(none)", f.name,
+                                           schema::to_string(f.type), spec.name));
+      ++c;
+    }
+  }
+  if (c != columns_.size())
+    throw std::logic_error(
+        fmt::format("table {}: column {} is not in the schema's table {}", name, columns_[c].first, spec.name));
+}
+
+void table::write(H5::Group& g, const std::string& name, const schema::table& spec) const {
+  check(name, spec);
   std::size_t rows = 0, width = 0;
   std::vector<std::size_t> offset;
   for (const auto& [col_name, col] : columns_) {

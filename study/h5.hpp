@@ -10,6 +10,8 @@
 #include <variant>
 #include <vector>
 
+#include "study/schema.hpp"
+
 namespace stepbench::h5 {
 
 void attr(H5::H5Object& obj, const std::string& name, const std::string& value);
@@ -34,11 +36,15 @@ class table {
   void add(std::string name, std::vector<std::int64_t> values);
   void add(std::string name, std::vector<std::int8_t> values);
   void add(std::string name, std::vector<std::string> values);  // variable-length strings
-  void write(H5::Group& g, const std::string& dataset) const;
+  // Writes the table after checking its columns against the schema's table `spec`
+  // (names, order, types; a timed-only group present whole or absent): a mismatch is a
+  // bug in the writer, thrown as std::logic_error before anything is written.
+  void write(H5::Group& g, const std::string& dataset, const schema::table& spec) const;
 
  private:
   using column =
       std::variant<std::vector<double>, std::vector<std::int64_t>, std::vector<std::int8_t>, std::vector<std::string>>;
+  void check(const std::string& dataset, const schema::table& spec) const;
   std::vector<std::pair<std::string, column>> columns_;
 };
 

@@ -300,7 +300,7 @@ double measured_step_cost_ns(const problem_study& ps, std::string_view method) {
     if (ms.info.name != method) continue;
     std::vector<double> per_step;
     for (const auto& r : ms.rows)
-      if (!r.metrics.diverged && !r.metrics.failed && !r.metrics.skipped && r.steps > 0 &&
+      if (r.metrics.completed() && r.steps > 0 &&
           std::isfinite(r.time.time_ns) && r.time.time_ns > 0.0)
         per_step.push_back(r.time.time_ns / static_cast<double>(r.steps));
     return median(per_step);
@@ -396,7 +396,7 @@ void write_runs(H5::Group& g, const loop_method& m, double step_cost_ns, const s
   t.add("outcome", col([](R, C c) { return std::string(to_string(c.schedule.outcome)); }));
   t.add("outcome_without_clamp", col([](R, C c) { return std::string(to_string(c.without_clamp)); }));
   t.add("clamp_prevented_spiral", col([&](R, C c) { return i8(c.clamp_prevented_spiral); }));
-  t.write(g, "runs");
+  t.write(g, "runs", schema::find("loop_runs"));
   std::vector<std::vector<double>> finals;
   for (const auto& r : rows) finals.push_back(r.final_physics);
   h5::dataset(g, "final_physics_state", finals);
@@ -418,7 +418,7 @@ void write_cheapest(H5::Group& g, const loop_method& m, const loop_options& opts
   t.add("physics_hz", col([](const loop_cheapest& c) { return c.physics_hz; }));
   t.add("steps_per_frame_mean", col([](const loop_cheapest& c) { return c.steps_per_frame_mean; }));
   t.add("shown_err_max", col([](const loop_cheapest& c) { return c.shown_err_max; }));
-  t.write(g, "cheapest");
+  t.write(g, "cheapest", schema::find("loop_cheapest"));
 }
 
 }  // namespace

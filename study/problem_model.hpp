@@ -31,16 +31,14 @@ namespace stepbench::registry_detail {
 template <integrator I>
 struct ours_fixed {
   static method_info info() {
-    return {std::string(I::name),
-            std::string(I::description),
-            method_origin::ours,
-            method_kind::fixed_step,
-            static_cast<double>(I::order),
-            I::traits,
-            "stepbench"};
+    return {.name = std::string(I::name),
+            .description = std::string(I::description),
+            .origin = method_origin::ours,
+            .kind = method_kind::fixed_step,
+            .declared_order = static_cast<double>(I::order),
+            .traits = I::traits,
+            .library = "stepbench"};
   }
-  template <problem P>
-  static constexpr bool applies = true;
   template <problem P>
   static auto prepare(const P& p, double dt, double horizon, std::span<const double> times, const run_limits&) {
     return [p, dt, horizon, plan = plan_records(horizon, dt, times)] { return drive(p, I{}, dt, horizon, plan); };
@@ -50,16 +48,14 @@ struct ours_fixed {
 template <adaptive_integrator I>
 struct ours_adaptive {
   static method_info info() {
-    return {std::string(I::name),
-            std::string(I::description),
-            method_origin::ours,
-            method_kind::adaptive,
-            static_cast<double>(I::order),
-            I::traits,
-            "stepbench"};
+    return {.name = std::string(I::name),
+            .description = std::string(I::description),
+            .origin = method_origin::ours,
+            .kind = method_kind::adaptive,
+            .declared_order = static_cast<double>(I::order),
+            .traits = I::traits,
+            .library = "stepbench"};
   }
-  template <problem P>
-  static constexpr bool applies = true;
   template <problem P>
   static auto prepare(const P& p, double tol, double horizon, std::span<const double> times, const run_limits& limits) {
     // The budget in steps: the work budget over the coordinates and the method's force
@@ -100,8 +96,17 @@ template <class I>
 inline constexpr bool is_ours<ours_fixed<I>> = true;
 template <class I>
 inline constexpr bool is_ours<ours_adaptive<I>> = true;
+// A method applies to every problem unless it declares `applies<P>` (Odeint's peers
+// need a state size known at compile time, the baselines their own two problems).
 template <class M, class P>
-inline constexpr bool runs_on = M::template applies<P> && (!has_contacts<P> || is_ours<M>);
+consteval bool applies_to() {
+  if constexpr (requires { M::template applies<P>; })
+    return M::template applies<P>;
+  else
+    return true;
+}
+template <class M, class P>
+inline constexpr bool runs_on = applies_to<M, P>() && (!has_contacts<P> || is_ours<M>);
 
 template <class M>
 const method_info& info_of() {
@@ -125,7 +130,7 @@ run_result to_run_result(const drive_result<Vec>& r, double param, double horizo
   out.rejected_steps = r.rejected_steps;
   out.work = r.work;
   out.non_finite = r.non_finite;
-  out.failure = r.failure;
+  out.stop_reason = r.stop_reason;
   out.skipped = r.over_budget;
   out.sample_t = r.sample_t;
   for (std::size_t j = 0; j < r.sample_t.size(); ++j) {
@@ -180,18 +185,7 @@ class problem_model final : public problem_instance {
   int dim() const override { return p_.dim(); }
   std::string_view position_unit() const override { return P::position_unit; }
 
-  std::vector<param_value> params() const override {
-    std::vector<param_value> out;
-    for (const auto& q : P::parameters()) {
-      // A parameter that takes names lists them under its description, one a line (what
-      // `stepbench list` shows: the lecture's friction table under `material`).
-      std::string text(q.description);
-      for (const auto& v : named_values(q.name))
-        text += fmt::format("\n{:>10}{:>4g}  {:<40} {}", "", v.value, v.name, v.description);
-      out.push_back({std::string(q.name), std::string(q.unit), std::move(text), p_.*q.member});
-    }
-    return out;
-  }
+  std::vector<param_value> params() const override { return declared_params(p_); }
   void set(std::string_view param, double value) override {
     for (const auto& q : P::parameters())
       if (q.name == param) {
@@ -203,28 +197,7 @@ class problem_model final : public problem_instance {
     throw std::invalid_argument(
         fmt::format("unknown parameter '{}' for problem {} (known: {})", param, P::name, fmt::join(known, ", ")));
   }
-  void set_text(std::string_view param, std::string_view text) override {
-    for (const auto& v : named_values(param))
-      if (v.name == text) return set(param, v.value);
-    double value = 0.0;
-    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (text.empty() || ec != std::errc() || end != text.data() + text.size() || !std::isfinite(value)) {
-      const auto names = named_values(param);
-      if (names.empty()) throw std::invalid_argument(fmt::format("--set {}: '{}' is not a finite number", param, text));
-      throw std::invalid_argument(
-          fmt::format("--set {}: '{}' is neither a number nor one of the {} names it takes "
-                      "(`stepbench list` shows them)",
-                      param, text, names.size()));
-    }
-    set(param, value);
-  }
-  std::vector<named_value> named_values(std::string_view param) const override {
-    if constexpr (stepbench::has_named_values<P>)
-      return P::named_values(param);
-    else
-      return {};
-  }
-  std::string validate() const override { return p_.validate(); }
+  std::string validate() const override { return stepbench::validate(p_); }
   double horizon() const override { return p_.horizon(); }
   bool has_closed_form() const override { return stepbench::has_closed_form<P>; }
   bool has_energy() const override { return stepbench::has_energy<P>; }
@@ -324,7 +297,7 @@ class problem_model final : public problem_instance {
         out = {};
         out.param = param;
         out.horizon = horizon;
-        out.failure = e.what();
+        out.stop_reason = e.what();
       }
     });
     return out;

@@ -43,13 +43,8 @@ struct oscillator_problem {
 
   static constexpr auto parameters() {
     using p = param<oscillator_problem>;
-    return std::array{p{"omega", &oscillator_problem::omega, "rad/s", "angular frequency"},
-                      p{"mass_kg", &oscillator_problem::mass_kg, "kg", "mass"}};
-  }
-  std::string validate() const {
-    for (auto err : {require_positive("omega", omega), require_positive("mass_kg", mass_kg)})
-      if (!err.empty()) return err;
-    return {};
+    return std::array{p{"omega", &oscillator_problem::omega, "rad/s", "angular frequency", positive},
+                      p{"mass_kg", &oscillator_problem::mass_kg, "kg", "mass", positive}};
   }
   int dim() const { return 1; }
   double mass() const { return mass_kg; }
@@ -81,13 +76,8 @@ struct decay_problem {
 
   static constexpr auto parameters() {
     using p = param<decay_problem>;
-    return std::array{p{"lambda", &decay_problem::lambda, "1/s", "decay rate"},
-                      p{"mass_kg", &decay_problem::mass_kg, "kg", "mass"}};
-  }
-  std::string validate() const {
-    for (auto err : {require_positive("lambda", lambda), require_positive("mass_kg", mass_kg)})
-      if (!err.empty()) return err;
-    return {};
+    return std::array{p{"lambda", &decay_problem::lambda, "1/s", "decay rate", positive},
+                      p{"mass_kg", &decay_problem::mass_kg, "kg", "mass", positive}};
   }
   int dim() const { return 1; }
   double mass() const { return mass_kg; }
@@ -122,13 +112,7 @@ struct complex_damper_problem {
     using p = param<complex_damper_problem>;
     return std::array{p{"rate_re", &complex_damper_problem::rate_re, "1/s", "real part a of the rate"},
                       p{"rate_im", &complex_damper_problem::rate_im, "1/s", "imaginary part b of the rate"},
-                      p{"mass_kg", &complex_damper_problem::mass_kg, "kg", "mass"}};
-  }
-  std::string validate() const {
-    for (auto err :
-         {require_finite("rate_re", rate_re), require_finite("rate_im", rate_im), require_positive("mass_kg", mass_kg)})
-      if (!err.empty()) return err;
-    return {};
+                      p{"mass_kg", &complex_damper_problem::mass_kg, "kg", "mass", positive}};
   }
   int dim() const { return 2; }
   double mass() const { return mass_kg; }
@@ -517,7 +501,7 @@ void write_stability(H5::Group& root, const stability_data& d) {
   t.add("run_confirms", col([](const stability_limit& l) { return static_cast<std::int8_t>(l.run_confirms); }));
   t.add("step_failed_at", col([](const stability_limit& l) { return l.step_failed_at; }));
   t.add("note", col([](const stability_limit& l) { return l.note; }));
-  t.write(g, "limits");
+  t.write(g, "limits", schema::find("stability_limits"));
 
   const auto& r = d.regions;
   h5::dataset(g, "region_re", r.re);

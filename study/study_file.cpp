@@ -93,7 +93,7 @@ void write_method(H5::Group& parent, const method_study& ms, bool timed) {
   attr(g, "exact_for_problem", static_cast<int>(ms.fit.state == fit_result::status::exact));
   attr(g, "declared_order_holds", ms.declared_order_holds);
 
-  runs_table(ms.rows, timed).write(g, "runs");
+  runs_table(ms.rows, timed).write(g, "runs", schema::find("runs"));
 }
 
 // The equal-error table: for each metric and target, every method that reaches it with
@@ -142,7 +142,7 @@ void write_equal_error(H5::Group& g, const problem_study& ps, bool timed) {
   t.add("time_ns", time_ns);
   t.add("force_evals", force_evals);
   t.add("is_answer", is_answer);
-  t.write(g, "equal_error");
+  t.write(g, "equal_error", schema::find("equal_error"));
 }
 
 void write_front(H5::Group& g, const problem_study& ps, bool by_time, bool timed) {
@@ -160,13 +160,13 @@ void write_front(H5::Group& g, const problem_study& ps, bool by_time, bool timed
   t.add("param", param);
   t.add("cost", cost);
   t.add("err_pos_max", error);
-  t.write(g, by_time ? "front_time" : "front_force_evals");
+  t.write(g, by_time ? "front_time" : "front_force_evals", schema::find("front"));
 }
 
 void write_problem(H5::Group& parent, const problem_study& ps, bool timed) {
   const auto& p = *ps.problem;
   H5::Group g = parent.createGroup(std::string(p.name()));
-  for (const auto& param : p.params()) attr(g, param.name, param.value);
+  parameters_table(p.params()).write(g, "parameters", schema::find("parameters"));
   attr(g, "horizon", ps.horizon);
   attr(g, "dim", p.dim());
   attr(g, "position_unit", std::string(p.position_unit()));
@@ -242,6 +242,31 @@ class temp_file_guard {
 
 }  // namespace
 
+h5::table parameters_table(const std::vector<param_value>& params) {
+  std::vector<std::string> name, unit, kind, value_name, allowed, description;
+  std::vector<double> value, default_value;
+  for (const auto& q : params) {
+    name.push_back(q.name);
+    value.push_back(q.value);
+    unit.push_back(q.unit);
+    kind.emplace_back(q.kind());
+    value_name.push_back(q.value_name());
+    default_value.push_back(q.default_value);
+    allowed.push_back(q.allowed.text());
+    description.push_back(q.description);
+  }
+  h5::table t;
+  t.add("name", std::move(name));
+  t.add("value", std::move(value));
+  t.add("unit", std::move(unit));
+  t.add("kind", std::move(kind));
+  t.add("value_name", std::move(value_name));
+  t.add("default", std::move(default_value));
+  t.add("allowed", std::move(allowed));
+  t.add("description", std::move(description));
+  return t;
+}
+
 h5::table runs_table(const std::vector<method_row>& rows, bool timed) {
   h5::table t;
   auto col = [&](auto get) {
@@ -287,20 +312,16 @@ h5::table runs_table(const std::vector<method_row>& rows, bool timed) {
   return t;
 }
 
-std::vector<double> equal_error_targets() {
-  std::vector<double> out;
-  for (int e = 2; e <= 12; ++e) out.push_back(std::pow(10.0, -e));
-  return out;
-}
+std::vector<double> equal_error_targets() { return decades(2, 12, 1); }
 
 std::vector<wp_method> work_precision_input(const problem_study& ps, const std::string& metric) {
   std::vector<wp_method> out;
   for (const auto& ms : ps.methods) {
     wp_method m{ms.info.name, ms.info.origin, ms.info.kind, {}};
     for (const auto& r : ms.rows)
-      m.rows.push_back(
-          {r.param, metric_value(r.metrics, metric), r.time.time_ns, static_cast<double>(r.work.force_evals),
-           !r.metrics.diverged && !r.metrics.failed && !r.metrics.skipped, r.metrics.diverged, r.time.cut});
+      m.rows.push_back({r.param, metric_value(r.metrics, metric), r.time.time_ns,
+                        static_cast<double>(r.work.force_evals), r.metrics.completed(), r.metrics.diverged,
+                        r.time.cut});
     out.push_back(std::move(m));
   }
   return out;

@@ -10,7 +10,7 @@
 
 namespace stepbench {
 
-inline constexpr int study_format_version = 2;
+inline constexpr int study_format_version = schema::format_version;
 
 // The targets of the equal-error table written with every problem: 1e-2 .. 1e-12.
 std::vector<double> equal_error_targets();
@@ -24,6 +24,10 @@ void check_writable(const std::string& path);
 void write_study(const study& s, const std::string& path);
 
 // The `runs` table of a method's rows (docs/study-format.md); timing fields when timed.
+// A problem's declared parameters (core/parameter.hpp) as the /problems/<p>/parameters
+// table: name, value, unit, kind, value_name (the name of the value, where it has one),
+// default, allowed (the constraint in words), description.
+h5::table parameters_table(const std::vector<param_value>& params);
 h5::table runs_table(const std::vector<method_row>& rows, bool timed);
 
 // The rows of a problem's methods in the shape the work-precision rule takes, for one

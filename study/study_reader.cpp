@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "core/measure.hpp"
 #include "study/h5.hpp"
 #include "study/study_file.hpp"
 
@@ -71,14 +72,13 @@ study_problem read_problem(const H5::Group& g, const std::string& name) {
   p.horizon = h5::double_attr(g, "horizon");
   p.pos_scale = h5::double_attr(g, "pos_scale");
   p.vel_scale = h5::double_attr(g, "vel_scale");
-  for (unsigned i = 0; i < static_cast<unsigned>(g.getNumAttrs()); ++i) {
-    const H5::Attribute a = g.openAttribute(i);
-    if (a.getTypeClass() == H5T_FLOAT && a.getSpace().getSimpleExtentNpoints() == 1) {
-      double v = 0;
-      a.read(H5::PredType::NATIVE_DOUBLE, &v);
-      p.params[a.getName()] = v;
-    }
-  }
+  // The declared parameters, apart from the derived attributes (format 3).
+  if (!h5::is_dataset(g, "parameters"))
+    throw std::runtime_error(fmt::format("missing dataset 'parameters' in {}", g.getObjName()));
+  const H5::DataSet params = g.openDataSet("parameters");
+  const auto names = h5::read_strings(params, "name");
+  const auto values = h5::read_doubles(params, "value");
+  for (std::size_t i = 0; i < names.size() && i < values.size(); ++i) p.params[names[i]] = values[i];
   if (h5::is_group(g, "reference")) {
     const H5::Group refs = g.openGroup("reference");
     for (const auto& src : h5::children(refs)) {
@@ -188,7 +188,7 @@ std::vector<wp_method> work_precision_input(const study_problem& p, const std::s
     const auto& time = timed ? m.col("time_ns") : none;
     const auto& cut = timed ? m.col("cut") : zeros;
     for (std::size_t i = 0; i < param.size(); ++i)
-      w.rows.push_back({param[i], err[i], time[i], evals[i], diverged[i] == 0 && failed[i] == 0 && skipped[i] == 0,
+      w.rows.push_back({param[i], err[i], time[i], evals[i], row_completed(diverged[i] != 0, failed[i] != 0, skipped[i] != 0),
                         diverged[i] != 0, cut[i] != 0});
     out.push_back(std::move(w));
   }

@@ -64,7 +64,7 @@ struct study_data {
 };
 
 // The newest format this build reads (and writes), and the oldest.
-inline constexpr long study_format_read_min = 2;
+inline constexpr long study_format_read_min = 3;
 
 // Reads the whole file. Throws std::runtime_error with one line, "cannot read study file
 // '<path>': <what is wrong>", for a missing, non-HDF5, truncated, corrupt or foreign

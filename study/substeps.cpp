@@ -14,7 +14,7 @@ namespace {
 
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
-bool completed(const method_row& r) { return !r.metrics.diverged && !r.metrics.failed && !r.metrics.skipped; }
+bool completed(const method_row& r) { return r.metrics.completed(); }
 
 double cost_of(const method_row& r, bool by_time) {
   return by_time ? r.time.time_ns : static_cast<double>(r.work.force_evals);
@@ -161,7 +161,7 @@ void write_substeps(H5::Group& root, const std::vector<substep_study>& studies, 
       h5::table t = runs_table(rows, timed);
       t.add("substeps", n);
       t.add("extra_damping", damping);
-      t.write(mg, "runs");
+      t.write(mg, "runs", schema::find("substeps_runs"));
     }
     const auto verdicts = substep_verdicts(s, timed);
     h5::table v;
@@ -185,7 +185,7 @@ void write_substeps(H5::Group& root, const std::vector<substep_study>& studies, 
     v.add("substeps_to_match", col([](const substep_verdict& x) { return std::int64_t{x.substeps_to_match}; }));
     v.add("cost_to_match", col([](const substep_verdict& x) { return x.cost_to_match; }));
     v.add("summary", col([](const substep_verdict& x) { return x.summary; }));
-    v.write(g, "verdict");
+    v.write(g, "verdict", schema::find("substeps_verdict"));
   }
 }
 

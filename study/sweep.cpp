@@ -20,11 +20,13 @@ bool contains(const std::vector<T>& v, const T& x) {
 
 }  // namespace
 
-std::vector<double> tolerance_ladder(bool thinned) {
+std::vector<double> decades(int first, int last, int stride) {
   std::vector<double> out;
-  for (int e = 2; e <= 12; e += thinned ? 2 : 1) out.push_back(std::pow(10.0, -e));
+  for (int e = first; e <= last; e += stride) out.push_back(std::pow(10.0, -e));
   return out;
 }
+
+std::vector<double> tolerance_ladder(bool thinned) { return decades(2, 12, thinned ? 2 : 1); }
 
 std::unique_ptr<problem_instance> configured_problem(const std::string& name, const sweep_options& opts) {
   auto p = make_problem(name);
@@ -86,7 +88,7 @@ void fit_rows(method_study& ms, double pos_scale) {
     fit.dt.push_back(row.param);
     fit.error.push_back(row.metrics.err_pos_max);
     fit.steps.push_back(row.steps);
-    fit.diverged.push_back(row.metrics.diverged || row.metrics.failed || row.metrics.skipped);
+    fit.incomplete.push_back(!row.metrics.completed());
   }
   ms.fit = fit_order(fit);
   ms.declared_order_holds =

@@ -19,6 +19,9 @@
 
 namespace stepbench {
 
+// 10^-first, 10^-(first + stride), ... down to 10^-last: the tolerance ladder and the
+// equal-error targets (study_file.hpp) are both decades, built here.
+std::vector<double> decades(int first, int last, int stride);
 // Relative tolerances of the adaptive methods: 1e-2 .. 1e-12 (every other one when
 // `thinned`).
 std::vector<double> tolerance_ladder(bool thinned = false);

@@ -70,7 +70,7 @@ expect_error "--horizon must be > 0" run --problem pendulum --integrator rk4 --d
 expect_error "--horizon must be a finite number" run --problem pendulum --integrator rk4 --dt 0.1 --horizon inf
 expect_error "malformed --set 'theta0_deg'" run --problem pendulum --integrator rk4 --dt 0.1 --set theta0_deg
 expect_error "malformed --set '=3'" run --problem pendulum --integrator rk4 --dt 0.1 --set =3
-expect_error "--set theta0_deg must be a finite number" run --problem pendulum --integrator rk4 --dt 0.1 --set theta0_deg=big
+expect_error "--set pendulum.theta0_deg must be a finite number, got 'big'" run --problem pendulum --integrator rk4 --dt 0.1 --set theta0_deg=big
 expect_error "unknown parameter 'k' for problem pendulum" run --problem pendulum --integrator rk4 --dt 0.1 --set k=1
 expect_error "theta0_deg must be in (0, 180)" run --problem pendulum --integrator rk4 --dt 0.1 --set theta0_deg=200
 expect_error "--problem is required" run --integrator rk4 --dt 0.1

@@ -107,10 +107,10 @@ echo "not a study" >"$work/text.h5"
 expect_cannot "cannot read study file '$work/text.h5': not an HDF5 file" "$work/base.h5" "$work/text.h5"
 $py -c "import h5py; h5py.File('$work/foreign.h5', 'w').attrs['x'] = 1"
 expect_cannot "not a stepbench study" "$work/foreign.h5" "$work/base.h5"
-cp "$work/base.h5" "$work/v3.h5" && h5edit "$work/v3.h5" "f.attrs['format_version'] = np.int64(3)"
-expect_cannot "format_version 3" "$work/base.h5" "$work/v3.h5"
-cp "$work/base.h5" "$work/v1.h5" && h5edit "$work/v1.h5" "f.attrs['format_version'] = np.int64(1)"
-expect_cannot "format_version 1" "$work/v1.h5" "$work/base.h5"
+cp "$work/base.h5" "$work/v4.h5" && h5edit "$work/v4.h5" "f.attrs['format_version'] = np.int64(4)"
+expect_cannot "format_version 4" "$work/base.h5" "$work/v4.h5"
+cp "$work/base.h5" "$work/v2.h5" && h5edit "$work/v2.h5" "f.attrs['format_version'] = np.int64(2)"
+expect_cannot "format_version 2" "$work/v2.h5" "$work/base.h5"
 expect_cannot "--error-factor must be a finite number, got 'abc'" "$work/base.h5" "$work/same.h5" --error-factor abc
 expect_cannot "--error-factor must be a finite number >= 1" "$work/base.h5" "$work/same.h5" --error-factor 0.5
 expect_cannot "--order-drop must be a finite number >= 0" "$work/base.h5" "$work/same.h5" --order-drop -1

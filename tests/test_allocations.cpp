@@ -144,7 +144,7 @@ TEST(allocations, none_per_step_adaptive) {
           count[k] = allocations_during([&] {
             const auto r = drive_adaptive(p, I(tol[k]), p.horizon(), times, 1L << 22);
             steps[k] = r.steps;
-            completed = completed && r.failure.empty();
+            completed = completed && r.stop_reason.empty();
           });
         if (!completed) return;  // adaptive Euler on the stiff scenes: over its step budget
         // rk45 is exact on a constant force and takes the same steps at both tolerances.

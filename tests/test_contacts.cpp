@@ -211,7 +211,7 @@ TEST(bouncing_balls, scene_is_the_truths_default) {
   }
   bouncing_balls big;
   big.balls = 10000;
-  EXPECT_EQ(big.validate(), "");
+  EXPECT_EQ(validate(big), "");
   EXPECT_NEAR(big.width() * big.height() / 10000, 2.0 / 16, 1e-12);
   EXPECT_EQ(big.initial().x.size(), 20000);
 }

@@ -16,7 +16,7 @@ fit_input ladder(int levels, auto error_of_dt) {
     in.dt.push_back(dt);
     in.error.push_back(error_of_dt(dt));
     in.steps.push_back(20L << k);
-    in.diverged.push_back(false);
+    in.incomplete.push_back(false);
   }
   return in;
 }
@@ -45,7 +45,7 @@ TEST(fit, skips_preasymptotic_and_roundoff_levels) {
 
 TEST(fit, diverged_levels_are_excluded) {
   auto in = ladder(8, [](double dt) { return 1e-2 * dt; });
-  in.diverged[0] = in.diverged[1] = true;
+  in.incomplete[0] = in.incomplete[1] = true;
   in.error[0] = in.error[1] = NAN;
   const auto r = fit_order(in);
   ASSERT_EQ(r.state, fit_result::status::fitted);
@@ -83,7 +83,7 @@ TEST(fit, converging_errors_under_a_large_bound_are_not_exact) {
     in.dt.push_back(1e-9 / std::ldexp(1.0, k));
     in.error.push_back(9e-7 / std::ldexp(1.0, k));
     in.steps.push_back(1000000000L << k);
-    in.diverged.push_back(false);
+    in.incomplete.push_back(false);
   }
   ASSERT_LT(in.error[0], roundoff_bound(in.steps[0], 1.0));
   const auto r = fit_order(in);

@@ -124,14 +124,16 @@ TEST(sliding_block, the_lectures_figures) {
 // from the table refused, and `stepbench list`'s text holding every pair.
 TEST(sliding_block, material_by_name) {
   auto p = make_problem("sliding_block");
-  p->set_text("material", "steel_on_steel");
+  const auto params = p->params();
+  const auto& material = params[4];
+  ASSERT_EQ(material.name, "material");
+  p->set("material", material.parse("steel_on_steel", "sliding_block.material"));
   EXPECT_EQ(p->validate(), "");
-  for (const auto& q : p->params())
-    if (q.name == "material") {
-      EXPECT_EQ(q.value, friction_row("steel_on_steel"));
-      for (const auto& r : exact::friction_table)
-        EXPECT_NE(q.description.find(exact::friction_name(r)), std::string::npos);
-    }
+  EXPECT_EQ(p->params()[4].value, friction_row("steel_on_steel"));
+  EXPECT_EQ(p->params()[4].value_name(), "steel_on_steel");
+  ASSERT_EQ(material.names.size(), exact::friction_table.size() + 1);  // and "none"
+  for (const auto& r : exact::friction_table)
+    EXPECT_EQ(material.parse(exact::friction_name(r), "m"), friction_row(exact::friction_name(r)));
   sliding_block b;
   b.material = friction_row("steel_on_steel");
   EXPECT_EQ(b.static_coefficient(), 0.74);
@@ -140,13 +142,14 @@ TEST(sliding_block, material_by_name) {
   EXPECT_EQ(b.static_coefficient(), 0.15);
   b.material = friction_row("cast_iron_on_wood");
   b.lubricated = 0;
-  EXPECT_NE(b.validate().find("no static coefficient"), std::string::npos) << b.validate();
+  EXPECT_NE(validate(b).find("no static coefficient"), std::string::npos) << validate(b);
   b.material = friction_row("steel_on_steel");
   b.mu_k = 0.2;
-  EXPECT_NE(b.validate().find("not both"), std::string::npos);
-  EXPECT_THROW(p->set_text("material", "cheese_on_steel"), std::invalid_argument);
-  p->set_text("material", "3");
-  EXPECT_EQ(p->params()[4].value, 3.0);
+  EXPECT_NE(validate(b).find("not both"), std::string::npos);
+  b.material = 34;
+  EXPECT_EQ(validate(b), "material must be a whole number from 0 to 33");
+  EXPECT_THROW(material.parse("cheese_on_steel", "sliding_block.material"), std::invalid_argument);
+  EXPECT_EQ(material.parse("3", "sliding_block.material"), 3.0);
 }
 
 // Sticking: steel on steel at 30 degrees holds (mu_s = 0.74 > tan 30) though kinetic

@@ -178,15 +178,55 @@ TEST(pendulum, closed_form_satisfies_ode_and_conserves_energy) {
 TEST(problems, validate_rejects_bad_parameters) {
   pendulum p;
   p.theta0_deg = 180.0;
-  EXPECT_NE(p.validate(), "");
+  EXPECT_EQ(validate(p), "theta0_deg must be in (0, 180)");
   damped_spring d;
   d.mass_kg = 0.0;
-  EXPECT_NE(d.validate(), "");
+  EXPECT_EQ(validate(d), "mass_kg must be a positive finite number");
   d = {};
   d.k_d = -1.0;
-  EXPECT_NE(d.validate(), "");
+  EXPECT_EQ(validate(d), "k_d must be finite and >= 0");
   projectile pr;
   pr.speed = std::nan("");
-  EXPECT_NE(pr.validate(), "");
-  EXPECT_EQ(constant_acceleration{}.validate(), "");
+  EXPECT_EQ(validate(pr), "speed must be a positive finite number");
+  spring_chain c;
+  c.masses = 2.5;
+  EXPECT_EQ(validate(c), "masses must be a whole number from 2 to 1048576");
+  bouncing_ball b;
+  b.locate = 2;
+  EXPECT_EQ(validate(b), "locate must be 0 (end_of_step) or 1 (locate)");
+  EXPECT_EQ(validate(constant_acceleration{}), "");
+}
+
+// Each parameter is declared once; what --set, `list` and the study file see derives
+// from it: the declaration's default, its constraint, and its names.
+TEST(problems, parameters_are_declared_once) {
+  pendulum p;
+  p.theta0_deg = 150.0;
+  const auto params = declared_params(p);
+  ASSERT_EQ(params.size(), 5u);
+  EXPECT_EQ(params[3].name, "theta0_deg");
+  EXPECT_EQ(params[3].unit, "deg");
+  EXPECT_EQ(params[3].value, 150.0);
+  EXPECT_EQ(params[3].default_value, 120.0);
+  EXPECT_EQ(params[3].kind(), "real");
+  EXPECT_FALSE(params[3].allowed.admits(0.0));
+  EXPECT_TRUE(params[3].allowed.admits(179.9));
+  EXPECT_FALSE(params[3].allowed.admits(std::numeric_limits<double>::infinity()));
+  EXPECT_EQ(params[3].parse("90", "pendulum.theta0_deg"), 90.0);
+  EXPECT_THROW(params[3].parse("90x", "pendulum.theta0_deg"), std::invalid_argument);
+
+  const auto chain = declared_params(spring_chain{});
+  EXPECT_EQ(chain[0].kind(), "whole");
+  const auto block = declared_params(sliding_block{});
+  const auto& material = block[4];
+  EXPECT_EQ(material.name, "material");
+  EXPECT_EQ(material.kind(), "named");
+  EXPECT_EQ(material.parse("steel_on_steel", "sliding_block.material"), friction_row("steel_on_steel"));
+  EXPECT_EQ(material.value_name(), "none");
+  try {
+    material.parse("unobtainium", "sliding_block.material");
+    ADD_FAILURE() << "unobtainium was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("steel_on_steel"), std::string::npos) << e.what();
+  }
 }

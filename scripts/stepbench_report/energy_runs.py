@@ -6,11 +6,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import schema
+
 ENERGY_ATTRS = ("periods", "samples_per_period", "series_points", "bounded_growth", "lost", "rule", "wall_seconds")
 ENERGY_PROBLEM_ATTRS = ("period", "dt", "steps_per_period", "horizon", "energy0", "angular_momentum0")
-SUMMARY_FIELDS = ("method", "symplectic", "dt", "steps", "force_evals", "completed", "max_rel_err", "final_rel_err",
-                  "drift_per_period", "first_tenth_max", "last_tenth_max", "last_tenth_mean", "verdict", "drift_sign",
-                  "angmom_max_rel_err", "angmom_drift_per_period", "seconds", "note")
+SUMMARY_FIELDS = schema.fields("energy_summary")
 VERDICTS = ("bounded", "drifting", "")
 
 

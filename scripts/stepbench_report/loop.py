@@ -6,20 +6,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import schema
+
 LOOP_ATTRS = ("designs", "display_hz", "physics_hz", "reference_display_hz", "clamp_s", "stall_s", "stall_at_fraction",
               "jitter", "jitter_seed", "jitter_distribution", "accumulator_slack", "target", "stated_step_cost_ns",
               "spiral_factor", "settle_frames", "wall_seconds")
 LOOP_PROBLEM_ATTRS = ("position_unit", "horizon", "truth_source")
 LOOP_METHOD_ATTRS = ("step_cost_ns", "step_cost_source")
-LOOP_RUN_FIELDS = ("design", "clock", "display_hz", "physics_hz", "dt", "substeps", "clamp_s", "jitter_seed",
-                   "stall_at_s", "frames", "physics_steps", "force_evals", "shown_err_max", "shown_err_rms",
-                   "final_shown_err", "clock_dependence", "physics_clock_dependence", "judder", "lag_s", "lag_clock_s",
-                   "steps_per_frame_mean", "steps_per_frame_max", "stall_burst_steps", "clamp_hits", "alpha_min",
-                   "alpha_max", "physics_t", "diverged", "note", "step_cost_ns", "frame_budget_ns",
-                   "worst_frame_work_ns", "late_frames", "physics_load", "outcome", "outcome_without_clamp",
-                   "clamp_prevented_spiral")
-LOOP_CHEAPEST_FIELDS = ("display_hz", "target", "found", "design", "physics_hz", "steps_per_frame_mean",
-                        "shown_err_max")
+LOOP_RUN_FIELDS = schema.fields("loop_runs")
+LOOP_CHEAPEST_FIELDS = schema.fields("loop_cheapest")
 DESIGNS = ("variable", "fixed", "interpolated", "substeps")
 CLOCKS = ("constant", "jitter", "stall")
 OUTCOMES = ("keeps_up", "slow_motion", "spiral")

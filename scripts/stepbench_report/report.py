@@ -16,11 +16,12 @@ META_KEYS = ["version", "git_commit", "compiler", "build_type", "dependencies", 
              "reference_atol", "fit_metric", "divergence_factor", "equal_error_targets", "wall_seconds", "timing"]
 BENCH_KEYS = ["benchmark_mode", "benchmark_min_time_s", "benchmark_repetitions", "benchmark_case_budget_s",
               "benchmark_wall_seconds", "cpu_scaling_enabled", "num_cpus", "mhz_per_cpu"]
-# Problem attributes the problems table shows in their own columns or not at all; every
-# other attribute is a parameter of the scene.
-PROBLEM_KEYS = {"horizon", "dim", "description", "has_closed_form", "has_energy", "has_jacobian", "truth_source",
-                "truth_trusted", "truth_note", "agreement_limit", "pos_scale", "vel_scale", "energy_scale",
-                "position_unit"}
+
+def _parameter(q):
+    """One declared parameter as `name = value unit` (a named value by its name)."""
+    value = q["value_name"] or f"{float(q['value']):.6g}"
+    unit = "" if q["unit"] in ("", "1") or q["value_name"] else f" {q['unit']}"
+    return f"{q['name']} = {value}{unit}"
 
 
 def _value(v):
@@ -137,7 +138,7 @@ def _metadata(doc, study):
     rows = []
     for p in study.problems:
         pa = p.attrs
-        params = ", ".join(f"{k} = {_value(v)}" for k, v in sorted(pa.items()) if k not in PROBLEM_KEYS)
+        params = ", ".join(_parameter(q) for q in p.parameters)
         truth = pa["truth_source"] if int(pa["truth_trusted"]) else f"none trusted: {pa['truth_note']}"
         rows.append([p.name, pa["description"], fmt_num(pa["horizon"], 4) + " s", p.unit, truth, params])
     doc.table(["problem", "scene", "horizon", "position unit", "truth", "parameters"], rows, caption="Problems:")

@@ -15,9 +15,9 @@ import numpy as np
 
 from . import energy_runs as energy_section
 from . import loop as loop_section
+from . import schema
 from . import substeps as substeps_section
 
-FORMAT_VERSION = 2  # the only format_version this report reads
 
 # What docs/study-format.md documents, and the report reads, at each level.
 ROOT_ATTRS = ("format_version", "version", "git_commit", "compiler", "build_type", "dependencies", "created_utc",
@@ -35,13 +35,13 @@ METHOD_ATTRS = ("origin", "kind", "param_kind", "declared_order", "description",
                 "reuses_last_force", "needs_jacobian", "error_estimate", "dense_output", "fit_status", "fit_metric",
                 "fit_param", "fit_slope", "observed_order", "fit_levels", "fit_residual_log10", "fit_note",
                 "exact_for_problem", "declared_order_holds")
-RUN_FIELDS = ("param", "steps", "rejected_steps", "force_evals", "jacobian_evals", "newton_iterations",
-              "linear_solves", "err_pos_final", "err_vel_final", "err_pos_max", "err_pos_rms", "energy_drift",
-              "energy_err_max", "diverged", "failed", "skipped", "note")
-TIMED_RUN_FIELDS = ("time_ns", "time_ns_min", "time_ns_max", "repetitions", "cut")
-EQUAL_ERROR_FIELDS = ("metric", "target", "rank", "method", "origin", "kind", "param", "error", "cost_kind", "cost",
-                      "time_ns", "force_evals", "is_answer")
-FRONT_FIELDS = ("method", "param", "cost", "err_pos_max")
+# Table fields come from the schema the C++ side declares (schema.py).
+RUN_FIELDS = schema.fields("runs")
+TIMED_RUN_FIELDS = schema.timed_fields("runs")
+EQUAL_ERROR_FIELDS = schema.fields("equal_error")
+FRONT_FIELDS = schema.fields("front")
+# /problems/<p>/parameters: the scene's declared parameters, apart from its derived attributes.
+PARAMETER_FIELDS = schema.fields("parameters")
 
 # The targets of the report's summary: the file must have computed `equal_error` for
 # each (the issue's "errors of 1e-2, 1e-4 and 1e-6").
@@ -49,7 +49,6 @@ SUMMARY_TARGETS = (1e-2, 1e-4, 1e-6)
 
 # The closed vocabularies of the format: any other value is an error, not a guess.
 ORIGINS = ("ours", "peer", "baseline")
-PARAM_KIND = {"fixed_step": "dt", "adaptive": "tolerance"}  # kind -> what `param` is
 FIT_STATUSES = ("fitted", "exact", "insufficient")
 
 # /stability: the stability limits and regions of our integrators, computed in C++ from
@@ -58,8 +57,7 @@ STABILITY_ATTRS = ("oscillator", "decay", "adaptive_tolerance", "y_min", "y_max"
                    "rho_tol", "clear_factor", "root_rtol", "run_steps", "envelope_growth", "blowup_factor",
                    "decay_floor", "run_y_start", "run_per_decade", "run_rtol", "confirm_y", "agreement", "region_dt",
                    "limits_seconds", "regions_seconds")
-LIMIT_FIELDS = ("integrator", "test", "measured", "theory", "rel_difference", "unstable_for_all_dt",
-                "unconditionally_stable", "run_confirms", "step_failed_at", "note")
+LIMIT_FIELDS = schema.fields("stability_limits")
 STABILITY_TESTS = ("oscillator", "decay")
 
 # The optional root groups have their own readers: /loop (loop.py), /energy
@@ -118,7 +116,7 @@ class Method:
     @property
     def completed(self):
         """Rows that ran to the horizon: not diverged, failed or skipped (their errors mean something)."""
-        return (self.runs["diverged"] == 0) & (self.runs["failed"] == 0) & (self.runs["skipped"] == 0)
+        return schema.completed(self.runs)
 
     @property
     def diverged(self):
@@ -153,6 +151,7 @@ class Problem:
     references: dict  # source -> attrs
     equal_error: np.ndarray  # the C++ cheapest-method table, strings decoded
     fronts: dict  # "force_evals" and, in a timed study, "time" -> the C++ Pareto front
+    parameters: np.ndarray  # the declared parameters, one row each, strings decoded
 
     @property
     def unit(self):
@@ -253,8 +252,8 @@ class _Reader:
     def method(self, g, timed):
         attrs = self.need_attrs(g, METHOD_ATTRS)
         self.need_value(g, "origin", attrs["origin"], ORIGINS)
-        self.need_value(g, "kind", attrs["kind"], tuple(PARAM_KIND))
-        self.need_value(g, "param_kind", attrs["param_kind"], (PARAM_KIND[attrs["kind"]],))
+        self.need_value(g, "kind", attrs["kind"], tuple(schema.PARAM_KIND))
+        self.need_value(g, "param_kind", attrs["param_kind"], (schema.PARAM_KIND[attrs["kind"]],))
         self.need_value(g, "fit_status", attrs["fit_status"], FIT_STATUSES)
         self.need_value(g, "declared_order_holds", int(attrs["declared_order_holds"]), (-1, 0, 1))
         runs = self.need_table(g, "runs", RUN_FIELDS + (TIMED_RUN_FIELDS if timed else ()))
@@ -278,7 +277,8 @@ class _Reader:
         if timed:
             fronts["time"] = self.need_table(g, "front_time", FRONT_FIELDS)
         p = Problem(g.name.rsplit("/", 1)[1], attrs, methods, references,
-                    self.need_table(g, "equal_error", EQUAL_ERROR_FIELDS), fronts)
+                    self.need_table(g, "equal_error", EQUAL_ERROR_FIELDS), fronts,
+                    self.need_table(g, "parameters", PARAMETER_FIELDS))
         self.check_derived(g, p)
         return p
 
@@ -326,11 +326,11 @@ class _Reader:
         if "format_version" not in f.attrs:
             raise self.error("not a stepbench study (an HDF5 file without format_version)")
         version = int(f.attrs["format_version"])
-        if version > FORMAT_VERSION:
+        if version > schema.FORMAT_VERSION:
             raise self.error(f"written by a newer stepbench (format_version {version}; "
-                             f"this report reads {FORMAT_VERSION})")
-        if version < FORMAT_VERSION:
-            raise self.error(f"format_version {version} is older than this report reads ({FORMAT_VERSION}); "
+                             f"this report reads {schema.FORMAT_VERSION})")
+        if version < schema.FORMAT_VERSION:
+            raise self.error(f"format_version {version} is older than this report reads ({schema.FORMAT_VERSION}); "
                              "run the study again with this stepbench")
         attrs = self.need_attrs(f, ROOT_ATTRS)
         self.need_value(f, "timing", int(attrs["timing"]), (0, 1))

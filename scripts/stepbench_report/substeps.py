@@ -10,14 +10,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import schema
+
 SUBSTEP_ATTRS = ("frame_dt",)
 SUBSTEP_METHOD_ATTRS = ("origin", "needs_jacobian")
-SUBSTEP_RUN_FIELDS = ("param", "steps", "force_evals", "err_pos_max", "diverged", "failed", "skipped", "note",
-                      "substeps", "extra_damping")
-TIMED_RUN_FIELDS = ("time_ns",)
-VERDICT_FIELDS = ("implicit_method", "explicit_method", "cost_kind", "implicit_cost", "implicit_error",
-                  "implicit_damping", "substeps_at_equal_cost", "explicit_cost", "explicit_error", "explicit_damping",
-                  "substeps_to_match", "cost_to_match", "summary")
+SUBSTEP_RUN_FIELDS = schema.fields("substeps_runs")
+TIMED_RUN_FIELDS = schema.timed_fields("substeps_runs")
+VERDICT_FIELDS = schema.fields("substeps_verdict")
 COST_KINDS = ("time_ns", "force_evals")
 ORIGINS = ("ours", "peer", "baseline")
 FIGURE = "substeps_equal_cost.png"
@@ -37,7 +36,7 @@ class SubstepMethod:
     @property
     def completed(self):
         r = self.runs
-        return (r["diverged"] == 0) & (r["failed"] == 0) & (r["skipped"] == 0)
+        return schema.completed(r)
 
 
 @dataclass

@@ -129,6 +129,10 @@ def test_metadata_comes_first(reports, shape):
         problems = md_dict(md, "Problems:")
         for pname, g in f["problems"].items():
             assert problems[pname]["position unit"] == g.attrs["position_unit"]
+            # The parameter column shows exactly the declared parameters, in their order.
+            shown = [item.split(" = ")[0] for item in problems[pname]["parameters"].split(", ")]
+            declared = [n.decode() if isinstance(n, bytes) else n for n in g["parameters"]["name"]]
+            assert shown == declared, pname
     if shape == "timed":
         bench = md_dict(md, "Timing run (Google Benchmark):")
         assert bench["benchmark_mode"]["value"] == "quick"
@@ -413,9 +417,9 @@ def make_bad_file(kind, good, path):
         with h5py.File(path, "w") as f:
             f["x"] = np.arange(3)
     elif kind == "newer":
-        edit(good, path, set_version(3))
+        edit(good, path, set_version(4))
     elif kind == "older":
-        edit(good, path, set_version(1))
+        edit(good, path, set_version(2))
     elif kind == "no attribute":
         edit(good, path, lambda f: f["problems/pendulum/methods/rk4"].attrs.__delitem__("declared_order_holds"))
     elif kind == "no root attribute":
@@ -436,8 +440,8 @@ BAD_FILES = [
     ("truncated", "damaged or truncated HDF5 file: Unable to open file (truncated file"),
     ("corrupt", "damaged or truncated HDF5 file"),
     ("foreign", "not a stepbench study (an HDF5 file without format_version)"),
-    ("newer", "written by a newer stepbench (format_version 3; this report reads 2)"),
-    ("older", "format_version 1 is older than this report reads (2); run the study again"),
+    ("newer", "written by a newer stepbench (format_version 4; this report reads 3)"),
+    ("older", "format_version 2 is older than this report reads (3); run the study again"),
     ("no attribute", "/problems/pendulum/methods/rk4 lacks attribute declared_order_holds"),
     ("no root attribute", "the root group lacks attribute divergence_factor"),
     ("no field", "/problems/pendulum/methods/gsl_rk4/runs lacks field err_pos_max"),

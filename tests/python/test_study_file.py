@@ -50,7 +50,7 @@ def text(v):
 def test_root_attributes(plain):
     for key in ROOT_ATTRS:
         assert key in plain.attrs, key
-    assert plain.attrs["format_version"] == 2 and plain.attrs["timing"] == 0
+    assert plain.attrs["format_version"] == 3 and plain.attrs["timing"] == 0
     assert plain.attrs["levels"] == 8  # --quick
     assert "GSL" in plain.attrs["dependencies"] and "SUNDIALS" in plain.attrs["dependencies"]
     for target in (1e-2, 1e-4, 1e-6):
@@ -61,8 +61,15 @@ def test_every_problem_and_method(plain, listing):
     tolerances = plain.attrs["tolerances"]
     for p in listing["problems"]:
         g = plain["problems"][p["name"]]
-        for param in p["parameters"]:
-            assert g.attrs[param["name"]] == pytest.approx(param["default"])
+        # The declared parameters in one table, exactly those `list` declares, and no
+        # parameter among the derived attributes.
+        table = g["parameters"][()]
+        assert [text(n) for n in table["name"]] == [q["name"] for q in p["parameters"]]
+        for row, param in zip(table, p["parameters"]):
+            assert row["value"] == pytest.approx(param["default"]) and row["default"] == row["value"]
+            assert text(row["unit"]) == param["unit"] and text(row["kind"]) == param["kind"]
+            assert text(row["allowed"]) == param["allowed"]
+            assert param["name"] not in g.attrs
         assert g.attrs["horizon"] == pytest.approx(p["horizon"])
         assert g.attrs["position_unit"] == p["position_unit"]
         assert set(g["reference"]) == {"gsl_rk8pd", "cvode_bdf", "cvode_adams", "arkode_erk8"}

@@ -1,0 +1,62 @@
+#include "cli/args.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include "study/registry.hpp"
+
+namespace stepbench {
+
+double parse_number(std::string_view text, std::string_view what) {
+  double value = 0.0;
+  const char* end = text.data() + text.size();
+  auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  if (text.empty() || ec != std::errc() || ptr != end || !std::isfinite(value))
+    throw std::invalid_argument(fmt::format("{} must be a finite number, got '{}'", what, text));
+  return value;
+}
+
+void add_override(parameter_overrides& out, std::string_view text, std::span<const std::string> selected) {
+  const auto eq = text.find('=');
+  if (eq == std::string_view::npos || eq == 0 || eq + 1 == text.size())
+    throw std::invalid_argument(fmt::format("malformed --set '{}': expected problem.name=value", text));
+  const std::string_view target = text.substr(0, eq), value_text = text.substr(eq + 1);
+  std::string problem, name;
+  if (const auto dot = target.find('.'); dot != std::string_view::npos) {
+    problem = target.substr(0, dot);
+    name = target.substr(dot + 1);
+    if (problem.empty() || name.empty())
+      throw std::invalid_argument(fmt::format("malformed --set '{}': expected problem.name=value", text));
+  } else if (selected.size() == 1) {
+    problem = selected.front();
+    name = target;
+  } else {
+    throw std::invalid_argument(fmt::format(
+        "--set {}: name the problem (problem.{}=value): {}", text, target,
+        selected.empty() ? "every problem is selected" : fmt::format("{} problems are selected", selected.size())));
+  }
+  auto instance = make_problem(problem);  // throws, naming an unknown problem
+  if (!selected.empty() && std::find(selected.begin(), selected.end(), problem) == selected.end())
+    throw std::invalid_argument(fmt::format("--set {}: problem {} is not selected", text, problem));
+  const auto params = instance->params();
+  const auto it = std::find_if(params.begin(), params.end(), [&](const param_value& q) { return q.name == name; });
+  if (it == params.end()) {
+    std::vector<std::string_view> known;
+    for (const auto& q : params) known.push_back(q.name);
+    throw std::invalid_argument(fmt::format("--set {}: unknown parameter '{}' for problem {} (known: {})", text, name,
+                                            problem, fmt::join(known, ", ")));
+  }
+  const std::string qualified = problem + "." + name;
+  const double value = it->parse(value_text, qualified);
+  if (auto why = it->check(value); !why.empty())
+    throw std::invalid_argument(fmt::format("--set {}={}: {}", qualified, value_text, why));
+  out[problem][name] = value;
+}
+
+}  // namespace stepbench

@@ -1,0 +1,26 @@
+#pragma once
+// Command-line values, parsed once for every command of `stepbench` and for
+// stepbench_bench: a number is the whole string or an error, and `--set` has one grammar.
+#include <map>
+#include <span>
+#include <string>
+#include <string_view>
+
+namespace stepbench {
+
+// Parses a finite double; throws std::invalid_argument("<what> must be a finite number, got '<text>'").
+double parse_number(std::string_view text, std::string_view what);
+
+// Parameter values by problem, then by parameter name: what every --set adds to.
+using parameter_overrides = std::map<std::string, std::map<std::string, double>>;
+
+// One `--set`: `problem.name=value`, or `name=value` when exactly one problem is
+// selected (`selected` empty means every problem). The value is a number or a name the
+// parameter takes (`sliding_block.material=steel_on_steel`). Throws std::invalid_argument
+// in one line naming what is wrong: an ambiguous unqualified name, an unknown problem or
+// parameter (listing the known ones), a problem not selected, a value that is neither a
+// number nor a name the parameter takes (listing them), or a value outside the
+// parameter's declared constraint.
+void add_override(parameter_overrides& out, std::string_view text, std::span<const std::string> selected);
+
+}  // namespace stepbench

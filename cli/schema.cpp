@@ -1,0 +1,19 @@
+// `stepbench schema`: the study file's schema (study/schema.hpp) as JSON, the text the
+// Python report reads as scripts/stepbench_report/schema.json (a test compares the two).
+#include "study/schema.hpp"
+
+#include <cstdio>
+
+#include "cli/commands.hpp"
+
+namespace stepbench::cli {
+
+command add_schema(CLI::App& app) {
+  auto* sub = app.add_subcommand("schema", "print the study file's schema (format version, tables, fields) as JSON");
+  return {sub, [] {
+            std::fputs(schema::to_json().c_str(), stdout);
+            return 0;
+          }};
+}
+
+}  // namespace stepbench::cli

@@ -1,0 +1,51 @@
+#pragma once
+// The study file's schema, declared once: its format version, every table's fields with
+// their types, the "row completed" rule and what a method's `param` is (core/method.hpp). The C++ writer
+// checks each table it writes against it (h5::table::write), the C++ readers take their
+// fields from it, and the Python report reads the same declaration from
+// scripts/stepbench_report/schema.json, which `stepbench schema` prints and a test
+// compares with this file's (docs/study-format.md says what each field means).
+#include <array>
+#include <span>
+#include <string>
+#include <string_view>
+
+namespace stepbench::schema {
+
+// Bump when the layout changes incompatibly; readers refuse other versions.
+inline constexpr int format_version = 3;
+
+enum class field_type { f64, i64, i8, str };
+std::string_view to_string(field_type t);
+
+struct field {
+  std::string_view name;
+  field_type type;
+};
+
+// Consecutive fields of a table; a timed-only group is present exactly when the study
+// was timed (stepbench_bench --study_out), as a whole.
+struct field_group {
+  std::span<const field> fields;
+  bool timed_only = false;
+};
+
+struct table {
+  std::string_view name;   // the schema's name for it ("runs", "front")
+  std::string_view where;  // where it lives in the file, for the reader and the docs
+  std::span<const field_group> groups;
+};
+
+// Every table of the study file, the loop, energy and substeps studies included.
+std::span<const table> tables();
+// The table named `name`; throws std::logic_error for an unknown name (a bug, not input).
+const table& find(std::string_view name);
+
+// The "row completed" rule as data: a row completed when every one of these flags is 0
+// (core/measure.hpp's row_completed is the same rule in C++).
+inline constexpr std::array<std::string_view, 3> row_incomplete_flags{"diverged", "failed", "skipped"};
+
+// The whole schema as JSON text (`stepbench schema`; scripts/stepbench_report/schema.json).
+std::string to_json();
+
+}  // namespace stepbench::schema

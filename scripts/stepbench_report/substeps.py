@@ -10,6 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .formatting import fmt_time_ns
+
 SUBSTEP_ATTRS = ("frame_dt",)
 SUBSTEP_METHOD_ATTRS = ("origin", "needs_jacobian")
 SUBSTEP_RUN_FIELDS = ("param", "steps", "force_evals", "err_pos_max", "diverged", "failed", "skipped", "note",
@@ -105,7 +107,6 @@ def read(reader, f):
 # --- formatting ----------------------------------------------------------------------------------
 
 def _cost_text(kind, c):
-    from .tables import fmt_time_ns  # tables imports study, which imports this module
     if not np.isfinite(c):
         return "n/a"
     return fmt_time_ns(c) if kind == "time_ns" else f"{c:.4g} force eval{'' if c == 1 else 's'}"

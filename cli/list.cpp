@@ -42,7 +42,8 @@ void print_list(const json& out) {
     for (const auto& m : all_methods()) {
       if (m.origin != origin) continue;
       std::string caps;
-      for (const auto& [key, on] : capabilities_json(m.traits).items())
+      const json declared = capabilities_json(m.traits);  // named: items() of a temporary would dangle
+      for (const auto& [key, on] : declared.items())
         if (on.get<bool>()) caps += (caps.empty() ? "" : ", ") + key;
       methods.add({m.name, std::string(to_string(m.kind)),
                    std::isfinite(m.declared_order) ? fmt::format("{:g}", m.declared_order) : "-", m.description, caps});

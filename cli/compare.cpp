@@ -13,6 +13,7 @@
 #include "cli/commands.hpp"
 #include "cli/args.hpp"
 #include "core/work_precision.hpp"
+#include "study/compare_render.hpp"
 
 namespace stepbench::cli {
 namespace {

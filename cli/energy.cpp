@@ -12,6 +12,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/args.hpp"
+#include "study/table_render.hpp"
 
 namespace stepbench::cli {
 namespace {
@@ -28,6 +29,7 @@ struct energy_args {
 json number_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
 std::string sci(double v) { return std::isfinite(v) ? fmt::format("{:.2e}", v) : "-"; }
+std::string signed_sci(double v) { return std::isfinite(v) ? fmt::format("{:+.2e}", v) : "-"; }
 
 int run_energy(const energy_args& a) {
   energy_options opts;
@@ -77,19 +79,23 @@ int run_energy(const energy_args& a) {
     fmt::print("{}: {:g} periods of {:.6g} s, dt = {:.6g} s ({} steps a period); E0 = {:.6g}{}\n", p.problem,
                opts.periods, p.period, p.dt, p.steps_per_period, p.e0,
                std::isfinite(p.l0) ? fmt::format(", L0 = {:.6g}", p.l0) : "");
-    fmt::print("  {:<20} {:>10} {:>12} {:>12}  {:<15} {:>10} {:>12}\n", "method", "max |dE|/E", "final dE/E",
-               "drift/period", "verdict", "max |dL|/L", "dL drift/per");
+    table t{{{"method"},
+             right_column("max |dE|/E"),
+             right_column("final dE/E"),
+             right_column("drift/period"),
+             {"verdict"},
+             right_column("max |dL|/L"),
+             right_column("dL drift/period")},
+            {}};
     for (const auto& r : p.runs) {
       const std::string verdict = !r.completed       ? "failed: " + r.note
                                   : r.drift_sign > 0 ? "drifting, gains"
                                   : r.drift_sign < 0 ? "drifting, loses"
                                                      : r.verdict;
-      fmt::print("  {:<20} {:>10} {:>12} {:>12}  {:<15} {:>10} {:>12}\n", r.info.name, sci(r.max_rel_err),
-                 std::isfinite(r.final_rel_err) ? fmt::format("{:+.2e}", r.final_rel_err) : "-",
-                 std::isfinite(r.drift_per_period) ? fmt::format("{:+.2e}", r.drift_per_period) : "-", verdict,
-                 sci(r.angmom_max_rel_err),
-                 std::isfinite(r.angmom_drift_per_period) ? fmt::format("{:+.2e}", r.angmom_drift_per_period) : "-");
+      t.add({r.info.name, sci(r.max_rel_err), signed_sci(r.final_rel_err), signed_sci(r.drift_per_period), verdict,
+             sci(r.angmom_max_rel_err), signed_sci(r.angmom_drift_per_period)});
     }
+    fmt::print("{}", render_text(t));
   }
   fmt::print(
       "bounded: the largest |dE|/E over the last tenth of the run is at most {:g} x that over the first tenth, "

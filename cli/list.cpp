@@ -9,6 +9,7 @@
 
 #include "cli/commands.hpp"
 #include "study/registry.hpp"
+#include "study/table_render.hpp"
 
 namespace stepbench::cli {
 namespace {
@@ -21,6 +22,62 @@ json capabilities_json(const capabilities& c) {
           {"needs_jacobian", c.needs_jacobian},
           {"error_estimate", c.error_estimate},
           {"dense_output", c.dense_output}};
+}
+
+// The text form of the listing: the problems, their parameters, and the methods by origin,
+// each a table.
+void print_list(const json& out) {
+  table problems{{{"problem"}, right_column("dim"), right_column("horizon", "s"), {"closed form"}, {"description"}},
+                 {}};
+  table params{{{"problem"}, {"parameter"}, right_column("default"), {"unit"}, {"allowed"}, {"description"}}, {}};
+  // A long list of names (the lecture's friction table, taken by both sliding blocks) is
+  // printed once, after the parameters.
+  std::map<std::string, json> long_lists;
+  for (const auto& p : out["problems"]) {
+    const std::string name = p["name"].get<std::string>();
+    problems.add({name, std::to_string(p["dim"].get<int>()), fmt::format("{:.6g}", p["horizon"].get<double>()),
+                  p["closed_form"].get<bool>() ? "yes" : "no", p["description"].get<std::string>()});
+    for (const auto& q : p["parameters"]) {
+      const auto& names = q["names"];
+      std::string allowed = q["allowed"].get<std::string>();
+      if (!names.empty() && names.size() <= 4) {
+        std::vector<std::string> options;
+        for (const auto& n : names)
+          options.push_back(fmt::format("{:g} {}", n["value"].get<double>(), n["name"].get<std::string>()));
+        allowed = fmt::format("{}", fmt::join(options, ", "));
+      } else if (!names.empty()) {
+        allowed += ", or a name below";
+        long_lists.try_emplace(q["name"].get<std::string>(), names);
+      }
+      params.add({name, q["name"].get<std::string>(), fmt::format("{:g}", q["default"].get<double>()),
+                  q["unit"].get<std::string>(), allowed, q["description"].get<std::string>()});
+    }
+  }
+  fmt::print("problems:\n{}\nparameters:\n{}", render_text(problems), render_text(params));
+  for (const auto& [param, names] : long_lists) {
+    table named{{right_column("value"), {"name"}, {"meaning"}}, {}};
+    for (const auto& n : names)
+      named.add({fmt::format("{:g}", n["value"].get<double>()), n["name"].get<std::string>(),
+                 n["description"].get<std::string>()});
+    fmt::print("\nnames {} takes:\n{}", param, render_text(named));
+  }
+  for (const auto origin : {method_origin::ours, method_origin::peer, method_origin::baseline}) {
+    table methods{{{"method"}, {"kind"}, right_column("order"), {"description"}, {"capabilities"}}, {}};
+    for (const auto& m : all_methods()) {
+      if (m.origin != origin) continue;
+      std::string caps;
+      const json declared = capabilities_json(m.traits);  // named: items() of a temporary would dangle
+      for (const auto& [key, on] : declared.items())
+        if (on.get<bool>()) caps += (caps.empty() ? "" : ", ") + key;
+      methods.add({m.name, std::string(to_string(m.kind)),
+                   std::isfinite(m.declared_order) ? fmt::format("{:g}", m.declared_order) : "-", m.description, caps});
+    }
+    fmt::print("\n{}:\n{}",
+               origin == method_origin::ours   ? "integrators (ours)"
+               : origin == method_origin::peer ? "peers"
+                                               : "baseline (for scale, never recommended)",
+               render_text(methods));
+  }
 }
 
 int run_list(bool as_json) {
@@ -67,50 +124,7 @@ int run_list(bool as_json) {
     std::cout << out.dump(2) << "\n";
     return 0;
   }
-  std::map<std::string, json> long_lists;
-  fmt::print("problems:\n");
-  for (const auto& p : out["problems"]) {
-    fmt::print("  {:<22} {} (dim {}, horizon {:.6g} s{})\n", p["name"].get<std::string>(),
-               p["description"].get<std::string>(), p["dim"].get<int>(), p["horizon"].get<double>(),
-               p["closed_form"].get<bool>() ? ", closed form" : "");
-    for (const auto& q : p["parameters"]) {
-      const auto& names = q["names"];
-      // A long list of names (the lecture's friction table) is printed once, below.
-      std::string allowed = q["allowed"].get<std::string>();
-      if (!names.empty() && names.size() <= 4) {
-        std::vector<std::string> options;
-        for (const auto& n : names)
-          options.push_back(fmt::format("{:g} {}", n["value"].get<double>(), n["name"].get<std::string>()));
-        allowed = fmt::format("{}", fmt::join(options, ", "));
-      } else if (!names.empty()) {
-        allowed += fmt::format(", or one of the {} names below", names.size());
-        long_lists.try_emplace(q["name"].get<std::string>(), names);
-      }
-      fmt::print("      {:<14} = {:<10g} [{}] {} ({})\n", q["name"].get<std::string>(), q["default"].get<double>(),
-                 q["unit"].get<std::string>(), q["description"].get<std::string>(), allowed);
-    }
-  }
-  for (const auto& [param, names] : long_lists) {
-    fmt::print("names {} takes:\n", param);
-    for (const auto& n : names)
-      fmt::print("  {:>4g}  {:<40} {}\n", n["value"].get<double>(), n["name"].get<std::string>(),
-                 n["description"].get<std::string>());
-  }
-  for (const auto origin : {method_origin::ours, method_origin::peer, method_origin::baseline}) {
-    fmt::print("{}:\n", origin == method_origin::ours   ? "integrators (ours)"
-                        : origin == method_origin::peer ? "peers"
-                                                        : "baseline (for scale, never recommended)");
-    for (const auto& m : all_methods()) {
-      if (m.origin != origin) continue;
-      std::string caps;
-      const json declared = capabilities_json(m.traits);
-      for (const auto& [key, on] : declared.items())
-        if (on.get<bool>()) caps += (caps.empty() ? "" : ", ") + key;
-      fmt::print("  {:<24} {:<10} order {:<4} {}{}\n", m.name, to_string(m.kind),
-                 std::isfinite(m.declared_order) ? fmt::format("{:g}", m.declared_order) : "-", m.description,
-                 caps.empty() ? "" : " [" + caps + "]");
-    }
-  }
+  print_list(out);
   return 0;
 }
 

@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <iostream>
@@ -19,6 +20,7 @@
 #include "cli/commands.hpp"
 #include "study/study_file.hpp"
 #include "study/sweep.hpp"
+#include "study/table_render.hpp"
 
 namespace stepbench::cli {
 namespace {
@@ -238,18 +240,20 @@ int run_study(const loop_args& a) {
     const auto& o = s.loop.options;
     fmt::print("{} with {}: max shown error [{}] at a {:g} Hz display (constant clock, clamp {:g} s)\n", lp.name,
                m.info.name, lp.position_unit, o.reference_display_hz, o.clamp_s);
-    fmt::print("{:>12}", "physics Hz");
-    for (loop_design d : all_loop_designs) fmt::print(" {:>13}", to_string(d));
-    fmt::print("\n");
+    table grid{{right_column("physics", "Hz")}, {}};
+    for (loop_design d : all_loop_designs) grid.columns.push_back(right_column(std::string(to_string(d))));
     for (double ph : o.physics_hz) {
-      fmt::print("{:>12g}", ph);
-      for (loop_design d : all_loop_designs)
-        for (const auto& r : m.rows)
-          if (r.clock == "constant" && r.config.display_hz == o.reference_display_hz && r.config.design == d &&
-              (d == loop_design::variable || r.config.physics_hz == ph))
-            fmt::print(" {:>13.3g}", r.shown_err_max);
-      fmt::print("\n");
+      std::vector<std::string> cells{fmt::format("{:g}", ph)};
+      for (loop_design d : all_loop_designs) {
+        const auto r = std::find_if(m.rows.begin(), m.rows.end(), [&](const auto& r) {
+          return r.clock == "constant" && r.config.display_hz == o.reference_display_hz && r.config.design == d &&
+                 (d == loop_design::variable || r.config.physics_hz == ph);
+        });
+        cells.push_back(r == m.rows.end() ? "-" : fmt::format("{:.3g}", r->shown_err_max));
+      }
+      grid.add(std::move(cells));
     }
+    fmt::print("{}", render_text(grid, ""));
     for (const auto& c : cheapest_designs(m, o))
       if (c.display_hz == o.reference_display_hz)
         fmt::print("cheapest under {:g} {}: {}\n", c.target, lp.position_unit,

@@ -22,6 +22,7 @@
 #include "cli/commands.hpp"
 #include "core/work_precision.hpp"
 #include "study/study_reader.hpp"
+#include "study/table_render.hpp"
 
 namespace stepbench::cli {
 namespace {
@@ -90,15 +91,11 @@ std::string verdict(double ours_over_peer) {
   return "OPEN";
 }
 
-// Cheapest of ours and cheapest peer at a target, among the methods that were timed.
+// Cheapest of ours and cheapest peer at a target, among the methods that were timed
+// (wp_candidates::timed_methods: core/work_precision.hpp says why).
 json equal_error(const study_problem& p, double target, const std::string& metric) {
-  std::vector<wp_method> methods;
-  for (auto& m : work_precision_input(p, metric, true)) {
-    bool timed = false;
-    for (const auto& r : m.rows) timed = timed || std::isfinite(r.time_ns);
-    if (timed) methods.push_back(std::move(m));
-  }
-  const auto r = cheapest(methods, target, true, metric, p.unit);
+  const std::vector<wp_method> methods = work_precision_input(p, metric, true);
+  const auto r = cheapest(methods, target, true, metric, p.unit, wp_candidates::timed_methods);
   json out = {{"problem", p.name}, {"metric", metric}, {"target", target}, {"cost", r.cost}, {"ranked", json::array()}};
   const wp_pick *ours = nullptr, *peer = nullptr;
   for (const auto& pick : r.ranked) {
@@ -123,9 +120,8 @@ json equal_error(const study_problem& p, double target, const std::string& metri
   return out;
 }
 
-int run_ratios(const ratios_args& a) {
-  const study_data s = read_study(a.study);
-  if (!s.timed) throw std::runtime_error(fmt::format("{} has no timings: run stepbench_bench --study_out", a.study));
+// Every figure, as `--json` prints it and the text below is drawn from.
+json ratios_json(const study_data& s, const ratios_args& a) {
   json out = {{"study", a.study}, {"cpu", s.meta.count("cpu") ? s.meta.at("cpu") : ""}};
   if (const auto* spring = s.find("damped_spring"))
     out["step_cost"] = step_costs(*spring, {"rk4", "baseline_rk4", "gsl_rk4", "odeint_rk4"});
@@ -155,95 +151,137 @@ int run_ratios(const ratios_args& a) {
       if (m.declared_order_holds == 0)
         out["order_notes"].push_back(
             {{"problem", p.name}, {"method", m.name}, {"declared", m.declared_order}, {"observed", m.fit_slope}});
-  if (a.json) {
-    std::cout << out.dump(2) << "\n";
-    return 0;
-  }
+  return out;
+}
 
-  fmt::print("Performance ratios from {} ({}; each figure measured in that one run)\n", a.study,
-             out["cpu"].get<std::string>());
-  if (const auto& sc = out["step_cost"]; !sc.is_null()) {
-    const auto& ns = sc["ns_per_step"];
-    fmt::print("\nStep cost, {} at dt = {:.6g} s (ns per step):", sc["problem"].get<std::string>(),
-               sc["dt"].get<double>());
-    for (const auto& [k, v] : ns.items()) fmt::print("  {} {:.2f}", k, v.get<double>());
-    fmt::print("\n");
-    auto ratio = [&](const char* x, const char* y, const char* target, auto ok) {
-      if (!ns.contains(x) || !ns.contains(y)) return;
-      const double r = ns[x].get<double>() / ns[y].get<double>();
-      fmt::print("  {:<28} {:>6.2f}   target {} {}\n", fmt::format("{} / {}", x, y), r, target,
-                 ok(r) ? "met" : "NOT MET");
-    };
-    ratio("rk4", "baseline_rk4", "<= 1.15", [](double r) { return r <= 1.15; });
-    ratio("gsl_rk4", "rk4", ">= 6", [](double r) { return r >= 6.0; });
-    if (sc["force_evals_per_step"].contains("gsl_rk4"))
-      fmt::print(
-          "    (GSL's rk4 estimates its error by step doubling: {:.2f} force evaluations a step against our 4)\n",
-          sc["force_evals_per_step"]["gsl_rk4"].get<double>());
-    ratio("rk4", "odeint_rk4", "<= 0.85", [](double r) { return r <= 0.85; });
-  } else {
-    fmt::print("\nStep cost: rk4 and its peers on damped_spring were not all timed\n");
+// --- The text form: every table drawn by the one renderer (study/table_render.hpp). ---
+
+std::string fixed(const json& v, int digits) {
+  return v.is_null() ? "-" : fmt::format("{:.{}f}", v.get<double>(), digits);
+}
+
+// A step-cost record: each method's ns and force evaluations a step, then the ratios
+// the README quotes, each with its target where it has one.
+struct ratio_line {
+  const char *x, *y;
+  const char* target = nullptr;  // "<= 1.15"; nullptr: no target, the ratio informs
+  bool (*met)(double) = nullptr;
+};
+
+void print_step_cost(const json& sc, const std::string& title, int ns_digits, const std::vector<ratio_line>& lines) {
+  const auto& ns = sc["ns_per_step"];
+  const auto& fe = sc["force_evals_per_step"];
+  fmt::print("\n{}, {} at dt = {:.6g} s:\n", title, sc["problem"].get<std::string>(), sc["dt"].get<double>());
+  table costs{{{"method"}, right_column("time a step", "ns"), right_column("force evaluations a step")}, {}};
+  for (const auto& [k, v] : ns.items()) costs.add({k, fixed(v, ns_digits), fixed(fe[k], 2)});
+  fmt::print("{}", render_text(costs));
+  table ratios{{{"ratio"}, right_column("measured"), {"target"}, {"verdict"}}, {}};
+  for (const auto& l : lines) {
+    if (!ns.contains(l.x) || !ns.contains(l.y)) continue;
+    const double r = ns[l.x].get<double>() / ns[l.y].get<double>();
+    ratios.add({fmt::format("{} / {}", l.x, l.y), fmt::format("{:.2f}", r), l.target ? l.target : "-",
+                l.target ? (l.met(r) ? "met" : "NOT MET") : ""});
   }
-  for (const auto& sc : out["step_cost_rk8"]) {
-    const auto& ns = sc["ns_per_step"];
-    const auto& fe = sc["force_evals_per_step"];
-    fmt::print("\nStep cost, eighth order, {} at dt = {:.6g} s (ns per step; force evaluations a step):\n ",
-               sc["problem"].get<std::string>(), sc["dt"].get<double>());
-    for (const auto& [k, v] : ns.items()) fmt::print("  {} {:.1f} ({:.2f})", k, v.get<double>(), fe[k].get<double>());
-    fmt::print("\n");
-    auto ratio = [&](const char* x, const char* y, const char* target, auto ok) {
-      if (!ns.contains(x) || !ns.contains(y)) return;
-      const double r = ns[x].get<double>() / ns[y].get<double>();
-      fmt::print("  {:<28} {:>6.2f}{}\n", fmt::format("{} / {}", x, y), r,
-                 target ? fmt::format("   target {} {}", target, ok(r) ? "met" : "NOT MET") : std::string());
-    };
-    ratio("rk8", "baseline_rk8", "<= 1.15", [](double r) { return r <= 1.15; });
-    ratio("gsl_rk8pd", "rk8", nullptr, [](double) { return true; });
-    ratio("odeint_rkf78", "rk8", nullptr, [](double) { return true; });
-    ratio("arkode_erk8", "rk8", nullptr, [](double) { return true; });
+  if (!ratios.empty()) fmt::print("\n{}", render_text(ratios));
+}
+
+void print_ns_per_call(const json& per_problem) {
+  if (per_problem.empty()) return;
+  fmt::print("\nns per right-hand-side call (median over the timed rows of time / force evaluations):\n");
+  table t{{{"method"}}, {}};
+  std::vector<std::string> methods;
+  for (const auto& e : per_problem) {
+    t.columns.push_back(right_column(e["problem"].get<std::string>(), "ns"));
+    for (const auto& [k, v] : e["methods"].items())
+      if (std::find(methods.begin(), methods.end(), k) == methods.end()) methods.push_back(k);
   }
-  if (!out["ns_per_rhs_call"].empty()) {
-    fmt::print("\nns per right-hand-side call (median over the timed rows of time / force evaluations):\n");
-    for (const auto& e : out["ns_per_rhs_call"]) {
-      fmt::print("  {:<15}", e["problem"].get<std::string>());
-      for (const auto& [k, v] : e["methods"].items()) fmt::print("  {} {:.1f}", k, v["ns_per_call"].get<double>());
-      fmt::print("\n");
-    }
+  for (const auto& name : methods) {
+    std::vector<std::string> row{name};
+    for (const auto& e : per_problem)
+      row.push_back(e["methods"].contains(name) ? fixed(e["methods"][name]["ns_per_call"], 1) : "-");
+    t.add(std::move(row));
   }
+  fmt::print("{}", render_text(t));
+}
+
+std::string who(const json& j) {
+  return j.is_null() ? std::string("none reaches it")
+                     : fmt::format("{} {}", j["method"].get<std::string>(), format_time_ns(j["time_ns"].get<double>()));
+}
+
+void print_equal_error(const json& out) {
   fmt::print("\nEqual error: time to reach err_pos_max (cheapest measured row that reaches it; the study's rule)\n");
-  fmt::print("  {:<15} {:>7}  {:<34} {:<34} {:>11} {:>11}  {}\n", "problem", "target", "cheapest of ours",
-             "cheapest peer", "peer / ours", "ours / peer", "target <= 0.5");
-  auto who = [](const json& j) {
-    return j.is_null()
-               ? std::string("none reaches it")
-               : fmt::format("{} {}", j["method"].get<std::string>(), format_time_ns(j["time_ns"].get<double>()));
-  };
-  for (const auto& e : out["equal_error"])
-    fmt::print("  {:<15} {:>7.0e}  {:<34} {:<34} {:>11} {:>11}  {}\n", e["problem"].get<std::string>(),
-               e["target"].get<double>(), who(e["ours"]), who(e["peer"]),
-               e["peer_over_ours"].is_null() ? "-" : fmt::format("{:.2f}", e["peer_over_ours"].get<double>()),
-               e["ours_over_peer"].is_null() ? "-" : fmt::format("{:.2f}", e["ours_over_peer"].get<double>()),
-               e["target_0_5"].get<std::string>());
+  table t{{{"problem"},
+           right_column("target"),
+           {"cheapest of ours"},
+           {"cheapest peer"},
+           right_column("peer / ours"),
+           right_column("ours / peer"),
+           {"target <= 0.5"}},
+          {}};
   std::string open;
-  for (const auto& e : out["equal_error"])
+  for (const auto& e : out["equal_error"]) {
+    t.add({e["problem"].get<std::string>(), fmt::format("{:.0e}", e["target"].get<double>()), who(e["ours"]),
+           who(e["peer"]), fixed(e["peer_over_ours"], 2), fixed(e["ours_over_peer"], 2),
+           e["target_0_5"].get<std::string>()});
     if (e["target_0_5"] == "OPEN")
       open += fmt::format("{}{} at {:.0e}", open.empty() ? "" : ", ", e["problem"].get<std::string>(),
                           e["target"].get<double>());
+  }
+  fmt::print("{}", render_text(t));
   fmt::print("  open (ours / peer >= 1.0): {}\n", open.empty() ? "none" : open);
   for (const auto& e : out["equal_error"]) {
     if (e["problem"] != "pendulum" || e["target"].get<double>() != 1e-6) continue;
     fmt::print("\n  pendulum, every method to err_pos_max = 1e-6:\n");
-    for (const auto& r : e["ranked"])
-      fmt::print("    {:<24} {:>10}  {} {:g}{}\n", r["method"].get<std::string>(),
-                 format_time_ns(r["time_ns"].get<double>()), r["origin"] == "ours" ? "ours," : "",
-                 r["param"].get<double>(), r["origin"] == "baseline" ? "  (baseline, for scale)" : "");
+    table ranked{{{"method"}, right_column("time"), {"origin"}, right_column("dt or tolerance")}, {}};
+    for (const auto& r : e["ranked"]) {
+      const std::string origin = r["origin"].get<std::string>();
+      ranked.add({r["method"].get<std::string>(), format_time_ns(r["time_ns"].get<double>()),
+                  origin == "baseline" ? "baseline, for scale" : origin,
+                  fmt::format("{:g}", r["param"].get<double>())});
+    }
+    fmt::print("{}", render_text(ranked, "    "));
   }
   if (const auto& f = out["equal_error_final"]; !f.is_null())
     fmt::print("\n  pendulum to err_pos_final = 1e-6 instead: cheapest of ours {}, cheapest peer {}\n", who(f["ours"]),
                who(f["peer"]));
+}
+
+void print_ratios(const json& out, const std::string& study) {
+  fmt::print("Performance ratios from {} ({}; each figure measured in that one run)\n", study,
+             out["cpu"].get<std::string>());
+  if (const auto& sc = out["step_cost"]; !sc.is_null()) {
+    print_step_cost(sc, "Step cost", 2,
+                    {{"rk4", "baseline_rk4", "<= 1.15", [](double r) { return r <= 1.15; }},
+                     {"gsl_rk4", "rk4", ">= 6", [](double r) { return r >= 6.0; }},
+                     {"rk4", "odeint_rk4", "<= 0.85", [](double r) { return r <= 0.85; }}});
+    if (sc["force_evals_per_step"].contains("gsl_rk4"))
+      fmt::print("  (GSL's rk4 estimates its error by step doubling: {:.2f} force evaluations a step against our 4)\n",
+                 sc["force_evals_per_step"]["gsl_rk4"].get<double>());
+  } else {
+    fmt::print("\nStep cost: rk4 and its peers on damped_spring were not all timed\n");
+  }
+  for (const auto& sc : out["step_cost_rk8"])
+    print_step_cost(sc, "Step cost, eighth order", 1,
+                    {{"rk8", "baseline_rk8", "<= 1.15", [](double r) { return r <= 1.15; }},
+                     {"gsl_rk8pd", "rk8"},
+                     {"odeint_rkf78", "rk8"},
+                     {"arkode_erk8", "rk8"}});
+  print_ns_per_call(out["ns_per_rhs_call"]);
+  print_equal_error(out);
   for (const auto& n : out["order_notes"])
     fmt::print("  note: {} on {} declares order {:g} but achieves {:.2f}\n", n["method"].get<std::string>(),
                n["problem"].get<std::string>(), n["declared"].get<double>(), n["observed"].get<double>());
+}
+
+int run_ratios(const ratios_args& a) {
+  const study_data s = read_study(a.study);
+  if (!s.timed) throw std::runtime_error(fmt::format("{} has no timings: run stepbench_bench --study_out", a.study));
+  const json out = ratios_json(s, a);
+  if (a.json)
+    std::cout << out.dump(2) << "\n";
+  else
+    print_ratios(out, a.study);
   return 0;
 }
 

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
+#include "study/table_render.hpp"
 
 namespace stepbench::cli {
 namespace {
@@ -48,8 +49,13 @@ int run_stability(bool as_json) {
       s.run_steps, s.envelope_growth, s.blowup_factor);
   fmt::print("  adaptive methods: the step they take when every attempt is accepted (tolerance {:g})\n\n",
              always_accept_tolerance);
-  fmt::print("{:<20} {:<10} {:>12} {:>12} {:>10}  {}\n", "integrator", "test", "theory (a)", "measured (b)",
-             "(b)/(a)-1", "long runs");
+  table t{{{"integrator"},
+           {"test"},
+           right_column("theory (a)"),
+           right_column("measured (b)"),
+           right_column("(b)/(a)-1"),
+           {"long runs"}},
+          {}};
   for (const auto& l : d.limits) {
     std::string theory, measured, diff;
     if (l.unstable_for_all_dt) {
@@ -65,9 +71,10 @@ int run_stability(bool as_json) {
       measured = std::isfinite(l.measured) ? fmt::format("{:.6f}", l.measured) : "-";
       diff = std::isfinite(l.rel_difference()) ? fmt::format("{:+.1e}", l.rel_difference()) : "-";
     }
-    fmt::print("{:<20} {:<10} {:>12} {:>12} {:>10}  {}{}\n", l.integrator, to_string(l.test), theory, measured, diff,
-               l.run_confirms ? "" : "NOT CONFIRMED: ", l.note);
+    t.add({l.integrator, std::string(to_string(l.test)), theory, measured, diff,
+           (l.run_confirms ? "" : "NOT CONFIRMED: ") + l.note});
   }
+  fmt::print("{}", render_text(t, ""));
   fmt::print("\n\"unstable\": unstable for every dt; \"uncond.\": stable for every dt (up to y = {:g}).\n",
              s.y_unconditional);
   fmt::print("Computed in {:.3f} s (limits {:.3f} s, stability regions on a {} x {} grid {:.3f} s).\n",

@@ -40,23 +40,29 @@ std::optional<wp_pick> cheapest_result::answer(const std::vector<wp_method>& met
 }
 
 cheapest_result cheapest(const std::vector<wp_method>& methods, double target, bool timed, const std::string& metric,
-                         const std::string& unit) {
+                         const std::string& unit, wp_candidates candidates) {
   if (!(target > 0.0) || !std::isfinite(target))
     throw std::invalid_argument(fmt::format("the target error must be > 0, got {}", target));
   cheapest_result r;
   r.target = target;
+  const auto competes = [&](const wp_method& m) {
+    return candidates == wp_candidates::every_method ||
+           std::any_of(m.rows.begin(), m.rows.end(), [](const wp_row& row) { return std::isfinite(row.time_ns); });
+  };
   // Time is the cost only if it can rank every qualifying row; otherwise the counted
   // force evaluations, which every row has.
   bool all_timed = timed;
   for (const auto& m : methods)
-    for (const auto& row : m.rows)
-      if (qualifies(row, target, timed) && !(std::isfinite(row.time_ns) && row.time_ns > 0.0)) all_timed = false;
+    if (competes(m))
+      for (const auto& row : m.rows)
+        if (qualifies(row, target, timed) && !(std::isfinite(row.time_ns) && row.time_ns > 0.0)) all_timed = false;
   r.cost = all_timed ? "time_ns" : "force_evals";
   auto cost_of = [&](const wp_row& row) { return all_timed ? row.time_ns : row.force_evals; };
 
   std::optional<wp_pick> best_achieved;
   for (std::size_t mi = 0; mi < methods.size(); ++mi) {
     const auto& m = methods[mi];
+    if (!competes(m)) continue;
     auto make_pick = [&](std::size_t ri) {
       wp_pick p;
       p.method = mi;

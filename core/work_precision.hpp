@@ -69,11 +69,21 @@ struct cheapest_result {
   std::optional<wp_pick> answer(const std::vector<wp_method>& methods) const;
 };
 
+// Which methods compete. The two callers genuinely differ:
+//  - every_method: advise and the study file's equal-error table rank every method; one
+//    the benchmark did not time still has its force evaluations, and the cost falls back
+//    to them (the rule above) rather than leaving the method out of the answer;
+//  - timed_methods: `stepbench ratios` quotes times, so it leaves out a method with no
+//    timed row at all (one a --benchmark_filter left out of the timed run), which would
+//    otherwise turn every cost at the target into force evaluations. Such a method is
+//    neither ranked nor excluded.
+enum class wp_candidates { every_method, timed_methods };
+
 // The rule above. `timed`: the study carries timings (cut rows are then excluded).
-// `unit` is used only in the exclusion reasons. Throws std::invalid_argument unless
-// target > 0 and finite.
+// `unit` is used only in the exclusion reasons. Indices in the result are into
+// `methods`. Throws std::invalid_argument unless target > 0 and finite.
 cheapest_result cheapest(const std::vector<wp_method>& methods, double target, bool timed, const std::string& metric,
-                         const std::string& unit);
+                         const std::string& unit, wp_candidates candidates = wp_candidates::every_method);
 
 // The Pareto front of every usable row of every method, by cost (time_ns, or
 // force_evals when `by_time` is false) against error: going up in cost, a row joins

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "study/table_render.hpp"
+
 namespace stepbench {
 namespace {
 
@@ -64,12 +66,6 @@ std::string format_advice(const advice& a, std::size_t runners_up) {
     return fmt::format("diverged at {} rows: {} .. {}", p.diverged_rows, format_param(kind, *p.smallest_diverged),
                        format_param(kind, *p.largest_diverged));
   };
-  auto line = [&](const wp_pick& p) {
-    const auto& m = a.methods[p.method];
-    const auto& row = m.rows[p.row];
-    return fmt::format("{:<34} {:<18} {:>18}  {} {:.3g} {}  [{}]", label(m), format_param(m.kind, row.param),
-                       cost_text(r.cost, row), a.metric, row.error, a.unit, margin(p));
-  };
   out += fmt::format("{}: {} <= {:g} {}; cost = {}\n", a.problem, a.metric, a.tol, a.unit, cost_name);
   const auto answer = r.answer(a.methods);
   if (!answer) {
@@ -91,15 +87,27 @@ std::string format_advice(const advice& a, std::size_t runners_up) {
   for (const auto& p : r.ranked)
     if (!answer || p.method != answer->method) others.push_back(&p);
   if (!others.empty()) {
-    out += answer ? "runners-up:\n" : "for scale:\n";
-    for (std::size_t i = 0; i < others.size() && i < runners_up; ++i)
-      out += fmt::format("  {}. {}\n", i + 2, line(*others[i]));
+    table t{{right_column("rank"),
+             {"method"},
+             {"dt or tolerance"},
+             right_column("cost"),
+             right_column(a.metric, a.unit),
+             {"stability margin"}},
+            {}};
+    for (std::size_t i = 0; i < others.size() && i < runners_up; ++i) {
+      const auto& m = a.methods[others[i]->method];
+      const auto& row = m.rows[others[i]->row];
+      t.add({fmt::format("{}.", i + 2), label(m), format_param(m.kind, row.param), cost_text(r.cost, row),
+             fmt::format("{:.3g}", row.error), margin(*others[i])});
+    }
+    out += (answer ? "runners-up:\n" : "for scale:\n") + render_text(t);
     if (others.size() > runners_up)
       out += fmt::format("  ... and {} more that also meet the tolerance\n", others.size() - runners_up);
   }
   if (!r.excluded.empty()) {
-    out += "excluded:\n";
-    for (const auto& e : r.excluded) out += fmt::format("  {:<34} {}\n", label(a.methods[e.method]), e.reason);
+    table t{{{"method"}, {"reason"}}, {}};
+    for (const auto& e : r.excluded) t.add({label(a.methods[e.method]), e.reason});
+    out += "excluded:\n" + render_text(t);
   }
   return out;
 }

@@ -10,7 +10,8 @@
 //
 // The checks are one function per group of the study file (truth, references, methods,
 // and within a method: its ladder, its order fit, its rows), called from one list in
-// compare.cpp; a later group (stability limits) is one more function there.
+// compare.cpp, and check_stability for /stability; a new group is one more function
+// there. Comparing is this file's; drawing the result is study/compare_render.cpp's.
 //
 // Exit status of the command: 0 nothing regressed, 1 a regression (or, with
 // gate_timing, a flagged slowdown), 2 could not compare (bad usage, a file read_study
@@ -159,10 +160,6 @@ std::optional<change_kind> judge_order(double old_order, double new_order, doubl
 double timing_threshold(const timing_side& old_time, const timing_side& new_time);
 int judge_timing(double ratio, double threshold);
 
-// The report as readable text or as Markdown (a CI job summary, a pull-request comment).
-std::string format_text(const comparison& c);
-std::string format_markdown(const comparison& c);
-// One line: "3 regressions, 1 improvement, ..." as the summary says it.
-std::string summary_line(const comparison& c);
+// The report of a comparison as text or Markdown: study/compare_render.hpp.
 
 }  // namespace stepbench

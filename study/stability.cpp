@@ -516,6 +516,4 @@ void write_stability(H5::Group& root, const stability_data& d) {
   }
 }
 
-void write_stability(H5::Group& root) { write_stability(root, compute_stability()); }
-
 }  // namespace stepbench

@@ -17,8 +17,8 @@
 // test always passes, so its step is rk45's Dormand-Prince step and adaptive_euler's two
 // half steps of explicit Euler.
 //
-// Written to the study file as /stability (docs/study-format.md) and printed by
-// `stepbench stability`.
+// Computed by the sweep into every study (study/sweep.hpp), written to the study file as
+// /stability (docs/study-format.md), and printed by `stepbench stability`.
 #include <H5Cpp.h>
 
 #include <Eigen/Core>
@@ -135,9 +135,8 @@ Eigen::Matrix2d amplification_matrix(std::string_view integrator, stability_test
 // max |eigenvalue| of a 2x2 matrix, from its trace and determinant.
 double spectral_radius(const Eigen::Matrix2d& m);
 
-// Writes /stability under `root` (docs/study-format.md).
+// Writes /stability under `root` (docs/study-format.md): what run_sweep computed with the
+// default settings, in every study file.
 void write_stability(H5::Group& root, const stability_data& data);
-// Computes with the default settings and writes: what every study file gets.
-void write_stability(H5::Group& root);
 
 }  // namespace stepbench

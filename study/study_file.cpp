@@ -5,20 +5,18 @@
 
 #include <cerrno>
 #include <cmath>
-#include <csignal>
 #include <cstring>
-#include <ctime>
 #include <filesystem>
-#include <fstream>
 #include <stdexcept>
-#include <thread>
 
 #include "build_info.hpp"
 #include "study/energy.hpp"
 #include "study/h5.hpp"
 #include "study/loop.hpp"
+#include "study/machine.hpp"
 #include "study/stability.hpp"
 #include "study/substeps.hpp"
+#include "study/temp_file_guard.hpp"
 
 namespace stepbench {
 namespace {
@@ -205,41 +203,6 @@ void write_problem(H5::Group& parent, const problem_study& ps, bool timed) {
 
 std::string temp_path_for(const std::string& path) { return fmt::format("{}.tmp.{}", path, ::getpid()); }
 
-// The temporary file being written, for the signal handler below (a fixed buffer: a
-// handler may only call async-signal-safe functions, such as unlink and raise).
-char temp_being_written[4096] = {0};
-
-extern "C" void remove_temp_and_reraise(int sig) {
-  if (temp_being_written[0]) ::unlink(temp_being_written);
-  ::signal(sig, SIG_DFL);
-  ::raise(sig);
-}
-
-// While a study file is written, SIGINT, SIGTERM and SIGHUP remove the temporary file
-// before ending the process as they would have: an interrupted run leaves the previous
-// results file byte-identical and nothing else behind. (Before the write there is
-// nothing to clean up: the previous file is only ever replaced by a rename.)
-class temp_file_guard {
- public:
-  explicit temp_file_guard(const std::string& path) {
-    std::snprintf(temp_being_written, sizeof temp_being_written, "%s", path.c_str());
-    struct sigaction action {};
-    action.sa_handler = remove_temp_and_reraise;
-    sigemptyset(&action.sa_mask);
-    for (std::size_t i = 0; i < std::size(signals_); ++i) sigaction(signals_[i], &action, &previous_[i]);
-  }
-  ~temp_file_guard() {
-    for (std::size_t i = 0; i < std::size(signals_); ++i) sigaction(signals_[i], &previous_[i], nullptr);
-    temp_being_written[0] = 0;
-  }
-  temp_file_guard(const temp_file_guard&) = delete;
-  temp_file_guard& operator=(const temp_file_guard&) = delete;
-
- private:
-  static constexpr int signals_[] = {SIGINT, SIGTERM, SIGHUP};
-  struct sigaction previous_[3];
-};
-
 }  // namespace
 
 h5::table parameters_table(const std::vector<param_value>& params) {
@@ -327,25 +290,6 @@ std::vector<wp_method> work_precision_input(const problem_study& ps, const std::
   return out;
 }
 
-std::string cpu_model() {
-  std::ifstream in("/proc/cpuinfo");
-  for (std::string line; std::getline(in, line);)
-    if (line.rfind("model name", 0) == 0) {
-      const auto colon = line.find(':');
-      if (colon != std::string::npos) return line.substr(line.find_first_not_of(' ', colon + 1));
-    }
-  return "unknown";
-}
-
-std::string utc_now_iso8601() {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
-}
-
 void check_writable(const std::string& path) {
   if (path.empty()) throw std::runtime_error("cannot write results file '': empty path");
   if (std::filesystem::is_directory(path))
@@ -373,7 +317,7 @@ void write_study(const study& s, const std::string& path) {
     attr(file, "build_flags", build_info::build_flags);
     attr(file, "created_utc", utc_now_iso8601());
     attr(file, "cpu", cpu_model());
-    attr(file, "cores", static_cast<int>(std::thread::hardware_concurrency()));
+    attr(file, "cores", core_count());
     attr(file, "levels", s.options.levels);
     attr(file, "base_steps", s.options.base_steps);
     attr(file, "sample_count", s.options.sample_count);
@@ -398,7 +342,7 @@ void write_study(const study& s, const std::string& path) {
       attr(file, "num_cpus", t.num_cpus);
       attr(file, "mhz_per_cpu", t.mhz_per_cpu);
     }
-    write_stability(file);  // /stability: computed from our compiled steps (study/stability.hpp)
+    write_stability(file, s.stability);  // /stability: our compiled steps' limits (study/stability.hpp)
     H5::Group problems = file.createGroup("problems");
     for (const auto& ps : s.problems) write_problem(problems, ps, s.timed.has_value());
     write_substeps(file, s.substeps, s.timed.has_value());

@@ -34,8 +34,4 @@ h5::table runs_table(const std::vector<method_row>& rows, bool timed);
 // error metric (core/work_precision.hpp).
 std::vector<wp_method> work_precision_input(const problem_study& ps, const std::string& metric);
 
-// "Intel(R) Xeon(R) ..." from /proc/cpuinfo, or "unknown".
-std::string cpu_model();
-std::string utc_now_iso8601();
-
 }  // namespace stepbench

@@ -161,6 +161,7 @@ study run_sweep(const sweep_options& opts) {
   if (energy.methods.empty()) energy.methods = opts.methods;
   if (energy.scenes.empty()) energy.enabled = false;
   out.energy = run_energy_study(energy, opts.overrides);
+  out.stability = compute_stability();
   out.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }

@@ -16,6 +16,7 @@
 #include "study/energy.hpp"
 #include "study/loop.hpp"
 #include "study/registry.hpp"
+#include "study/stability.hpp"
 
 namespace stepbench {
 
@@ -120,6 +121,9 @@ struct study {
   std::vector<substep_study> substeps;
   loop_study loop;      // empty when the options disable it or name none of the problems
   energy_study energy;  // empty when the options disable it
+  // The stability limits and regions of our integrators (study/stability.hpp): not of the
+  // selected problems, so every study carries the same, computed by run_sweep.
+  stability_data stability;
   double wall_seconds = 0.0;
   std::optional<timing_settings> timed;
 };

@@ -13,9 +13,11 @@
 #include <fstream>
 
 #include "study/compare.hpp"
+#include "study/compare_render.hpp"
 #include "study/study_file.hpp"
 #include "study/study_reader.hpp"
 #include "study/sweep.hpp"
+#include "study/table_render.hpp"
 
 using namespace stepbench;
 namespace fs = std::filesystem;
@@ -434,4 +436,25 @@ TEST_F(compare_test, machine_and_build_differences_are_reported) {
   const std::string md = format_markdown(c);
   EXPECT_NE(md.find("| cpu |"), std::string::npos) << md;
   EXPECT_NE(md.find("Another CPU"), std::string::npos);
+}
+
+// The one table renderer every command prints with: aligned text and Markdown.
+TEST(table_render, text_and_markdown) {
+  table t{{{"method"}, right_column("time", "ns"), {"note"}}, {}};
+  t.add({"rk4", "13.7", ""}).add({"velocity_verlet", "4.2", "a|b"});
+  EXPECT_EQ(render_text(t),
+            "  method           time [ns]  note\n"
+            "  rk4                   13.7\n"
+            "  velocity_verlet        4.2  a|b\n");
+  EXPECT_EQ(render_markdown(t),
+            "| method | time [ns] | note |\n"
+            "|---|---:|---|\n"
+            "| rk4 | 13.7 |   |\n"
+            "| velocity_verlet | 4.2 | a\\|b |\n");
+  EXPECT_THROW(t.add({"too", "few"}), std::logic_error);
+  t.drop_column(2);
+  EXPECT_EQ(render(t, table_format::text, ""),
+            "method           time [ns]\nrk4                   13.7\nvelocity_verlet        4.2\n");
+  EXPECT_EQ(wrap("one two three", "- ", "  ", 9), "- one two\n  three\n");
+  EXPECT_EQ(plural(1, "row", "rows"), "1 row");
 }

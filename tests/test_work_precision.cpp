@@ -92,6 +92,24 @@ TEST(work_precision, time_is_the_cost_when_every_qualifying_row_is_timed) {
   EXPECT_EQ(cheapest(ms, 1e-2, true, "err_pos_max", "m").cost, "force_evals");
 }
 
+TEST(work_precision, timed_methods_leave_out_a_method_never_timed) {
+  auto ms = untimed();
+  for (auto& m : ms)
+    for (auto& r : m.rows) r.time_ns = m.name == "fourth" ? NAN : r.force_evals * 6.25;
+  // Every method: fourth has no time, so the cost falls back to force evaluations.
+  const auto all = cheapest(ms, 1e-2, true, "err_pos_max", "m");
+  EXPECT_EQ(all.cost, "force_evals");
+  ASSERT_EQ(all.ranked.size(), 2u);
+  // Timed methods only (stepbench ratios): fourth is neither ranked nor excluded, the cost
+  // is time, and the indices still point into the input.
+  const auto timed = cheapest(ms, 1e-2, true, "err_pos_max", "m", wp_candidates::timed_methods);
+  EXPECT_EQ(timed.cost, "time_ns");
+  ASSERT_EQ(timed.ranked.size(), 1u);
+  EXPECT_EQ(ms[timed.ranked[0].method].name, "second");
+  EXPECT_EQ(excluded(timed, ms, "fourth"), nullptr);
+  ASSERT_NE(excluded(timed, ms, "first"), nullptr);
+}
+
 TEST(work_precision, cut_rows_are_too_slow) {
   auto ms = untimed();
   for (auto& m : ms)

@@ -9,7 +9,7 @@ import numpy as np  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.transforms import blended_transform_factory  # noqa: E402
 
-from . import tables  # noqa: E402
+from . import formatting  # noqa: E402
 
 DPI = 100
 plt.rcParams.update({
@@ -99,11 +99,11 @@ def _fit_label(m):
     status = m.attrs["fit_status"]
     declared = f"{m.declared_order:g}" if np.isfinite(m.declared_order) else "none"
     if status == "exact":
-        return f"{tables.label(m)}: exact for this problem"
+        return f"{formatting.label(m)}: exact for this problem"
     word = "order" if m.origin == "ours" else "declares"
     if status == "fitted":
-        return f"{tables.label(m)}: slope {m.attrs['fit_slope']:.2f} ({word} {declared})"
-    return f"{tables.label(m)}: not fitted ({word} {declared})"
+        return f"{formatting.label(m)}: slope {m.attrs['fit_slope']:.2f} ({word} {declared})"
+    return f"{formatting.label(m)}: not fitted ({word} {declared})"
 
 
 def convergence(problem, styles, path):
@@ -324,7 +324,7 @@ def work_precision(study, styles, path, front_key):
         ax.set_xlabel(xlabel)
         ax.set_ylabel(error_label("err_pos_max", p.unit))
     handles = [h for h, _ in seen.values()]
-    labels = [tables.label(m) for _, m in seen.values()]
+    labels = [formatting.label(m) for _, m in seen.values()]
     handles.append(Line2D([], [], color="gold", linewidth=7, alpha=0.45))
     labels.append("Pareto front (nothing beats it in both cost and error; baseline excluded)")
     if any_zero:

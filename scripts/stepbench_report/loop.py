@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import schema
+from .formatting import fmt_num, fmt_time_ns
 
 LOOP_ATTRS = ("designs", "display_hz", "physics_hz", "reference_display_hz", "clamp_s", "stall_s", "stall_at_fraction",
               "jitter", "jitter_seed", "jitter_distribution", "accumulator_slack", "target", "stated_step_cost_ns",
@@ -145,7 +146,6 @@ def figure(loop, styles, path):
 # --- the section --------------------------------------------------------------------------------
 
 def _err(v):
-    from .tables import fmt_num  # tables imports study, which imports this module
     return fmt_num(v) if np.isfinite(v) else "n/a"
 
 
@@ -180,7 +180,6 @@ def cheapest_text(loop, p, m, display_hz):
 
 
 def section(doc, study, figs):
-    from .tables import fmt_num, fmt_time_ns
     doc.h(2, "Game loop")
     loop = study.loop
     if loop is None:

@@ -8,7 +8,7 @@ from . import figures, render, tables
 from . import energy_runs as energy_section
 from . import loop as loop_section
 from . import substeps as substeps_section
-from .tables import fmt_num
+from .formatting import fmt_num
 
 TITLE = "stepbench report: accuracy, stability and cost of time integrators"
 META_KEYS = ["version", "git_commit", "compiler", "build_type", "dependencies", "created_utc", "cpu", "cores",
@@ -295,10 +295,3 @@ def _references(doc, study):
             doc.table(tables.REFERENCE_HEAD, rows)
         else:
             doc.p("No references recorded.")
-
-
-def _generic_section(doc, data):
-    """Hook output for data whose layout a later issue defines: its attributes and
-    datasets as found, so the section appears as soon as the data does."""
-    doc.table(["attribute", "value"], [[k, _value(v)] for k, v in sorted(data["attrs"].items())])
-    doc.table(["dataset", "shape"], [[k, str(v)] for k, v in sorted(data["datasets"].items())])

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import schema
+from .formatting import fmt_time_ns
 
 SUBSTEP_ATTRS = ("frame_dt",)
 SUBSTEP_METHOD_ATTRS = ("origin", "needs_jacobian")
@@ -104,7 +105,6 @@ def read(reader, f):
 # --- formatting ----------------------------------------------------------------------------------
 
 def _cost_text(kind, c):
-    from .tables import fmt_time_ns  # tables imports study, which imports this module
     if not np.isfinite(c):
         return "n/a"
     return fmt_time_ns(c) if kind == "time_ns" else f"{c:.4g} force eval{'' if c == 1 else 's'}"

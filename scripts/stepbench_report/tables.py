@@ -2,29 +2,12 @@
 fits or selects: the cheapest methods come from `equal_error`, the fronts from
 `front_*`, the orders and their verdicts from each method's attributes (all computed
 in C++, core/work_precision.hpp and core/convergence_fit.hpp)."""
-import math
-
 import numpy as np
 
+from .formatting import fmt_num, fmt_time_ns, label
 from .study import SUMMARY_TARGETS
 
 SUMMARY_METRICS = (("err_pos_final", "by final error"), ("err_pos_max", "by max error over the run"))
-
-
-def fmt_num(x, digits=3):
-    if x is None or (isinstance(x, (float, np.floating)) and math.isnan(x)):
-        return "n/a"
-    return f"{x:.{digits}g}"
-
-
-def fmt_time_ns(ns):
-    """As C++'s format_time_ns: "12.3 us"."""
-    if ns is None or not np.isfinite(ns):
-        return "n/a"
-    for scale, unit in ((1e9, "s"), (1e6, "ms"), (1e3, "us")):
-        if ns >= scale:
-            return f"{ns / scale:.3g} {unit}"
-    return f"{ns:.3g} ns"
 
 
 def fmt_param(method, value):
@@ -33,11 +16,6 @@ def fmt_param(method, value):
 
 def fmt_cost(cost_kind, cost):
     return fmt_time_ns(cost) if cost_kind == "time_ns" else f"{int(cost)} force evals"
-
-
-def label(method):
-    """The method's name as every table and legend shows it: peers and the baseline marked."""
-    return method.name + {"ours": "", "peer": " (peer)", "baseline": " (baseline, for scale)"}[method.origin]
 
 
 def _fit_range(method):

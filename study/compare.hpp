@@ -10,7 +10,8 @@
 //
 // The checks are one function per group of the study file (truth, references, methods,
 // and within a method: its ladder, its order fit, its rows), called from one list in
-// compare.cpp; a later group (stability limits) is one more function there.
+// compare.cpp; the stability limits of our methods (/stability) are checked after the
+// problems, by check_stability there.
 //
 // Exit status of the command: 0 nothing regressed, 1 a regression (or, with
 // gate_timing, a flagged slowdown), 2 could not compare (bad usage, a file read_study

@@ -1,7 +1,8 @@
 #pragma once
 // What a problem and an integrator are. These are compile-time contracts: the step
 // loop is instantiated per (problem, integrator) pair and inlines the force model.
-// Type erasure happens only in the registry (study/registry.cpp), outside every loop.
+// Type erasure happens only in the registry (problem_model<P> in study/problem_model.hpp,
+// compiled once per problem), outside every loop.
 //
 // The integrator categories follow Boost.Odeint's: a stepper advances by a given dt;
 // an adaptive stepper tries a step, estimates its error and proposes the next dt (and
@@ -80,7 +81,7 @@ struct contact_outcome {
 // A problem with contacts (a ground plane, walls, other bodies): the drive loop, not the
 // integrator, handles them (core/drive.hpp). contact_gap is the smallest signed distance
 // of the contacts (< 0: penetrated); resolve_contacts applies the lecture's response
-// (digest section 5: move back to the surface, v_b = (1 - k_f) v_t - k_r v_n) to every
+// (on collisions: move back to the surface, v_b = (1 - k_f) v_t - k_r v_n) to every
 // penetrated or touching contact that approaches, moves every penetrated body back to
 // its surface, and says what it did; locate_contacts chooses the mode: false
 // `end_of_step` (what games do: resolve after the step), true `locate` (find the contact

@@ -1,5 +1,5 @@
 #pragma once
-// The game loop around the integrator (digest section 7; G. Fiedler, "Fix Your
+// The game loop around the integrator (the lecture's game loop; G. Fiedler, "Fix Your
 // Timestep!", 2004): a display clock shows frames at times the integrator does not
 // choose, and each loop design decides what physics runs between two frames and which
 // state is drawn. Simulated here per (problem, integrator): the whole run inlines, with

@@ -1,10 +1,10 @@
 #pragma once
 // A problem with its parameters, type-erased: what the application (sweep, commands,
-// benchmark) holds. The registry (study/registry.cpp) implements it once per problem
-// type; every call below dispatches to code instantiated for that type, so no step loop
-// makes a virtual call.
+// benchmark) holds. problem_model<P> (study/problem_model.hpp) implements it once per
+// problem type, in that problem's own unit, and study/registry.cpp makes it by name;
+// every call below dispatches to code instantiated for that type, so no step loop makes
+// a virtual call.
 #include <functional>
-#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -72,7 +72,6 @@ class problem_instance {
   // a method that is not one of our fixed-step integrators, or a config that
   // loop_config_error refuses.
   virtual loop_result loop(std::string_view method, const loop_config& config) const = 0;
-  virtual std::unique_ptr<problem_instance> clone() const = 0;
 };
 
 }  // namespace stepbench

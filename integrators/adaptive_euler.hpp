@@ -1,6 +1,6 @@
 #pragma once
-// Adaptive Euler, the first of the lecture's recommended improvements (digest section
-// 6): explicit Euler with its step size chosen to meet a tolerance. The error of a step
+// Adaptive Euler, the first of the improvements the lecture recommends (integration):
+// explicit Euler with its step size chosen to meet a tolerance. The error of a step
 // of h is estimated by step doubling (HNW I, sec. II.4): one step of h and two of h/2;
 // their difference estimates the local error of the two half steps, which are the state
 // kept (the h^2 error terms are C h^2 for the full step and C h^2 / 2 for the halves, so

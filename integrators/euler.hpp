@@ -1,5 +1,5 @@
 #pragma once
-// Explicit (forward) Euler, as in the lecture (digest section 6): the position moves
+// Explicit (forward) Euler, as in the lecture's worked example: the position moves
 // with the OLD velocity, then the velocity with the old acceleration.
 //   x_{n+1} = x_n + dt v_n,   v_{n+1} = v_n + dt F(t_n, x_n, v_n) / m.
 // First order; exact only when the rate of change is constant.

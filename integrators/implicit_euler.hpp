@@ -1,6 +1,6 @@
 #pragma once
-// Implicit (backward) Euler, one of the lecture's recommended improvements (digest
-// section 6): the new state is defined by the forces at the END of the step,
+// Implicit (backward) Euler, one of the improvements the lecture recommends
+// (integration): the new state is defined by the forces at the END of the step,
 //   x_{n+1} = x_n + dt v_{n+1},   v_{n+1} = v_n + dt F(t_{n+1}, x_{n+1}, v_{n+1}) / m,
 // solved by Newton's method (integrators/implicit_newton.hpp). First order and
 // L-stable (Hairer & Wanner, Solving ODEs II, sec. IV.3): stable for every dt on every

@@ -1,5 +1,5 @@
 #pragma once
-// The lecture's momentum form (digest section 6): integrate the force into momentum,
+// The lecture's momentum form (integration): integrate the force into momentum,
 // derive the velocity, then move.
 //   p_{n+1} = p_n + dt F(t_n, x_n, v_n),   v_{n+1} = p_{n+1} / m,   x_{n+1} = x_n + dt v_{n+1}.
 // With p = m v this is semi-implicit Euler up to rounding (first order, symplectic); it

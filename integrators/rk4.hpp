@@ -1,5 +1,5 @@
 #pragma once
-// Classic fourth-order Runge-Kutta, in the lecture's form (digest section 6): state
+// Classic fourth-order Runge-Kutta, in the lecture's form (integration): state
 // {x, v}, derivative {dx, dv} = {v, F/m}; each sample takes an Euler sub-step from the
 // start with the previous sample's derivative:
 //   k1 = f(t, y),  k2 = f(t + dt/2, y + dt/2 k1),  k3 = f(t + dt/2, y + dt/2 k2),

@@ -37,7 +37,8 @@ int gsl_fixed_rhs(double t, const double y[], double dydt[], void* params) {
   return GSL_SUCCESS;
 }
 
-// The three GSL steppers a user might run at a fixed step.
+// The GSL steppers a user might run at a fixed step: three here, the fourth (rk8pd) in
+// peers/gsl_rk8pd_fixed.hpp.
 struct gsl_rk4_tag {
   static constexpr const char* name = "gsl_rk4";
   static constexpr const char* description =

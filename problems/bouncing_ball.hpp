@@ -1,6 +1,6 @@
 #pragma once
 // A ball under gravity, launched horizontally, bouncing on the ground plane z = 0 with the
-// lecture's collision response (digest section 5): after the step, a ball found on the
+// lecture's collision response (particle and plane): after the step, a ball found on the
 // wrong side, (x - p).n < 0, is moved back to the plane, and its velocity split into
 // v_n = (v.n) n and v_t = v - v_n becomes v_b = (1 - k_f) v_t - k_r v_n. State (x, z);
 // the ball is a point (the plane is where its centre touches).

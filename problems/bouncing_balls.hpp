@@ -1,7 +1,7 @@
 #pragma once
-// The lecture's closing program (digest section 8): N balls in a box under gravity,
-// bouncing off the four walls and off each other with the lecture's response (digest
-// section 5), resolved at the end of each step as a game does (`end_of_step`):
+// The lecture's closing example program, bouncing balls: N balls in a box under gravity,
+// bouncing off the four walls and off each other with the lecture's collision response
+// (on collisions), resolved at the end of each step as a game does (`end_of_step`):
 // - wall with inward normal n: a ball whose centre is nearer than r is moved back to
 //   distance r, and if it approaches, v_b = (1 - k_f) v_t - k_r v_n;
 // - two balls nearer than 2 r: each is moved back half the overlap along the line of

@@ -1,5 +1,5 @@
 #pragma once
-// The lecture's Euler example (digest section 6): a constant force of 10 N on a 1 kg
+// The lecture's Euler worked example (integration): a constant force of 10 N on a 1 kg
 // body from rest for 10 s. Closed form x(t) = x0 + v0 t + (F/m) t^2 / 2; the exact
 // distance is 500 m. Explicit Euler with dt = 1 s gives 450 m (the lecture's 470 m is
 // wrong), semi-implicit Euler 550 m.

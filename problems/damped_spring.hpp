@@ -1,6 +1,6 @@
 #pragma once
 // A mass on a spring and damper, F = -k_s x - k_d v, i.e. m x'' + k_d x' + k_s x = 0
-// (digest section 4): the physics of two scenes, `damped_spring` (the lecture's RK4
+// (the lecture's springs): the physics of two scenes, `damped_spring` (the lecture's RK4
 // example, below) and `stiff_spring` (problems/stiff_spring.hpp), which differ only in
 // their defaults: a scene is a struct of defaults, the physics is written once here.
 //
@@ -111,7 +111,7 @@ struct spring_damper {
   }
 };
 
-// The lecture's RK4 example (digest sections 4 and 6): a unit mass, k = 10, b = 1.
+// The lecture's RK4 example (springs, integration): a unit mass, k = 10, b = 1.
 struct damped_spring_scene {
   static constexpr std::string_view name = "damped_spring";
   static constexpr std::string_view description = "mass on a spring and damper (lecture's RK4 example)";

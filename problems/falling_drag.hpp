@@ -1,6 +1,6 @@
 #pragma once
 // A body falling from rest under gravity with quadratic air drag F_d = -c |v| v (the
-// standard model at game speeds in air; the lecture's forces, digest section 3, have none).
+// standard model at game speeds in air; the lecture's forces have none).
 // Measured downward (x the distance fallen, v the downward speed):
 //   m dv/dt = m g - c |v| v,   terminal speed v_t = sqrt(m g / c),
 // closed form v = v_t tanh(g t / v_t), x = (v_t^2 / g) ln cosh(g t / v_t)

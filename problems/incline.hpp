@@ -1,5 +1,5 @@
 #pragma once
-// Friction on an incline (digest section 3). Not a time-stepped problem: the lecture's
+// Friction on an incline (the lecture's forces). Not time-stepped: the lecture's
 // two worked examples are closed-form, so this is a small helper checked by the tests.
 #include <cmath>
 

@@ -1,5 +1,5 @@
 #pragma once
-// The lecture's gravitation (digest section 3, f = G m M / r^2) as an orbit: a body of
+// The lecture's gravitation (forces: f = G m M / r^2) as an orbit: a body of
 // mass m around a fixed mass, F = -gm m r / |r|^3 (gm = G M), in the orbital plane, started
 // at periapsis as in the DETEST orbit problems (Hull, Enright, Fellen and Sedgwick, SIAM J.
 // Numer. Anal. 9 (1972), class D):

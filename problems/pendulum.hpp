@@ -1,5 +1,5 @@
 #pragma once
-// Simple pendulum (the lecture's console example, digest section 8):
+// Simple pendulum (the lecture's example programs: the console pendulum):
 // theta'' = -(g/L) sin(theta), released from rest at theta0.
 //
 // State is the angle: x = theta [rad], v = theta' [rad/s]. The integrators see the

@@ -1,5 +1,5 @@
 #pragma once
-// Projectile motion (digest section 2): up is +z, gravity g = [0, 0, -g]. Launched from
+// Projectile motion (the lecture's): up is +z, gravity g = [0, 0, -g]. Launched from
 // the origin along +x at `speed` and `angle_deg` above the horizon. The horizon is the
 // flight time back to launch height, 2 v_z / g. Closed form x(t) = x0 + v0 t + g t^2 / 2.
 #include <Eigen/Core>
@@ -50,7 +50,7 @@ struct projectile {
     return 0.5 * mass_kg * v.squaredNorm() + mass_kg * gravity * x.z();
   }
 
-  // The lecture's formulas (digest section 2), launch and landing at the same height.
+  // The lecture's projectile formulas, launch and landing at the same height.
   double flight_time() const { return 2.0 * launch_velocity().z() / gravity; }
   double apex_time() const { return launch_velocity().z() / gravity; }
   double apex_height() const {

@@ -1,5 +1,5 @@
 #pragma once
-// A block on an incline with the lecture's friction (digest section 3): normal force
+// A block on an incline with the lecture's friction (forces): normal force
 // |F_n| = m g cos(theta), kinetic friction mu_k |F_n| against the motion while it slides,
 // static friction up to mu_s |F_n| at rest. Pushed up the slope with v0, it decelerates
 // at g (sin theta + mu_k cos theta), stops, and then either stays (static friction holds:
@@ -182,7 +182,7 @@ struct incline_block {
   bool locate_contacts() const { return locate != 0.0; }
 };
 
-// The lecture's worked example (digest section 3): 30 degrees, mu_k = 0.5 (and mu_s = 0.5,
+// The lecture's friction worked example: 30 degrees, mu_k = 0.5 (and mu_s = 0.5,
 // its static example's): tan 30 = 0.577 > 0.5, so the block stops and slides back.
 struct sliding_block_scene {
   static constexpr std::string_view name = "sliding_block";

@@ -1,6 +1,6 @@
 #pragma once
 // A rope: `masses` point masses in 3-D joined in a line by the lecture's springs with
-// rest length and a damper along each spring (digest section 4),
+// rest length and a damper along each spring (the lecture's springs),
 //   F_i += k_s (|d| - L0) d/|d| + k_d ((w . u) u),   d = x_{i+1} - x_i, u = d / |d|,
 //   w = v_{i+1} - v_i, and the opposite force on mass i+1,
 // under gravity (-z), the first mass pinned (its force is the pin's: zero), released

@@ -1,9 +1,10 @@
 #pragma once
 // The registry's type erasure: our integrators and the peers as method entries of one
 // shape, and problem_model<P>, the problem_instance of a problem type. Included by
-// study/registry.cpp (the method entries) and by the problem shards CMake generates
-// from study/problem_shard.cpp.in (problem_model<P>, whose instantiations are most of
-// the build: split so that they compile in parallel and in less memory).
+// study/registry.cpp (the method entries) and by the problem units CMake generates from
+// study/problem_unit.cpp.in, one per problem, each with its own problem's header only
+// (problem_model<P>, whose instantiations are most of the build: one problem a unit, so
+// that they compile in parallel and in less memory, and an edit rebuilds one unit).
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -21,7 +22,6 @@
 #include "core/type_list.hpp"
 #include "integrators/all.hpp"
 #include "peers/all.hpp"
-#include "problems/all.hpp"
 #include "study/registry.hpp"
 
 namespace stepbench::registry_detail {
@@ -326,8 +326,13 @@ class problem_model final : public problem_instance {
     });
     return out;
   }
+};
 
-  std::unique_ptr<problem_instance> clone() const override { return std::make_unique<problem_model>(*this); }
+// One problem of the registry: its name and its problem_model's factory. Each problem's
+// unit defines its entry; generated/registry/problem_entries.hpp lists them in order.
+struct problem_entry {
+  std::string_view name;
+  std::unique_ptr<problem_instance> (*make)();
 };
 
 }  // namespace stepbench::registry_detail

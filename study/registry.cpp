@@ -3,39 +3,26 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include <cstddef>
 #include <memory>
 #include <stdexcept>
-#include <utility>
 
+#include "problem_entries.hpp"  // generated from STEPBENCH_PROBLEMS (CMakeLists.txt)
 #include "study/problem_model.hpp"
 
 namespace stepbench {
-namespace registry_detail {
-// Defined in the shards (generated/problem_shard_<k>.cpp), one explicit instantiation
-// each; declared here without its body so that no problem_model is compiled in this file.
-template <std::size_t Shard>
-std::unique_ptr<problem_instance> make_problem_in_shard(std::string_view name);
-}  // namespace registry_detail
 
 using namespace registry_detail;
 
 std::vector<std::string> problem_names() {
   std::vector<std::string> names;
-  for_each_type(all_problems{}, [&]<class P>() { names.emplace_back(P::name); });
+  for (const auto entry : problem_entries) names.emplace_back(entry().name);
   return names;
 }
 
 std::unique_ptr<problem_instance> make_problem(std::string_view name) {
-  std::unique_ptr<problem_instance> out;
-  [&]<std::size_t... S>(std::index_sequence<S...>) {
-    ((out = out ? std::move(out) : make_problem_in_shard<S>(name)), ...);
-  }
-  (std::make_index_sequence<STEPBENCH_PROBLEM_SHARDS>{});
-  if (!out)
-    throw std::invalid_argument(
-        fmt::format("unknown problem '{}' (known: {})", name, fmt::join(problem_names(), ", ")));
-  return out;
+  for (const auto entry : problem_entries)
+    if (const problem_entry e = entry(); e.name == name) return e.make();
+  throw std::invalid_argument(fmt::format("unknown problem '{}' (known: {})", name, fmt::join(problem_names(), ", ")));
 }
 
 const std::vector<method_info>& all_methods() {

@@ -12,7 +12,8 @@
 #include "core/drive.hpp"
 #include "core/measure.hpp"
 #include "integrators/all.hpp"
-#include "problems/all.hpp"
+#include "problems/bouncing_ball.hpp"
+#include "problems/bouncing_balls.hpp"
 #include "study/registry.hpp"
 #include "study/sweep.hpp"
 

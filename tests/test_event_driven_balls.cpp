@@ -1,5 +1,5 @@
 // The exact event-driven truth for many bouncing balls (problems/exact/event_driven_balls.hpp):
-// closed-form contact times, the lecture's response (digest section 5), conservation,
+// closed-form contact times, the lecture's collision response, conservation,
 // containment, determinism, the Zeno guard, and the chaos that limits comparisons.
 #include <gtest/gtest.h>
 

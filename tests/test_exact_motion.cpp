@@ -304,7 +304,7 @@ TEST(falling_drag, satisfies_the_ode) {
 
 double deg(double d) { return d * pi / 180.0; }
 
-// Digest section 3, kinetic example: sliding down 30 degrees with mu_k = 0.5,
+// The lecture's friction, kinetic example: sliding down 30 degrees with mu_k = 0.5,
 // a = g sin 30 - mu_k g cos 30 = 4.9 (1 - sqrt(3) / 2) = 0.65647552... ~ 0.656 m/s^2.
 TEST(sliding_block, lecture_kinetic_example) {
   sliding_block b{9.8, deg(30.0), 0.5, 0.5, -1.0};  // already sliding down at 1 m/s
@@ -320,8 +320,8 @@ TEST(sliding_block, lecture_kinetic_example) {
   }
 }
 
-// Digest section 3, static example: tilting a plane with mu_s = 0.5, the block at rest
-// starts to slide at theta = atan(0.5) = 26.565 degrees (the lecture: 26.6).
+// The lecture's friction, static example: tilting a plane with mu_s = 0.5, the block
+// at rest starts to slide at theta = atan(0.5) = 26.565 degrees (the lecture: 26.6).
 TEST(sliding_block, lecture_slip_angle) {
   const double slip = std::atan(0.5);
   EXPECT_NEAR(slip * 180.0 / pi, 26.57, 5e-3);
@@ -435,7 +435,7 @@ TEST(sliding_block, matches_time_stepped_coulomb_model) {
 // ---------------------------------------------------------------------------------------
 // Friction table
 
-TEST(friction_table, digest_values_by_name) {
+TEST(friction_table, lecture_values_by_name) {
   const auto* ss = find_friction("steel_on_steel");
   ASSERT_NE(ss, nullptr);
   EXPECT_EQ(ss->mu_s_dry, 0.74);

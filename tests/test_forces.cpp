@@ -9,7 +9,10 @@
 #include "core/drive.hpp"
 #include "core/measure.hpp"
 #include "integrators/all.hpp"
-#include "problems/all.hpp"
+#include "problems/falling_drag.hpp"
+#include "problems/kepler.hpp"
+#include "problems/pendulum.hpp"
+#include "problems/sliding_block.hpp"
 #include "study/energy.hpp"
 #include "study/registry.hpp"
 #include "study/sweep.hpp"
@@ -93,13 +96,13 @@ TEST(falling_drag, closed_form_and_the_lectures_free_fall) {
   }
   const auto r = run_fixed(p, rk4{}, 1e-3);
   EXPECT_LT(std::abs(r.final_state.x[0] - p.exact(p.horizon()).x[0]), 1e-10);
-  // c = 0: x = g t^2 / 2 (digest section 1), exactly.
+  // c = 0: x = g t^2 / 2 (the lecture's kinematics), exactly.
   p.drag = 0.0;
   EXPECT_EQ(p.exact(2.0).x[0], 0.5 * 9.8 * 4.0);
   EXPECT_EQ(p.exact(2.0).v[0], 9.8 * 2.0);
 }
 
-// The lecture's worked examples (digest section 3): a block sliding down 30 degrees with
+// The lecture's friction examples (forces): a block sliding down 30 degrees with
 // mu_k = 0.5 accelerates at 0.656 m/s^2; a block at rest with mu_s = 0.5 starts to slide
 // at atan(0.5) = 26.57 degrees.
 TEST(sliding_block, the_lectures_figures) {

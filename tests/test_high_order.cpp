@@ -13,7 +13,9 @@
 #include "integrators/all.hpp"
 #include "integrators/explicit_rk.hpp"
 #include "integrators/tableaus.hpp"
-#include "problems/all.hpp"
+#include "problems/damped_spring.hpp"
+#include "problems/pendulum.hpp"
+#include "problems/spring_chain.hpp"
 #include "references/reference.hpp"
 #include "study/sweep.hpp"
 

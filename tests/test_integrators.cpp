@@ -6,7 +6,9 @@
 #include "integrators/all.hpp"
 #include "integrators/explicit_rk.hpp"
 #include "integrators/tableaus.hpp"
-#include "problems/all.hpp"
+#include "problems/constant_acceleration.hpp"
+#include "problems/damped_spring.hpp"
+#include "problems/pendulum.hpp"
 
 using namespace stepbench;
 

@@ -6,8 +6,11 @@
 
 #include "core/drive.hpp"
 #include "integrators/all.hpp"
-#include "problems/all.hpp"
+#include "problems/constant_acceleration.hpp"
+#include "problems/damped_spring.hpp"
 #include "problems/incline.hpp"
+#include "problems/pendulum.hpp"
+#include "problems/projectile.hpp"
 
 using namespace stepbench;
 
@@ -35,8 +38,9 @@ void expect_satisfies_ode(const P& p, double t, double tol) {
 
 }  // namespace
 
-// Digest section 6: 10 N on 1 kg from rest, 10 s, dt = 1 s. Exact 500 m; explicit
-// Euler 450 m (the lecture's 470 m is wrong); semi-implicit Euler 550 m.
+// The lecture's explicit Euler worked example (integration): 10 N on 1 kg from rest,
+// 10 s, dt = 1 s. Exact 500 m; explicit Euler 450 m (the lecture's 470 m is wrong);
+// semi-implicit Euler 550 m.
 TEST(lecture, euler_example_distances) {
   const constant_acceleration p;
   EXPECT_DOUBLE_EQ(p.exact(10.0).x[0], 500.0);
@@ -56,7 +60,8 @@ TEST(lecture, euler_example_eleven_steps) {
   EXPECT_DOUBLE_EQ((final_state<euler>(p, 1.0, 11.0).x[0]), 550.0);
 }
 
-// Digest section 2: 50 m/s at 70 degrees, g = 9.8. Range s^2 sin(2a) / g, apex
+// The lecture's projectile motion: 50 m/s at 70 degrees, g = 9.8. Range s^2 sin(2a) / g,
+// apex
 // vz^2 / (2 g), flight time 2 vz / g (values computed independently in double
 // precision from those formulas).
 TEST(lecture, projectile_range_apex_flight_time) {
@@ -81,7 +86,8 @@ TEST(lecture, projectile_range_apex_flight_time) {
   EXPECT_NEAR(angles[0], std::numbers::pi / 2 - p.angle_rad(), 1e-12);
 }
 
-// Digest section 3: block on a 30 degree incline, mu_k = 0.5: a = g sin - mu_k g cos,
+// The lecture's friction (forces): block on a 30 degree incline, mu_k = 0.5:
+// a = g sin - mu_k g cos,
 // about 0.656 m/s^2; static mu_s = 0.5 slides from atan(0.5), about 26.57 degrees.
 TEST(lecture, incline_acceleration_and_sliding_angle) {
   const double theta = 30.0 * std::numbers::pi / 180.0;

@@ -1,6 +1,6 @@
 #pragma once
 // Exact motion of a ball bouncing on the ground plane z = 0 with the lecture's collision
-// response (digest section 5): at contact, with the plane's normal n = (0, 1),
+// response (particle and plane): at contact, with the plane's normal n = (0, 1),
 //   v_n = (v . n) n,  v_t = v - v_n,  v_b = (1 - k_f) v_t - k_r v_n,
 // k_r the restitution and k_f the friction, both in [0, 1]. In the x-z plane (x horizontal,
 // z up), gravity (0, -g); launched at t = 0 from (0, h), h > 0, with velocity (vx0, vz0)

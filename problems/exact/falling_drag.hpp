@@ -1,6 +1,6 @@
 #pragma once
 // Exact fall from rest under gravity with quadratic air drag F_d = -c |v| v. (The lecture's
-// forces, digest section 3, are gravity, friction and springs; it has no air drag. This is
+// forces are gravity, the normal force, friction and springs; it has no air drag. This is
 // the standard quadratic model, a drag proportional to v^2 as at game speeds in air.) Measured
 // downward (x = distance fallen, v = downward speed), the body obeys
 //   m dv/dt = m g - c v^2,   v(0) = 0, x(0) = 0,

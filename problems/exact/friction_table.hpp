@@ -1,6 +1,6 @@
 #pragma once
-// The lecture's table of measured friction coefficients (digest section 3; the Korean seed,
-// "마찰계수 - 경험치", lines 270-307): material pairs, static and kinetic, dry ("마른 상태") and
+// The lecture's table of measured friction coefficients (its section on forces, in Korean
+// "마찰계수 - 경험치", empirical values): material pairs, static and kinetic, dry ("마른 상태") and
 // lubricated ("미끈거리는 상태", slippery). Rows are in the lecture's order, numbers exactly as
 // printed ("0.30" and "1.0" are the doubles 0.3 and 1.0); a cell the lecture leaves empty is
 // std::nullopt, never 0. tests/test_exact_motion.cpp re-reads the seed's table, when the seed

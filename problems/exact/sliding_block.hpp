@@ -1,6 +1,6 @@
 #pragma once
 // Exact motion of a block on an incline with Coulomb friction, the lecture's friction
-// section (digest section 3): normal force |F_n| = m g cos(theta), friction mu |F_n| against
+// (among its forces): normal force |F_n| = m g cos(theta), friction mu |F_n| against
 // the motion, kinetic mu_k while sliding, static mu_s (up to mu_s |F_n|) at rest.
 //
 // Coordinate s along the slope, positive UP the slope, s(0) = 0, initial velocity v0 (the

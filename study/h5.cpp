@@ -370,15 +370,8 @@ bool holds_one(const H5::Attribute& a) {
 }
 
 const char* kind_name(attr_kind kind) {
-  switch (kind) {
-    case attr_kind::string:
-      return "string";
-    case attr_kind::number:
-      return "numeric";
-    case attr_kind::integer:
-      return "integer";
-  }
-  return "";
+  constexpr const char* names[] = {"string", "numeric", "integer"};  // in attr_kind's order
+  return names[static_cast<int>(kind)];
 }
 
 // The attribute `name` of obj, checked to hold what `kind` reads (one value unless `one` is false).

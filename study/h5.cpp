@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 
@@ -250,17 +251,26 @@ std::vector<member> checked_members(const H5::CompType& type, const std::string&
 // HDF5 allocates the strings of a read; this hands them back however the read ended.
 class vlen_guard {
  public:
-  vlen_guard(const H5::DataType& type, const H5::DataSpace& space, void* buffer)
-      : type_(type), space_(space), buffer_(buffer) {}
-  ~vlen_guard() { H5Dvlen_reclaim(type_.getId(), space_.getId(), H5P_DEFAULT, buffer_); }
+  vlen_guard(const H5::DataType& type, const H5::DataSpace& space, const H5::DSetMemXferPropList& xfer, void* buffer)
+      : type_(type), space_(space), xfer_(xfer), buffer_(buffer) {}
+  ~vlen_guard() { H5Dvlen_reclaim(type_.getId(), space_.getId(), xfer_.getId(), buffer_); }
   vlen_guard(const vlen_guard&) = delete;
   vlen_guard& operator=(const vlen_guard&) = delete;
 
  private:
   const H5::DataType& type_;
   const H5::DataSpace& space_;
+  const H5::DSetMemXferPropList& xfer_;
   void* buffer_;
 };
+
+// The allocator of the strings a table read returns: a damaged length (stored beside the
+// string, unchecked by HDF5) would have it allocate and fill gigabytes; no string of a
+// file is longer than the file, so a longer one fails the read instead.
+void* bounded_malloc(std::size_t size, void* longest) {
+  return size <= *static_cast<const hsize_t*>(longest) ? std::malloc(size) : nullptr;
+}
+void release(void* p, void*) { std::free(p); }
 
 template <class T>
 T at(const unsigned char* p) {
@@ -306,14 +316,16 @@ table_data read_table(const H5::DataSet& ds) {
   for (const auto& m : members) out.fields_.emplace_back(m.name, m.kind);
   if (out.rows_ == 0) return out;
   std::vector<unsigned char> raw(out.rows_ * record, 0);
+  // HDF5 converts through a buffer of 1 MiB by default, allocated and freed on each read:
+  // glibc handed it back to the system and faulted it in again every time (73,000 page
+  // faults reading a full study, most of its time). Room for the disk records instead, at
+  // most twice the memory ones (a string's heap ID is 16 bytes, its char* 8).
+  H5::DSetMemXferPropList sized;
+  sized.setBuffer(2 * raw.size(), nullptr, nullptr);
+  hsize_t longest = file_size(ds);
+  sized.setVlenMemManager(bounded_malloc, &longest, release, nullptr);
   {
-    const vlen_guard strings(type, space, raw.data());
-    // HDF5 converts through a buffer of 1 MiB by default, allocated and freed on each read:
-    // glibc handed it back to the system and faulted it in again every time (73,000 page
-    // faults reading a full study, most of its time). Room for the disk records instead, at
-    // most twice the memory ones (a string's heap ID is 16 bytes, its char* 8).
-    H5::DSetMemXferPropList sized;
-    sized.setBuffer(2 * raw.size(), nullptr, nullptr);
+    const vlen_guard strings(type, space, sized, raw.data());
     ds.read(raw.data(), type, H5::DataSpace::ALL, H5::DataSpace::ALL, sized);
     for (const auto& m : members)
       for (std::size_t r = 0; r < out.rows_; ++r) {

@@ -408,7 +408,7 @@ def _load(path):
             return _Reader(path, f).study()
     except StudyError:
         raise
-    except (OSError, KeyError, ValueError, RuntimeError) as e:  # h5py's errors on a damaged object
+    except (OSError, KeyError, ValueError, RuntimeError, TypeError, MemoryError) as e:  # h5py's on a damaged object
         raise error(f"damaged or truncated HDF5 file: {_first_line(e)}") from None
 
 

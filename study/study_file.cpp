@@ -1,5 +1,6 @@
 #include "study/study_file.hpp"
 
+#include <fcntl.h>
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -203,6 +204,85 @@ void write_problem(H5::Group& parent, const problem_study& ps, bool timed) {
 
 std::string temp_path_for(const std::string& path) { return fmt::format("{}.tmp.{}", path, ::getpid()); }
 
+// The whole study file built in memory (HDF5's core driver without a backing store;
+// `name` names it in HDF5's messages). The disk is written by write_whole alone: a full
+// disk, a quota or a file-size limit then fails one write(2), never HDF5's flush inside
+// H5Fclose, whose failure left the library holding a half-closed file that crashed it
+// while the stack unwound (SIGSEGV after "H5Fclose failed").
+std::vector<unsigned char> study_image(const study& s, const std::string& name) {
+  H5::FileAccPropList in_memory;
+  in_memory.setCore(std::size_t{1} << 20, false);
+  H5::H5File file(name, H5F_ACC_TRUNC, H5::FileCreatPropList::DEFAULT, in_memory);
+  attr(file, "format_version", study_format_version);
+  attr(file, "version", build_info::version);
+  attr(file, "git_commit", build_info::git_commit);
+  attr(file, "compiler", build_info::compiler);
+  attr(file, "build_type", build_info::build_type);
+  attr(file, "dependencies", build_info::dependencies);
+  attr(file, "build_flags", build_info::build_flags);
+  attr(file, "created_utc", utc_now_iso8601());
+  attr(file, "cpu", cpu_model());
+  attr(file, "cores", core_count());
+  attr(file, "levels", s.options.levels);
+  attr(file, "base_steps", s.options.base_steps);
+  attr(file, "sample_count", s.options.sample_count);
+  attr(file, "tolerances", s.options.tolerances);
+  attr(file, "reference_rtol", s.options.tol.rtol);
+  attr(file, "reference_atol", s.options.tol.atol);
+  attr(file, "fit_metric", "err_pos_max");
+  attr(file, "divergence_factor", blowup_factor);
+  attr(file, "work_budget", s.options.limits.work_budget);
+  attr(file, "max_adaptive_steps", s.options.limits.max_steps);
+  attr(file, "equal_error_targets", equal_error_targets());
+  attr(file, "wall_seconds", s.wall_seconds);
+  attr(file, "timing", static_cast<int>(s.timed.has_value()));
+  if (s.timed) {
+    const auto& t = *s.timed;
+    attr(file, "benchmark_mode", t.mode);
+    attr(file, "benchmark_min_time_s", t.min_time_s);
+    attr(file, "benchmark_repetitions", t.repetitions);
+    attr(file, "benchmark_case_budget_s", t.case_budget_s);
+    attr(file, "benchmark_wall_seconds", t.wall_seconds);
+    attr(file, "cpu_scaling_enabled", t.cpu_scaling_enabled);
+    attr(file, "num_cpus", t.num_cpus);
+    attr(file, "mhz_per_cpu", t.mhz_per_cpu);
+  }
+  write_stability(file, s.stability);  // /stability: our compiled steps' limits (study/stability.hpp)
+  {
+    H5::Group problems = file.createGroup("problems");
+    for (const auto& ps : s.problems) write_problem(problems, ps, s.timed.has_value());
+  }
+  write_substeps(file, s.substeps, s.timed.has_value());
+  write_loop(file, s);           // /loop: the game-loop study (study/loop.hpp), when the study holds one
+  write_energy(file, s.energy);  // /energy: the long-run energy study (study/energy.hpp)
+  file.flush(H5F_SCOPE_GLOBAL);
+  const ssize_t size = H5Fget_file_image(file.getId(), nullptr, 0);
+  std::vector<unsigned char> image(size > 0 ? static_cast<std::size_t>(size) : 0);
+  if (size <= 0 || H5Fget_file_image(file.getId(), image.data(), image.size()) != size)
+    throw H5::FileIException("H5Fget_file_image", "cannot take the file's image");
+  file.close();
+  return image;
+}
+
+// Writes `bytes` to a new file at `path`; 0, or the errno of the call that failed
+// (ENOSPC, EDQUOT, EFBIG under temp_file_guard).
+int write_whole(const std::string& path, const std::vector<unsigned char>& bytes) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd < 0) return errno;
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int error = n < 0 ? errno : EIO;
+      ::close(fd);
+      return error;
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  return ::close(fd) == 0 ? 0 : errno;
+}
+
 }  // namespace
 
 h5::table parameters_table(const std::vector<param_value>& params) {
@@ -304,57 +384,17 @@ void check_writable(const std::string& path) {
 void write_study(const study& s, const std::string& path) {
   check_writable(path);
   const std::string tmp = temp_path_for(path);
-  const temp_file_guard guard(tmp);
   H5::Exception::dontPrint();
+  std::vector<unsigned char> image;
   try {
-    H5::H5File file(tmp, H5F_ACC_TRUNC);
-    attr(file, "format_version", study_format_version);
-    attr(file, "version", build_info::version);
-    attr(file, "git_commit", build_info::git_commit);
-    attr(file, "compiler", build_info::compiler);
-    attr(file, "build_type", build_info::build_type);
-    attr(file, "dependencies", build_info::dependencies);
-    attr(file, "build_flags", build_info::build_flags);
-    attr(file, "created_utc", utc_now_iso8601());
-    attr(file, "cpu", cpu_model());
-    attr(file, "cores", core_count());
-    attr(file, "levels", s.options.levels);
-    attr(file, "base_steps", s.options.base_steps);
-    attr(file, "sample_count", s.options.sample_count);
-    attr(file, "tolerances", s.options.tolerances);
-    attr(file, "reference_rtol", s.options.tol.rtol);
-    attr(file, "reference_atol", s.options.tol.atol);
-    attr(file, "fit_metric", "err_pos_max");
-    attr(file, "divergence_factor", blowup_factor);
-    attr(file, "work_budget", s.options.limits.work_budget);
-    attr(file, "max_adaptive_steps", s.options.limits.max_steps);
-    attr(file, "equal_error_targets", equal_error_targets());
-    attr(file, "wall_seconds", s.wall_seconds);
-    attr(file, "timing", static_cast<int>(s.timed.has_value()));
-    if (s.timed) {
-      const auto& t = *s.timed;
-      attr(file, "benchmark_mode", t.mode);
-      attr(file, "benchmark_min_time_s", t.min_time_s);
-      attr(file, "benchmark_repetitions", t.repetitions);
-      attr(file, "benchmark_case_budget_s", t.case_budget_s);
-      attr(file, "benchmark_wall_seconds", t.wall_seconds);
-      attr(file, "cpu_scaling_enabled", t.cpu_scaling_enabled);
-      attr(file, "num_cpus", t.num_cpus);
-      attr(file, "mhz_per_cpu", t.mhz_per_cpu);
-    }
-    write_stability(file, s.stability);  // /stability: our compiled steps' limits (study/stability.hpp)
-    H5::Group problems = file.createGroup("problems");
-    for (const auto& ps : s.problems) write_problem(problems, ps, s.timed.has_value());
-    write_substeps(file, s.substeps, s.timed.has_value());
-    write_loop(file, s);           // /loop: the game-loop study (study/loop.hpp), when the study holds one
-    write_energy(file, s.energy);  // /energy: the long-run energy study (study/energy.hpp)
-    file.close();
+    image = study_image(s, tmp);
   } catch (const H5::Exception& e) {
-    std::remove(tmp.c_str());
     throw std::runtime_error(fmt::format("cannot write results file '{}': HDF5: {}", path, e.getDetailMsg()));
-  } catch (...) {
+  }
+  const temp_file_guard guard(tmp);
+  if (const int error = write_whole(tmp, image)) {
     std::remove(tmp.c_str());
-    throw;
+    throw std::runtime_error(fmt::format("cannot write results file '{}': {}", path, std::strerror(error)));
   }
   std::error_code ec;
   std::filesystem::rename(tmp, path, ec);

@@ -1,14 +1,20 @@
 #include "study/study_reader.hpp"
 
 #include <H5Cpp.h>
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <stdexcept>
 
 #include "core/measure.hpp"
 #include "study/h5.hpp"
+#include "study/schema.hpp"
 #include "study/study_file.hpp"
 
 namespace stepbench {
@@ -40,26 +46,18 @@ study_method read_method(const H5::Group& g, const std::string& name) {
   m.declared_order_holds = static_cast<int>(h5::long_attr(g, "declared_order_holds"));
   m.fit_levels = h5::int_array_attr(g, "fit_levels");
   if (!h5::is_dataset(g, "runs")) throw std::runtime_error(fmt::format("missing dataset 'runs' in {}", g.getObjName()));
-  const H5::DataSet ds = g.openDataSet("runs");
-  if (ds.getTypeClass() != H5T_COMPOUND)
-    throw std::runtime_error(fmt::format("{}/runs is not a table", g.getObjName()));
-  const H5::CompType type = ds.getCompType();
-  for (int i = 0; i < type.getNmembers(); ++i) {
-    const std::string field = type.getMemberName(i);
-    const auto cls = type.getMemberClass(i);
-    if (cls == H5T_FLOAT) {
-      m.columns[field] = h5::read_doubles(ds, field);
-    } else if (cls == H5T_INTEGER) {
-      const auto ints = h5::read_ints(ds, field);
-      m.columns[field].assign(ints.begin(), ints.end());
-    } else if (cls == H5T_STRING && field == "note") {
-      m.notes = h5::read_strings(ds, field);
-    }
+  const h5::table_data runs = h5::read_table(g.openDataSet("runs"));
+  for (const auto& [field, kind] : runs.fields()) {
+    if (kind != h5::table_data::kind::text)
+      m.columns[field] = runs.doubles(field);
+    else if (field == "note")
+      m.notes = runs.strings(field);
   }
-  for (const char* required : {"param", "steps", "force_evals", "err_pos_final", "err_vel_final", "err_pos_max",
-                               "err_pos_rms", "diverged", "failed", "skipped"})
-    if (!m.columns.count(required))
-      throw std::runtime_error(fmt::format("missing field '{}' in {}/runs", required, g.getObjName()));
+  // Every field the schema declares for runs (the timing fields only in a timed study).
+  for (const auto& group : schema::find("runs").groups)
+    for (const auto& f : group.fields)
+      if (!group.timed_only && !runs.has(std::string(f.name)))
+        throw std::runtime_error(fmt::format("missing field '{}' in {}/runs", f.name, g.getObjName()));
   return m;
 }
 
@@ -75,10 +73,10 @@ study_problem read_problem(const H5::Group& g, const std::string& name) {
   // The declared parameters, apart from the derived attributes (format 3).
   if (!h5::is_dataset(g, "parameters"))
     throw std::runtime_error(fmt::format("missing dataset 'parameters' in {}", g.getObjName()));
-  const H5::DataSet params = g.openDataSet("parameters");
-  const auto names = h5::read_strings(params, "name");
-  const auto values = h5::read_doubles(params, "value");
-  for (std::size_t i = 0; i < names.size() && i < values.size(); ++i) p.params[names[i]] = values[i];
+  const h5::table_data params = h5::read_table(g.openDataSet("parameters"));
+  const auto& names = params.strings("name");
+  const auto values = params.doubles("value");
+  for (std::size_t i = 0; i < names.size(); ++i) p.params[names[i]] = values[i];
   if (h5::is_group(g, "reference")) {
     const H5::Group refs = g.openGroup("reference");
     for (const auto& src : h5::children(refs)) {
@@ -115,6 +113,74 @@ const study_problem* study_data::find(const std::string& problem) const {
   return nullptr;
 }
 
+namespace {
+
+// The whole file, unchecked for crashes (read_study checks first). Errors are
+// std::runtime_error or H5::Exception, without the file's name.
+study_data read_file(const std::string& path) {
+  study_data out;
+  out.path = path;
+  if (!H5::H5File::isHdf5(path)) throw std::runtime_error("not an HDF5 file");
+  const H5::H5File file(path, H5F_ACC_RDONLY);
+  if (!file.attrExists("format_version")) throw std::runtime_error("not a stepbench study (no format_version)");
+  out.format_version = h5::long_attr(file, "format_version");
+  if (out.format_version > study_format_version)
+    throw std::runtime_error(fmt::format("written by a newer stepbench (format_version {}; this build reads {} to {})",
+                                         out.format_version, study_format_read_min, study_format_version));
+  if (out.format_version < study_format_read_min)
+    throw std::runtime_error(fmt::format("format_version {} is older than this build reads ({}); run the study again",
+                                         out.format_version, study_format_read_min));
+  out.meta = h5::string_attrs(file);
+  out.settings = h5::number_attrs(file, false);
+  out.timed = h5::long_attr(file, "timing") != 0;
+  if (h5::is_group(file, "stability")) {
+    const H5::Group g = file.openGroup("stability");
+    if (!h5::is_dataset(g, "limits")) throw std::runtime_error("missing dataset /stability/limits");
+    const h5::table_data limits = h5::read_table(g.openDataSet("limits"));
+    const auto &integrator = limits.strings("integrator"), &test = limits.strings("test");
+    const auto theory = limits.doubles("theory"), measured = limits.doubles("measured");
+    const auto &all = limits.ints("unstable_for_all_dt"), &uncond = limits.ints("unconditionally_stable");
+    for (std::size_t i = 0; i < integrator.size(); ++i)
+      out.stability.push_back({integrator[i], test[i], theory[i], measured[i], all[i] != 0, uncond[i] != 0});
+  }
+  if (!h5::is_group(file, "problems")) throw std::runtime_error("missing group 'problems'");
+  const H5::Group problems = file.openGroup("problems");
+  for (const auto& name : h5::children(problems)) out.problems.push_back(read_problem(problems.openGroup(name), name));
+  return out;
+}
+
+// HDF5 1.10 trusts sizes stored in the file where no call of its API can check them
+// first (a global heap object's length when it reads a variable-length string, an
+// attribute message's size when it looks an attribute up): a damaged file can make it
+// copy out of bounds and crash. So the file is read first in a child process, its output
+// discarded; the child ends normally whether it read the file or refused it. Returns
+// how it ended when it did not ("SIGSEGV"; "exit 1": a sanitizer's report), else "".
+std::string crash_reading(const std::string& path) {
+  std::fflush(nullptr);
+  const pid_t child = ::fork();
+  if (child < 0)
+    throw std::runtime_error(fmt::format("cannot start the process that checks it: {}", std::strerror(errno)));
+  if (child == 0) {
+    const int null = ::open("/dev/null", O_WRONLY);
+    ::dup2(null, STDOUT_FILENO);
+    ::dup2(null, STDERR_FILENO);
+    try {
+      read_file(path);
+    } catch (...) {
+    }
+    std::_Exit(0);
+  }
+  int status = 0;
+  while (::waitpid(child, &status, 0) < 0)
+    if (errno != EINTR)
+      throw std::runtime_error(fmt::format("cannot wait for the process that checks it: {}", std::strerror(errno)));
+  if (WIFSIGNALED(status)) return fmt::format("SIG{}", sigabbrev_np(WTERMSIG(status)));
+  if (WEXITSTATUS(status) != 0) return fmt::format("exit {}", WEXITSTATUS(status));
+  return {};
+}
+
+}  // namespace
+
 study_data read_study(const std::string& path) {
   const auto fail = [&](const std::string& what) {
     return std::runtime_error(fmt::format("cannot read study file '{}': {}", path, what));
@@ -123,55 +189,15 @@ study_data read_study(const std::string& path) {
   if (!std::filesystem::exists(path, ec)) throw fail("no such file");
   if (std::filesystem::is_directory(path, ec)) throw fail("it is a directory");
   H5::Exception::dontPrint();
-  study_data out;
-  out.path = path;
   try {
-    if (!H5::H5File::isHdf5(path)) throw fail("not an HDF5 file");
-    const H5::H5File file(path, H5F_ACC_RDONLY);
-    if (!file.attrExists("format_version")) throw fail("not a stepbench study (no format_version)");
-    out.format_version = h5::long_attr(file, "format_version");
-    if (out.format_version > study_format_version)
-      throw fail(fmt::format("written by a newer stepbench (format_version {}; this build reads {} to {})",
-                             out.format_version, study_format_read_min, study_format_version));
-    if (out.format_version < study_format_read_min)
-      throw fail(fmt::format("format_version {} is older than this build reads ({}); run the study again",
-                             out.format_version, study_format_read_min));
-    for (unsigned i = 0; i < static_cast<unsigned>(file.getNumAttrs()); ++i) {
-      const H5::Attribute a = file.openAttribute(i);
-      if (a.getTypeClass() == H5T_STRING) {
-        std::string v;
-        a.read(a.getStrType(), v);
-        out.meta[a.getName()] = v;
-      } else if ((a.getTypeClass() == H5T_FLOAT || a.getTypeClass() == H5T_INTEGER) &&
-                 a.getSpace().getSimpleExtentNpoints() == 1) {
-        double v = 0;
-        a.read(H5::PredType::NATIVE_DOUBLE, &v);
-        out.settings[a.getName()] = v;
-      }
-    }
-    out.timed = h5::long_attr(file, "timing") != 0;
-    if (h5::is_group(file, "stability")) {
-      const H5::Group g = file.openGroup("stability");
-      if (!h5::is_dataset(g, "limits")) throw fail("missing dataset /stability/limits");
-      const H5::DataSet ds = g.openDataSet("limits");
-      const auto integrator = h5::read_strings(ds, "integrator"), test = h5::read_strings(ds, "test");
-      const auto theory = h5::read_doubles(ds, "theory"), measured = h5::read_doubles(ds, "measured");
-      const auto all = h5::read_ints(ds, "unstable_for_all_dt"), uncond = h5::read_ints(ds, "unconditionally_stable");
-      for (std::size_t i = 0; i < integrator.size(); ++i)
-        out.stability.push_back({integrator[i], test[i], theory[i], measured[i], all[i] != 0, uncond[i] != 0});
-    }
-    if (!h5::is_group(file, "problems")) throw fail("missing group 'problems'");
-    const H5::Group problems = file.openGroup("problems");
-    for (const auto& name : h5::children(problems))
-      out.problems.push_back(read_problem(problems.openGroup(name), name));
+    if (const std::string crash = crash_reading(path); !crash.empty())
+      throw std::runtime_error(fmt::format("damaged: reading it crashes the HDF5 library ({})", crash));
+    return read_file(path);
   } catch (const H5::Exception& e) {
     throw fail(fmt::format("HDF5: {} (truncated or corrupt?)", e.getDetailMsg()));
   } catch (const std::runtime_error& e) {
-    const std::string what = e.what();
-    if (what.rfind("cannot read study file", 0) == 0) throw;
-    throw fail(what);
+    throw fail(e.what());
   }
-  return out;
 }
 
 std::vector<wp_method> work_precision_input(const study_problem& p, const std::string& metric, bool timed) {

@@ -26,10 +26,14 @@ temp_file_guard::temp_file_guard(const std::string& temp_path) {
   action.sa_handler = remove_temp_and_reraise;
   sigemptyset(&action.sa_mask);
   for (std::size_t i = 0; i < std::size(signals_); ++i) sigaction(signals_[i], &action, &previous_[i]);
+  struct sigaction ignore {};
+  ignore.sa_handler = SIG_IGN;
+  sigaction(SIGXFSZ, &ignore, &previous_file_size_);
 }
 
 temp_file_guard::~temp_file_guard() {
   for (std::size_t i = 0; i < std::size(signals_); ++i) sigaction(signals_[i], &previous_[i], nullptr);
+  sigaction(SIGXFSZ, &previous_file_size_, nullptr);
   temp_being_written[0] = 0;
 }
 

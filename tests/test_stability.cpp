@@ -198,12 +198,12 @@ TEST(stability, written_to_the_study_file) {
   }
   H5::H5File file(path.string(), H5F_ACC_RDONLY);
   H5::Group g = file.openGroup("stability");
-  const H5::DataSet limits = g.openDataSet("limits");
-  const auto names = h5::read_strings(limits, "integrator");
-  const auto tests = h5::read_strings(limits, "test");
-  const auto theory = h5::read_doubles(limits, "theory");
-  const auto measured = h5::read_doubles(limits, "measured");
-  const auto uncond = h5::read_ints(limits, "unconditionally_stable");
+  const h5::table_data limits = h5::read_table(g.openDataSet("limits"));
+  const auto& names = limits.strings("integrator");
+  const auto& tests = limits.strings("test");
+  const auto theory = limits.doubles("theory");
+  const auto measured = limits.doubles("measured");
+  const auto& uncond = limits.ints("unconditionally_stable");
   ASSERT_EQ(names.size(), data().limits.size());
   for (std::size_t k = 0; k < names.size(); ++k) {
     const auto& l = data().limits[k];

@@ -8,6 +8,8 @@ attribute, field or dataset is a StudyError naming the file and what is missing.
 Nothing is filled in with a default.
 """
 import os
+import pickle
+import signal
 from dataclasses import dataclass, field
 
 import h5py
@@ -87,7 +89,7 @@ def _decoded(rows):
     out = rows.copy()
     for name in rows.dtype.names:
         if rows.dtype[name].kind in "OS":
-            out[name] = [_text(v) for v in rows[name]]
+            out[name] = np.char.decode(rows[name].astype(bytes))  # in one call, not a Python loop
     return out
 
 
@@ -240,7 +242,7 @@ class _Reader:
     def need_column(self, parent, table, rows, field, allowed):
         """Every value of column `field` of the table `parent`/`table` (read as `rows`) is
         one of `allowed`."""
-        for v in rows[field]:
+        for v in dict.fromkeys(rows[field].tolist()):  # each value once, in the order of the rows
             self.need_value(parent[table], field, v, allowed)
 
     @staticmethod
@@ -285,14 +287,13 @@ class _Reader:
     def check_derived(self, g, p):
         """The derived tables name rows of `runs` by (method, param): each must exist, or
         the report would print a figure it cannot trace to a run."""
-        names = {m.name: m for m in p.methods}
+        params = {m.name: set(m.param.tolist()) for m in p.methods}
         tables = [("equal_error", p.equal_error)] + [(f"front_{k}", v) for k, v in p.fronts.items()]
         for table, rows in tables:
-            for r in rows:
-                m = names.get(r["method"])
-                if m is None or m.row_at(r["param"]) is None:
+            for method, param in zip(rows["method"].tolist(), rows["param"].tolist()):
+                if param not in params.get(method, ()):
                     raise self.error(f"{g.name}/{table} names a run that {g.name}/methods lacks "
-                                     f"({r['method']} at {r['param']:g})")
+                                     f"({method} at {param:g})")
 
     def need_array(self, parent, name, ndim):
         ds = parent.get(name)
@@ -356,7 +357,38 @@ class _Reader:
 
 
 def load(path):
-    """The study at `path`, checked; StudyError (one line, naming the file) otherwise."""
+    """The study at `path`, checked; StudyError (one line, naming the file) otherwise.
+
+    HDF5 1.10 trusts sizes stored in the file where h5py cannot check them first (a
+    global heap object's length, an attribute message's size): a damaged file can crash
+    it. So the file is read in a child process, which hands back the study (or the error)
+    pickled; a child ended by a signal is a damaged file, not a dead report."""
+    readable, writable = os.pipe()
+    pid = os.fork()
+    if pid == 0:
+        os.close(readable)
+        os.dup2(os.open(os.devnull, os.O_WRONLY), 2)  # HDF5's own diagnostics: the error says it
+        try:
+            result = _load(path)
+        except Exception as e:  # noqa: BLE001 -- raised again in the parent
+            result = e
+        with os.fdopen(writable, "wb") as out:
+            pickle.dump(result, out, protocol=pickle.HIGHEST_PROTOCOL)
+        os._exit(0)
+    os.close(writable)
+    with os.fdopen(readable, "rb") as inp:
+        data = inp.read()
+    status = os.waitpid(pid, 0)[1]
+    if os.WIFSIGNALED(status) or not data:
+        end = signal.Signals(os.WTERMSIG(status)).name if os.WIFSIGNALED(status) else f"exit {status >> 8}"
+        raise StudyError(f"cannot read study file '{path}': damaged: reading it crashes the HDF5 library ({end})")
+    result = pickle.loads(data)
+    if isinstance(result, Exception):
+        raise result
+    return result
+
+
+def _load(path):
     def error(what):
         return StudyError(f"cannot read study file '{path}': {what}")
     if not os.path.exists(path):
@@ -376,7 +408,7 @@ def load(path):
             return _Reader(path, f).study()
     except StudyError:
         raise
-    except (OSError, KeyError, ValueError, RuntimeError) as e:  # h5py's errors on a damaged object
+    except (OSError, KeyError, ValueError, RuntimeError, TypeError, MemoryError) as e:  # h5py's on a damaged object
         raise error(f"damaged or truncated HDF5 file: {_first_line(e)}") from None
 
 

@@ -7,8 +7,8 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "cli/commands.hpp"
 #include "cli/args.hpp"
+#include "cli/commands.hpp"
 
 namespace stepbench::cli {
 namespace {

@@ -10,8 +10,8 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "cli/commands.hpp"
 #include "cli/args.hpp"
+#include "cli/commands.hpp"
 #include "core/work_precision.hpp"
 #include "study/compare_render.hpp"
 

@@ -10,8 +10,8 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "cli/commands.hpp"
 #include "cli/args.hpp"
+#include "cli/commands.hpp"
 #include "study/table_render.hpp"
 
 namespace stepbench::cli {
@@ -113,7 +113,8 @@ command add_energy(CLI::App& app) {
   sub->add_flag("--json", a->json, "print JSON: one record per problem and integrator");
   sub->add_option("--periods", a->periods, "periods to run (whole number)")->capture_default_str();
   sub->add_option("--problem", a->problems, "pendulum and/or kepler (repeatable; default both)");
-  sub->add_option("--set", a->sets, "override a parameter, problem.name=value, or name=value with one --problem (repeatable)");
+  sub->add_option("--set", a->sets,
+                  "override a parameter, problem.name=value, or name=value with one --problem (repeatable)");
   return {sub, [a] { return run_energy(*a); }};
 }
 

@@ -11,9 +11,9 @@ int main(int argc, char** argv) {
   using namespace stepbench::cli;
   CLI::App app{"stepbench: accuracy, stability and speed of time integrators on game-physics problems"};
   app.require_subcommand(1);
-  const std::vector<command> commands{add_list(app),      add_run(app),    add_sweep(app),
-                                      add_advise(app),    add_ratios(app), add_compare(app),
-                                      add_stability(app), add_loop(app),   add_energy(app), add_schema(app)};
+  const std::vector<command> commands{add_list(app),   add_run(app),     add_sweep(app),     add_advise(app),
+                                      add_ratios(app), add_compare(app), add_stability(app), add_loop(app),
+                                      add_energy(app), add_schema(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -6,10 +6,10 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "cli/args.hpp"
 #include "cli/commands.hpp"
 #include "core/drive.hpp"
 #include "core/measure.hpp"
-#include "cli/args.hpp"
 #include "study/registry.hpp"
 
 namespace stepbench::cli {

@@ -5,8 +5,8 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "cli/commands.hpp"
 #include "cli/args.hpp"
+#include "cli/commands.hpp"
 #include "study/study_file.hpp"
 
 namespace stepbench::cli {
@@ -70,7 +70,8 @@ command add_sweep(CLI::App& app) {
   sub->add_option("--integrator,--method", a->opts.methods, "restrict to these methods (repeatable)");
   sub->add_option("--levels", a->opts.levels, "timesteps in the halving ladder")->capture_default_str();
   sub->add_option("--base-steps", a->opts.base_steps, "steps at the coarsest level")->capture_default_str();
-  sub->add_option("--set", a->sets, "override a parameter, problem.name=value, or name=value with one --problem (repeatable)");
+  sub->add_option("--set", a->sets,
+                  "override a parameter, problem.name=value, or name=value with one --problem (repeatable)");
   sub->add_option("--out", a->out, "study file to write")->capture_default_str();
   sub->add_flag("--quick", a->quick, "8 levels and every other tolerance (the CI study)");
   sub->add_flag("--quiet", a->quiet, "print only the summary line");

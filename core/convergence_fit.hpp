@@ -27,7 +27,7 @@ struct fit_input {
   std::vector<double> error;  // the fitted metric at each level
   std::vector<long> steps;
   std::vector<bool> incomplete;  // the row did not complete (diverged, failed or skipped): not fitted
-  double scale = 1.0;  // size of the motion in the metric's unit
+  double scale = 1.0;            // size of the motion in the metric's unit
 };
 
 struct fit_result {

@@ -363,7 +363,7 @@ STEPBENCH_FLATTEN drive_result<typename P::vec> drive_adaptive(const P& problem,
     if ((horizon - t) / h > 10.0 * static_cast<double>(max_steps - out.steps)) {
       out.over_budget = true;
       out.stop_reason = "over the step budget of " + std::to_string(max_steps) + " steps: at t = " + std::to_string(t) +
-                    " the step size " + fmt_g(h) + " would need about " + fmt_g((horizon - t) / h) + " more";
+                        " the step size " + fmt_g(h) + " would need about " + fmt_g((horizon - t) / h) + " more";
       break;
     }
     if (!a.accepted) {

@@ -63,8 +63,10 @@ struct run_result {
   long rejected_steps = 0;  // attempts rejected by an error test or a failed solve
   work_counters work{};     // force (right-hand-side) evaluations and an implicit method's work
   bool non_finite = false;  // a NaN or Inf appeared; the run stopped there
-  std::string stop_reason;  // why the run stopped before the horizon: a solver error, or the work budget (`skipped`); empty if it did not
-  bool skipped = false;     // not run to the end because it would exceed the work budget (reason in `stop_reason`)
+  // Why the run stopped before the horizon: a solver error, or the work budget
+  // (`skipped`); empty when it reached the horizon.
+  std::string stop_reason;
+  bool skipped = false;  // not run to the end because it would exceed the work budget (reason in `stop_reason`)
   std::vector<double> sample_t;
   std::vector<std::vector<double>> sample_y;  // [x; v] at sample_t
   std::vector<double> final_y;                // [x; v] where the run stopped

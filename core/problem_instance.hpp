@@ -19,7 +19,6 @@ namespace stepbench {
 struct loop_config;  // core/game_loop.hpp
 struct loop_result;
 
-
 class problem_instance {
  public:
   virtual ~problem_instance() = default;

@@ -300,8 +300,7 @@ double measured_step_cost_ns(const problem_study& ps, std::string_view method) {
     if (ms.info.name != method) continue;
     std::vector<double> per_step;
     for (const auto& r : ms.rows)
-      if (r.metrics.completed() && r.steps > 0 &&
-          std::isfinite(r.time.time_ns) && r.time.time_ns > 0.0)
+      if (r.metrics.completed() && r.steps > 0 && std::isfinite(r.time.time_ns) && r.time.time_ns > 0.0)
         per_step.push_back(r.time.time_ns / static_cast<double>(r.steps));
     return median(per_step);
   }

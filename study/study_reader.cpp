@@ -214,8 +214,9 @@ std::vector<wp_method> work_precision_input(const study_problem& p, const std::s
     const auto& time = timed ? m.col("time_ns") : none;
     const auto& cut = timed ? m.col("cut") : zeros;
     for (std::size_t i = 0; i < param.size(); ++i)
-      w.rows.push_back({param[i], err[i], time[i], evals[i], row_completed(diverged[i] != 0, failed[i] != 0, skipped[i] != 0),
-                        diverged[i] != 0, cut[i] != 0});
+      w.rows.push_back({param[i], err[i], time[i], evals[i],
+                        row_completed(diverged[i] != 0, failed[i] != 0, skipped[i] != 0), diverged[i] != 0,
+                        cut[i] != 0});
     out.push_back(std::move(w));
   }
   return out;

@@ -28,17 +28,22 @@ namespace stepbench::registry_detail {
 
 // Our integrators as registry entries: the same shape as a peer's (info, applies,
 // prepare), so that every method is run and measured by the same code.
+// What every one of our integrators declares (its name, description, order and
+// capabilities), as a registry entry of the given kind.
+template <class I>
+method_info ours_info(method_kind kind) {
+  return {.name = std::string(I::name),
+          .description = std::string(I::description),
+          .origin = method_origin::ours,
+          .kind = kind,
+          .declared_order = static_cast<double>(I::order),
+          .traits = I::traits,
+          .library = "stepbench"};
+}
+
 template <integrator I>
 struct ours_fixed {
-  static method_info info() {
-    return {.name = std::string(I::name),
-            .description = std::string(I::description),
-            .origin = method_origin::ours,
-            .kind = method_kind::fixed_step,
-            .declared_order = static_cast<double>(I::order),
-            .traits = I::traits,
-            .library = "stepbench"};
-  }
+  static method_info info() { return ours_info<I>(method_kind::fixed_step); }
   template <problem P>
   static auto prepare(const P& p, double dt, double horizon, std::span<const double> times, const run_limits&) {
     return [p, dt, horizon, plan = plan_records(horizon, dt, times)] { return drive(p, I{}, dt, horizon, plan); };
@@ -47,15 +52,7 @@ struct ours_fixed {
 
 template <adaptive_integrator I>
 struct ours_adaptive {
-  static method_info info() {
-    return {.name = std::string(I::name),
-            .description = std::string(I::description),
-            .origin = method_origin::ours,
-            .kind = method_kind::adaptive,
-            .declared_order = static_cast<double>(I::order),
-            .traits = I::traits,
-            .library = "stepbench"};
-  }
+  static method_info info() { return ours_info<I>(method_kind::adaptive); }
   template <problem P>
   static auto prepare(const P& p, double tol, double horizon, std::span<const double> times, const run_limits& limits) {
     // The budget in steps: the work budget over the coordinates and the method's force

@@ -19,7 +19,7 @@ struct ode_system {
   std::function<void(double t, std::span<const double> y, std::span<double> dydt)> rhs;
   // Step budget between two output times: a problem too stiff or too large for a
   // solver fails in bounded time with the solver's message (the caller scales it with
-  // the problem's size and stiffness: study/registry.cpp, reference_step_budget).
+  // the problem's size and stiffness: core/first_order.hpp, reference_step_budget).
   long max_steps_per_output = 200'000;
   // Optional, for the stiff solver (CVODE BDF): the force Jacobians of a second-order
   // system y = [x; v], f = [v; F(t, x, v) / m] with n / 2 coordinates. force_jacobian(t,

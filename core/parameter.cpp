@@ -11,16 +11,16 @@ namespace stepbench {
 std::string constraint::text() const {
   const bool lo_inf = std::isinf(lo), hi_inf = std::isinf(hi);
   if (whole) {
-    if (hi_inf) return fmt::format("a whole number from {:g}", lo);
-    return fmt::format("a whole number from {:g} to {:g}", lo, hi);
+    if (hi_inf) return fmt::format("a whole number from {}", lo);
+    return fmt::format("a whole number from {} to {}", lo, hi);
   }
   if (lo_inf && hi_inf) return "finite";
   if (hi_inf) {
     if (lo == 0.0 && !lo_closed) return "a positive finite number";
-    return fmt::format("finite and {} {:g}", lo_closed ? ">=" : ">", lo);
+    return fmt::format("finite and {} {}", lo_closed ? ">=" : ">", lo);
   }
-  if (lo_inf) return fmt::format("finite and {} {:g}", hi_closed ? "<=" : "<", hi);
-  return fmt::format("in {}{:g}, {:g}{}", lo_closed ? '[' : '(', lo, hi, hi_closed ? ']' : ')');
+  if (lo_inf) return fmt::format("finite and {} {}", hi_closed ? "<=" : "<", hi);
+  return fmt::format("in {}{}, {}{}", lo_closed ? '[' : '(', lo, hi, hi_closed ? ']' : ')');
 }
 
 std::vector<named_value> contact_mode_names() {

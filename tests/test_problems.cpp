@@ -6,11 +6,14 @@
 
 #include "core/drive.hpp"
 #include "integrators/all.hpp"
+#include "problems/bouncing_ball.hpp"
 #include "problems/constant_acceleration.hpp"
 #include "problems/damped_spring.hpp"
 #include "problems/incline.hpp"
 #include "problems/pendulum.hpp"
 #include "problems/projectile.hpp"
+#include "problems/sliding_block.hpp"
+#include "problems/spring_chain.hpp"
 
 using namespace stepbench;
 

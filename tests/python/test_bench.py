@@ -212,7 +212,8 @@ def test_set_reaches_the_timed_cases_and_the_study(bench, stepbench, tmp_path):
     run_bench(bench, "--problem=damped_spring", "--set=damped_spring.k_d=3", "--benchmark_filter=^damped_spring/rk4/dt:0.0390625/",
               f"--benchmark_out={out}", "--benchmark_out_format=json", f"--study_out={path}", check=True)
     with h5py.File(path, "r") as f:
-        assert f["problems/damped_spring"].attrs["k_d"] == 3.0
+        params = f["problems/damped_spring/parameters"][()]
+        assert params[params["name"] == b"k_d"]["value"][0] == 3.0
     case = [b for b in json.loads(out.read_text())["benchmarks"] if b["run_type"] == "iteration"][0]
 
     def run(*extra):

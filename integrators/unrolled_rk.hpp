@@ -79,10 +79,19 @@ constexpr double sum(const std::array<double, S>& w) {
 // dst = base + sum_k (scale w_k) terms[j_k], in increasing j (the newest term last).
 // (Function templates rather than lambdas: GCC's flatten does not always inline a
 // generic lambda's call operator.)
+// A state of fixed size is summed coefficient by coefficient on plain doubles: the same
+// operations in the same order as Eigen's expression (so the same roundings), but a
+// sum of a dozen terms as one Eigen expression is a tree of a dozen nodes, which GCC
+// keeps on the stack instead of in registers (rk8 on one coordinate: a quarter slower).
 template <const auto& R, class Dst, class Base, class Terms, std::size_t... K>
 [[gnu::always_inline]] inline void assign_sum(Dst& dst, const Base& base, [[maybe_unused]] double scale,
                                               [[maybe_unused]] const Terms& terms, std::index_sequence<K...>) {
-  dst = (base + ... + ((scale * R.w[K]) * terms[R.j[K]]));
+  if constexpr (Dst::SizeAtCompileTime != Eigen::Dynamic) {
+    for (Eigen::Index i = 0; i < Dst::SizeAtCompileTime; ++i)
+      dst.coeffRef(i) = (base.coeff(i) + ... + ((scale * R.w[K]) * terms[R.j[K]].coeff(i)));
+  } else {
+    dst = (base + ... + ((scale * R.w[K]) * terms[R.j[K]]));
+  }
 }
 template <const auto& R, class Dst, class Base, class Terms>
 [[gnu::always_inline]] inline void assign_sum(Dst& dst, const Base& base, double scale, const Terms& terms) {
@@ -92,7 +101,12 @@ template <const auto& R, class Dst, class Base, class Terms>
 // dst = sum_k (scale w_k) terms[j_k] (at least one term).
 template <const auto& R, class Dst, class Terms, std::size_t... K>
 [[gnu::always_inline]] inline void assign_sum(Dst& dst, double scale, const Terms& terms, std::index_sequence<K...>) {
-  dst = (... + ((scale * R.w[K]) * terms[R.j[K]]));
+  if constexpr (Dst::SizeAtCompileTime != Eigen::Dynamic) {
+    for (Eigen::Index i = 0; i < Dst::SizeAtCompileTime; ++i)
+      dst.coeffRef(i) = (... + ((scale * R.w[K]) * terms[R.j[K]].coeff(i)));
+  } else {
+    dst = (... + ((scale * R.w[K]) * terms[R.j[K]]));
+  }
 }
 template <const auto& R, class Dst, class Terms>
 [[gnu::always_inline]] inline void assign_sum(Dst& dst, double scale, const Terms& terms) {

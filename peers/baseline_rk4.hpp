@@ -6,11 +6,10 @@
 // same latency ordering as ours. Same recording of samples as our loop, so the
 // comparison is of the step alone.
 #include <cmath>
-#include <span>
+#include <utility>
 
-#include "core/drive.hpp"
-#include "core/flatten.hpp"
 #include "core/method.hpp"
+#include "peers/step_adapter.hpp"
 #include "problems/damped_spring.hpp"
 #include "problems/pendulum.hpp"
 
@@ -28,57 +27,47 @@ inline auto baseline_acceleration(const pendulum& p) {
   return [g_over_l = p.gravity / p.length_m](double x, double) { return -g_over_l * std::sin(x); };
 }
 
-// The loop every baseline shares: one scalar degree of freedom (x, v) stepped by `step`
-// on the fixed-step loop (core/drive.hpp), samples recorded, a non-finite state stopping
-// the run. Inlined into each baseline's flattened run, so it adds nothing to the step.
-template <class Vec, class Step>
-[[gnu::always_inline]] inline drive_result<Vec> run_scalar_baseline(double& x, double& v, double dt, double horizon,
-                                                                    std::span<const record_point> plan,
-                                                                    long force_evals_per_step, Step&& step) {
-  drive_result<Vec> out;
-  out.start(1, plan.size());
-  const loop_end end = fixed_step_loop(
-      dt, horizon, plan, step, [](double) {},
-      [&](double t) {
-        if (!std::isfinite(x) || !std::isfinite(v)) return out.non_finite = true, false;
-        out.record(t, Vec(x), Vec(v));
-        return true;
-      });
-  out.steps = end.steps;
-  out.t_final = end.t;
-  out.work.force_evals = force_evals_per_step * end.steps;
-  out.non_finite = out.non_finite || !std::isfinite(x) || !std::isfinite(v);
-  out.final_state = {Vec(x), Vec(v)};
-  return out;
-}
+template <class P>
+concept has_baseline = requires(const P& p) {
+  baseline_acceleration(p)(0.0, 0.0);
+};
 
+// What every baseline's step adapter holds: one scalar degree of freedom (x, v), the
+// acceleration with the problem's constants folded, and the force evaluations counted
+// per step (a register increment, not a counting wrapper).
+template <problem P>
+struct scalar_baseline_state {
+  decltype(baseline_acceleration(std::declval<const P&>())) accel;
+  double x, v;
+  long evals = 0;
+  explicit scalar_baseline_state(const P& p)
+      : accel(baseline_acceleration(p)), x(p.initial().x[0]), v(p.initial().v[0]) {}
+  template <class Vec>
+  void state_into(Vec& xo, Vec& vo) const {
+    xo = Vec(x);
+    vo = Vec(v);
+  }
+  long force_evals() const { return evals; }
+};
+
+// The descriptor and the step adapter (registered as fixed_step_peer<baseline_rk4>,
+// peers/step_adapter.hpp, whose loop flattens the step into it).
 struct baseline_rk4 {
-  static method_info info() {
+  static method_info describe() {
     return {.name = "baseline_rk4",
             .description = "hand-written RK4 on plain doubles, fully inlined: the speed-of-light step, for scale",
             .origin = method_origin::baseline,
-            .kind = method_kind::fixed_step,
             .declared_order = 4.0,
             .library = "hand-written"};
   }
   template <problem P>
-  static constexpr bool applies = requires(const P& p) {
-    baseline_acceleration(p)(0.0, 0.0);
-  };
+  static constexpr bool applies = has_baseline<P>;
 
   template <problem P>
-  static auto prepare(const P& p, double dt, double horizon, std::span<const double> times, const run_limits&) {
-    return [p, dt, horizon, plan = plan_records(horizon, dt, times)] { return run(p, dt, horizon, plan); };
-  }
-
-  template <problem P>
-  STEPBENCH_FLATTEN static drive_result<typename P::vec> run(const P& p, double dt, double horizon,
-                                                             std::span<const record_point> plan) {
-    using vec = typename P::vec;
-    const auto accel = baseline_acceleration(p);
-    const auto s0 = p.initial();
-    double x = s0.x[0], v = s0.v[0];
-    return run_scalar_baseline<vec>(x, v, dt, horizon, plan, 4, [&](double, double h) {
+  struct adapter : scalar_baseline_state<P> {
+    using scalar_baseline_state<P>::scalar_baseline_state;
+    [[gnu::always_inline]] void step(double, double h) {
+      auto& [accel, x, v, evals] = *this;
       const double h2 = 0.5 * h;
       const double a1 = accel(x, v);
       const double x2 = x + h2 * v, v2 = v + h2 * a1, a2 = accel(x2, v2);
@@ -89,8 +78,9 @@ struct baseline_rk4 {
       const double a4 = accel(x4, v4);
       x = x_123 + w * v4;
       v = v_123 + w * a4;
-    });
-  }
+      evals += 4;
+    }
+  };
 };
 
 }  // namespace stepbench::peers

@@ -9,9 +9,7 @@
 // stage positions come from the accelerations directly (the Nystrom form,
 // integrators/unrolled_rk.hpp), so that consecutive stages overlap.
 #include <cmath>
-#include <span>
 
-#include "core/drive.hpp"
 #include "core/method.hpp"
 #include "integrators/tableaus.hpp"
 #include "integrators/unrolled_rk.hpp"
@@ -26,25 +24,26 @@ inline constexpr auto ba = rk_detail::times<12>(dop853_tableau.b, dop853_tableau
 }  // namespace baseline_rk8_detail
 
 struct baseline_rk8 {
-  static method_info info() {
+  static method_info describe() {
     return {.name = "baseline_rk8",
             .description =
                 "hand-written eighth-order RK (the DOP853 step) on plain doubles, fully inlined: the speed-of-light "
                 "step, for scale",
             .origin = method_origin::baseline,
-            .kind = method_kind::fixed_step,
             .declared_order = 8.0,
             .library = "hand-written"};
   }
   template <problem P>
-  static constexpr bool applies = requires(const P& p) {
-    baseline_acceleration(p)(0.0, 0.0);
-  };
+  static constexpr bool applies = has_baseline<P>;
 
   template <problem P>
-  static auto prepare(const P& p, double dt, double horizon, std::span<const double> times, const run_limits&) {
-    return [p, dt, horizon, plan = plan_records(horizon, dt, times)] { return run(p, dt, horizon, plan); };
-  }
+  struct adapter : scalar_baseline_state<P> {
+    using scalar_baseline_state<P>::scalar_baseline_state;
+    [[gnu::always_inline]] void step(double, double h) {
+      baseline_rk8::step<P::force_depends_on_velocity>(this->x, this->v, h, this->accel);
+      this->evals += 12;
+    }
+  };
 
   // One step of h from (x, v).
   template <bool Velocity, class Accel>
@@ -95,18 +94,6 @@ struct baseline_rk8 {
       if (tab.b[i] != 0.0) v1 += (h * tab.b[i]) * a[i];
     x = x1;
     v = v1;
-  }
-
-  template <problem P>
-  STEPBENCH_FLATTEN static drive_result<typename P::vec> run(const P& p, double dt, double horizon,
-                                                             std::span<const record_point> plan) {
-    using vec = typename P::vec;
-    constexpr bool velocity = P::force_depends_on_velocity;
-    const auto accel = baseline_acceleration(p);
-    const auto s0 = p.initial();
-    double x = s0.x[0], v = s0.v[0];
-    return run_scalar_baseline<vec>(x, v, dt, horizon, plan, 12,
-                                    [&](double, double h) { step<velocity>(x, v, h, accel); });
   }
 };
 

@@ -7,12 +7,7 @@
 //    (`odeint_bulirsch_stoer`);
 // (runge_kutta_fehlberg78 at our dt, `odeint_rkf78`, is in peers/odeint.hpp with the
 // other fixed-step Odeint peers.)
-// The adaptive loop is integrate_times' (boost/numeric/odeint/integrate/detail/
-// integrate_times.hpp, controlled-stepper version), written out so that rejected
-// attempts and the step budget are counted: each step is shortened to land exactly on
-// the next sample time, and after a shortened step the step size before it is kept if
-// larger. The first step is GSL's driver's (1e-6 of the first sample time): Odeint
-// needs one from the user.
+// Their loop is integrate_times' (adaptive_peer, peers/step_adapter.hpp).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -21,11 +16,10 @@
 #include <string>
 #include <vector>
 
-#include "core/drive.hpp"
 #include "core/first_order.hpp"
-#include "core/flatten.hpp"
 #include "core/method.hpp"
 #include "peers/odeint.hpp"
+#include "peers/step_adapter.hpp"
 
 #if STEPBENCH_HAVE_ODEINT
 #include <boost/numeric/odeint/stepper/bulirsch_stoer.hpp>
@@ -85,13 +79,15 @@ struct odeint_bulirsch_stoer_tag {
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wuninitialized"
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+// The descriptor and the step adapter (registered as adaptive_peer<odeint_adaptive<Tag>>,
+// whose loop is integrate_times', peers/step_adapter.hpp).
 template <class Tag>
 struct odeint_adaptive {
-  static method_info info() {
+  static constexpr double evals_per_step = Tag::evals_per_step;
+  static method_info describe() {
     return {.name = Tag::name,
             .description = Tag::description,
             .origin = method_origin::peer,
-            .kind = method_kind::adaptive,
             .declared_order = Tag::template order<std::array<double, 2>>(),
             .traits = {.error_estimate = true},
             .library = "Boost.Odeint"};
@@ -100,65 +96,30 @@ struct odeint_adaptive {
   static constexpr bool applies = odeint_detail::fixed_size<P>;
 
   template <problem P>
-  static auto prepare(const P& p, double tol, double horizon, std::span<const double> times, const run_limits& limits) {
-    const long max_steps = limits.adaptive_steps(p.dim(), Tag::evals_per_step);
-    return [p, tol, horizon, max_steps, t = std::vector<double>(times.begin(), times.end())] {
-      return run(p, tol, horizon, t, max_steps);
-    };
-  }
-
-  template <problem P>
-  STEPBENCH_FLATTEN static drive_result<typename P::vec> run(const P& p, double tol, double horizon,
-                                                             std::span<const double> times, long max_steps) {
-    namespace odeint = boost::numeric::odeint;
+  struct adapter {
     using state = odeint_detail::state<P>;
+    first_order_form<P> rhs;
     long calls = 0;
-    const first_order_form<P> rhs(p);
-    auto system = [&](const state& y, state& dydt, double t) {
-      ++calls;
-      rhs(t, y.data(), dydt.data());
-    };
-    auto stepper = Tag::template make<state>(tol);
-    state y = odeint_detail::initial_state(p);
-    drive_result<typename P::vec> out;
-    out.start(p.dim(), times.size());
-    double t = 0.0, dt = 1e-6 * times.front();
-    for (double tout : times) {
-      while (t < tout) {
-        double h = std::min(dt, tout - t);
-        const bool lands = h == tout - t;
-        if (!(h > 4.0 * std::numeric_limits<double>::epsilon() * std::max(std::abs(t), horizon))) {
-          out.stop_reason = "step size underflow at t = " + std::to_string(t);
-          odeint_detail::finish<P>(out, y, t, calls);
-          return out;
-        }
-        double t_step = t;
-        if (stepper.try_step(system, y, t_step, h) == odeint::success) {
-          ++out.steps;
-          t = lands ? tout : t_step;
-          dt = std::max(dt, h);  // h now holds the proposed next step
-          if (out.steps >= max_steps && t < horizon) {
-            out.over_budget = true;
-            out.stop_reason =
-                "over the step budget of " + std::to_string(max_steps) + " steps at t = " + std::to_string(t);
-            odeint_detail::finish<P>(out, y, t, calls);
-            return out;
-          }
-        } else {
-          ++out.rejected_steps;
-          dt = h;
-          if (!std::isfinite(dt)) {
-            out.non_finite = true;
-            odeint_detail::finish<P>(out, y, t, calls);
-            return out;
-          }
-        }
-      }
-      if (!odeint_detail::record_if_finite<P>(out, t, y)) break;
+    decltype(Tag::template make<state>(1.0)) stepper;
+    state y;
+
+    adapter(const P& p, double tol)
+        : rhs(p), stepper(Tag::template make<state>(tol)), y(odeint_detail::initial_state(p)) {}
+    adapter(const adapter&) = delete;
+
+    bool try_step(double& t, double& h) {
+      auto system = [this](const state& yy, state& dydt, double tt) {
+        ++calls;
+        rhs(tt, yy.data(), dydt.data());
+      };
+      return stepper.try_step(system, y, t, h) == boost::numeric::odeint::success;
     }
-    odeint_detail::finish<P>(out, y, t, calls);
-    return out;
-  }
+    template <class Vec>
+    void state_into(Vec& x, Vec& v) const {
+      odeint_detail::split_state(y, x, v);
+    }
+    long force_evals() const { return calls; }
+  };
 };
 
 #pragma GCC diagnostic pop

@@ -61,15 +61,14 @@ struct adaptive_euler {
       x1 = x_half + hh * v_half;
       v1 = v_half + (hh * im) * f_half;
       const double err = scaled_rms(x1 - x_full, v1 - v_full, s.x, s.v, x1, v1, tol) * (horizon / h);
-      const double h_next = control.next(h, err);
-      if (!(err <= 1.0)) return {false, 0.0, h_next};
-      x0 = s.x;
-      v0 = s.v;
-      h_last = h;
-      s.x = x1;
-      s.v = v1;
-      s.f_current = false;
-      return {true, h, h_next};
+      return control.attempt(h, err, [&] {
+        x0 = s.x;
+        v0 = s.v;
+        h_last = h;
+        s.x = x1;
+        s.v = v1;
+        s.f_current = false;
+      });
     }
 
     // The state at theta h into the last accepted step; (x1, v1) still hold its end.

@@ -10,11 +10,10 @@
 //    sc = tol + tol max(|y0|, |y1|), E5 = ||sum e5_i k_i / sc||^2, E3 the same with
 //    e3 = b - b_hat3, over n = 2 dim components,
 //      err = |h| E5 / sqrt(n (E5 + 0.01 E3)),
-//    which is O(h^8). The step-size control is dop853.f's with its defaults (no PI term,
-//    beta = 0): h_new = h / clamp(err^(1/8) / 0.9, 1/6, 1/0.333), after a rejection
-//    h / min(1/0.333, err^(1/8) / 0.9), and no growth right after a rejection. err^(1/8)
-//    is three square roots: the next step's coefficients wait for it, and pow() would
-//    cost a fifth of a step here.
+//    which is O(h^8). The step-size control is dop853.f's with its defaults
+//    (integrators/step_control.hpp: no PI term, beta = 0): h_new = h / clamp(err^(1/8) /
+//    0.9, 1/6, 1/0.333), after a rejection h / min(1/0.333, err^(1/8) / 0.9), and no
+//    growth right after a rejection.
 //  - Dense output of order 7 for the sample times, interpolated inside the steps. Its
 //    three extra stages cost three evaluations, paid only in a step that holds a sample
 //    time (computed at the first interpolation inside the step, not at every step as
@@ -31,24 +30,6 @@
 namespace stepbench {
 
 namespace dop853_detail {
-// dop853.f's step-size controller with its default constants (SAFE = 0.9, FAC1 = 0.333,
-// FAC2 = 6, BETA = 0).
-struct controller {
-  static constexpr double safe = 0.9, fac_max = 1.0 / 0.333, fac_min = 1.0 / 6.0;
-  bool rejected_last = false;
-  double next(double h, double err) {
-    const double fac11 = std::sqrt(std::sqrt(std::sqrt(err)));  // err^(1/8)
-    if (err <= 1.0) {
-      double h_new = h / std::clamp(fac11 / safe, fac_min, fac_max);
-      if (rejected_last) h_new = std::min(h_new, h);
-      rejected_last = false;
-      return h_new;
-    }
-    rejected_last = true;
-    return h / (std::isfinite(err) ? std::min(fac_max, fac11 / safe) : fac_max);
-  }
-};
-
 // The error weights over the 16 stages of dop853_extended (zero beyond stage 12).
 inline constexpr std::array<double, 16> e5 = [] {
   std::array<double, 16> e{};
@@ -76,7 +57,9 @@ struct dop853 {
   struct stepper {
     using Vec = typename Sys::vec;
     double tol;
-    dop853_detail::controller control;
+    // dop853.f's controller with its default constants (SAFE = 0.9, FAC1 = 0.333, FAC2 = 6, BETA = 0).
+    step_controller control{
+        .error_order = 7, .min_factor = 0.333, .max_factor = 6.0, .form = step_controller::rounding::quotient};
     unrolled_rk<dop853_extended, Sys> k;
     Vec x1, v1, ex5, ev5, ex3, ev3, rx, rv;  // new state, error estimates, reciprocal scales
     // The last accepted step, for dense output.
@@ -103,22 +86,20 @@ struct dop853 {
       k.template combine<dop853_detail::b>(x1, v1, s.x, s.v, h, h_im);
       k.template difference<dop853_detail::e5>(ex5, ev5, s.v, h, h_im);
       k.template difference<dop853_detail::e3>(ex3, ev3, s.v, h, h_im);
-      const double err = error(s);
-      const double h_next = control.next(h, err);
-      if (!(err <= 1.0)) return {false, 0.0, h_next};
-      x0 = s.x;
-      v0 = s.v;
-      sys_last = &sys;
-      t_last = t;
-      h_last = h;
-      h_im_last = h_im;
-      dense_ready = false;
-      s.x = x1;
-      s.v = v1;
-      sys.force(t + h, s.x, s.v, s.f);  // the next step's first stage, and stage 13 of the dense output
-      s.f_current = true;
-      k.F[12] = s.f;
-      return {true, h, h_next};
+      return control.attempt(h, error(s), [&] {
+        x0 = s.x;
+        v0 = s.v;
+        sys_last = &sys;
+        t_last = t;
+        h_last = h;
+        h_im_last = h_im;
+        dense_ready = false;
+        s.x = x1;
+        s.v = v1;
+        sys.force(t + h, s.x, s.v, s.f);  // the next step's first stage, and stage 13 of the dense output
+        s.f_current = true;
+        k.F[12] = s.f;
+      });
     }
 
     // dop853.f's err: |h| E5 / sqrt(n (E5 + 0.01 E3)); ex, ev include the factor h.

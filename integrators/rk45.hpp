@@ -49,17 +49,16 @@ struct rk45 {
       // The last stage is f(t + h, y1): y1 = (k.X, k.V[6]), its force k.F[6].
       k.weighted(error_weights, h, h_im, ex, ev);
       const double err = scaled_rms(ex, ev, s.x, s.v, k.X, k.V[6], tol);
-      const double h_next = control.next(h, err);
-      if (!(err <= 1.0)) return {false, 0.0, h_next};
-      x0 = s.x;
-      v0 = s.v;
-      h_last = h;
-      h_im_last = h_im;
-      s.x = k.X;
-      s.v = k.V[6];
-      s.f = k.F[6];
-      s.f_current = true;
-      return {true, h, h_next};
+      return control.attempt(h, err, [&] {
+        x0 = s.x;
+        v0 = s.v;
+        h_last = h;
+        h_im_last = h_im;
+        s.x = k.X;
+        s.v = k.V[6];
+        s.f = k.F[6];
+        s.f_current = true;
+      });
     }
 
     // The state at t_n + theta h of the last accepted step (0 <= theta <= 1).

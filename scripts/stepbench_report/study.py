@@ -7,13 +7,17 @@ and checks that everything the report uses is there: a file that lacks a documen
 attribute, field or dataset is a StudyError naming the file and what is missing.
 Nothing is filled in with a default.
 """
+import ctypes
+import fcntl
 import os
 import pickle
 import signal
+import sys
 from dataclasses import dataclass, field
 
 import h5py
 import numpy as np
+from h5py import h5, h5a, h5d, h5i, h5o, h5p, h5s, h5t
 
 from . import energy_runs as energy_section
 from . import loop as loop_section
@@ -71,6 +75,11 @@ class StudyError(Exception):
     something the format requires. The message is one line and names the file."""
 
 
+# One str object for each value: a full study holds some 30000 strings of 450 values,
+# and the child that reads it (load) pickles each object once.
+_interned = sys.intern
+
+
 def _text(value):
     """h5py hands strings back as bytes in compound fields and as str in attributes;
     the report sees str."""
@@ -81,15 +90,17 @@ def _text(value):
     return value
 
 
-def _decoded(rows):
+def _decoded(rows, in_place=False):
     """A structured array with its string fields (HDF5 variable-length strings, read as
-    bytes objects) turned into str, so that `rows["method"] == "rk4"` works."""
+    bytes objects) turned into str, so that `rows["method"] == "rk4"` works; in place
+    when the caller owns `rows`. The strings are interned (_interned)."""
     if rows.dtype.names is None:
         return rows
-    out = rows.copy()
+    out = rows if in_place else rows.copy()
     for name in rows.dtype.names:
         if rows.dtype[name].kind in "OS":
-            out[name] = np.char.decode(rows[name].astype(bytes))  # in one call, not a Python loop
+            # A list: np.char.decode costs more than the loop on the few rows a table has.
+            out[name] = [_interned(b.decode()) for b in rows[name].astype(bytes).tolist()]
     return out
 
 
@@ -202,22 +213,86 @@ def _method_sort_key(m):
     return (ORIGINS.index(m.origin), m.adaptive, order if np.isfinite(order) else 99, m.name)
 
 
+@dataclass(frozen=True)
+class _ReadType:
+    """How h5py reads a datatype stored in the file: into the numpy `dtype`, through the
+    HDF5 memory type `memory` (h5t.py_create of it); `vlen_text`: a variable-length
+    string, which h5py hands back as str in an attribute."""
+    dtype: np.dtype
+    memory: object
+    vlen_text: bool
+
+
 class _Reader:
     """Reads one open file; every lookup of something required goes through `need_*`,
     which raises a StudyError naming the object and what it lacks."""
 
     def __init__(self, path, f):
         self.path, self.f = path, f
+        self.read_types = {}  # (class, size) -> [(stored type, _ReadType)]: see read_type
+        self.transfer = _small_buffer_transfer()
 
     def error(self, what):
-        return StudyError(f"cannot read study file '{self.path}': {what}")
+        return _error(self.path, what)
 
     def need_attrs(self, obj, names):
-        missing = [n for n in names if n not in obj.attrs]
+        location = _attribute_holder(obj)
+        missing = [n for n in names if not h5a.exists(location, n.encode())]
         if missing:
             where = "the root group" if obj.name == "/" else obj.name
             raise self.error(f"{where} lacks attribute{'s' if len(missing) > 1 else ''} {', '.join(missing)}")
-        return {k: _text(v) for k, v in obj.attrs.items()}
+        return self.attributes(obj)
+
+    def attributes(self, obj):
+        """Every attribute of `obj` as `{name: _text(obj.attrs[name])}`, in the order of
+        `obj.attrs`. Read through h5py's low-level API the way h5py's AttributeManager
+        reads each, but with its types made once (read_type): a full study has some
+        8000 attributes, and `obj.attrs[name]` spends half its time making them anew."""
+        location = _attribute_holder(obj)
+        creation = location.get_create_plist()
+        tracked = creation.get_attr_creation_order() & h5p.CRT_ORDER_TRACKED
+        creation.close()
+        names = []
+        h5a.iterate(location, names.append, index_type=h5.INDEX_CRT_ORDER if tracked else h5.INDEX_NAME)
+        values = {}
+        for encoded in names:
+            name = _name(encoded)
+            attr = h5a.open(location, encoded)
+            space = attr.get_space()
+            extent = space.get_simple_extent_type()
+            read_as = self.read_type(attr.get_type())
+            if extent == h5s.NULL:
+                value = h5py.Empty(read_as.dtype)
+            elif read_as.dtype.subdtype is not None:  # an array datatype, which no study writes: h5py's own way
+                value = obj.attrs[name]
+            else:
+                array = np.zeros(() if extent == h5s.SCALAR else space.shape, read_as.dtype)
+                attr.read(array, mtype=read_as.memory)
+                if not read_as.vlen_text:
+                    value = array[()] if array.ndim == 0 else array
+                elif array.ndim == 0:
+                    value = _interned(array[()].decode("utf-8", "surrogateescape"))
+                else:
+                    value = np.array([b.decode("utf-8", "surrogateescape") for b in array.flat],
+                                     dtype=read_as.dtype).reshape(array.shape)
+            values[name] = _text(value)
+        return values
+
+    def read_type(self, stored):
+        """The _ReadType of the datatype `stored` (an attribute's or a dataset's). h5py
+        makes the numpy dtype and the memory type anew on every read: about 10 us for a
+        number, 0.3 ms for a 30-field table row, and a full study has some 8000 attributes
+        and 400 tables of a few dozen distinct types. Here each is made once, and found
+        again by H5Tequal among the types of its class and size."""
+        seen = self.read_types.setdefault((stored.get_class(), stored.get_size()), [])
+        for known, read_as in seen:
+            if known == stored:
+                return read_as
+        dtype = stored.dtype
+        string = h5t.check_string_dtype(dtype)
+        read_as = _ReadType(dtype, h5t.py_create(dtype), string is not None and string.length is None)
+        seen.append((stored, read_as))
+        return read_as
 
     def need_group(self, parent, name):
         g = parent.get(name)
@@ -226,14 +301,31 @@ class _Reader:
         return g
 
     def need_table(self, parent, name, fields):
-        ds = parent.get(name)
-        if not isinstance(ds, h5py.Dataset):
+        """The table `parent`/`name` with its strings decoded (_decoded), read as h5py's
+        `parent[name][()]` reads it, but with its types made once (read_type) and a small
+        conversion buffer (_small_buffer_transfer)."""
+        try:
+            ds = h5o.open(parent.id, name.encode())
+        except KeyError:
+            ds = None
+        if not isinstance(ds, h5d.DatasetID):
             raise self.error(f"{parent.name.rstrip('/')}/{name} is missing (a dataset)")
-        names = ds.dtype.names or ()
-        missing = [n for n in fields if n not in names]
+        stored = ds.get_type()
+        read_as = self.read_type(stored)
+        missing = [n for n in fields if n not in (read_as.dtype.names or ())]
         if missing:
-            raise self.error(f"{ds.name} lacks field{'s' if len(missing) > 1 else ''} {', '.join(missing)}")
-        return _decoded(ds[()])
+            raise self.error(f"{_name(h5i.get_name(ds))} lacks field{'s' if len(missing) > 1 else ''} "
+                             f"{', '.join(missing)}")
+        space = ds.get_space()
+        if space.get_simple_extent_type() != h5s.SIMPLE:  # a table never is: h5py's own way
+            return _decoded(h5py.Dataset(ds)[()])
+        rows = np.zeros(space.shape, read_as.dtype)
+        if rows.size:
+            # HDF5 converts whole rows, and a row takes at most twice its size here in the
+            # file (a variable-length string: 16 bytes there, a pointer here).
+            row_fits = 2 * max(stored.get_size(), read_as.dtype.itemsize) <= TRANSFER_BUFFER
+            ds.read(h5s.ALL, h5s.ALL, rows, read_as.memory, dxpl=self.transfer if row_fits else None)
+        return _decoded(rows, in_place=True)
 
     def need_value(self, obj, key, value, allowed):
         if value not in allowed:
@@ -243,7 +335,8 @@ class _Reader:
         """Every value of column `field` of the table `parent`/`table` (read as `rows`) is
         one of `allowed`."""
         for v in dict.fromkeys(rows[field].tolist()):  # each value once, in the order of the rows
-            self.need_value(parent[table], field, v, allowed)
+            if v not in allowed:
+                self.need_value(parent[table], field, v, allowed)  # raises, naming the table
 
     @staticmethod
     def subgroups(g):
@@ -309,8 +402,7 @@ class _Reader:
             raise self.error("/stability is not a group")
         attrs = self.need_attrs(g, STABILITY_ATTRS)
         limits = self.need_table(g, "limits", LIMIT_FIELDS)
-        for t in limits["test"]:
-            self.need_value(g["limits"], "test", t, STABILITY_TESTS)
+        self.need_column(g, "limits", limits, "test", STABILITY_TESTS)
         re, im = self.need_array(g, "region_re", 1), self.need_array(g, "region_im", 1)
         regions_group = self.need_group(g, "regions")
         regions = {}
@@ -322,7 +414,9 @@ class _Reader:
             regions[name] = grid
         return Stability(attrs, limits, re, im, regions)
 
-    def study(self):
+    def study(self, share=0, shares=1):
+        """Share `share` of `shares` of the study (see load): the problems _problem_share
+        gives it and, for share 0, the rest of the file; every share checks the root."""
         f = self.f
         if "format_version" not in f.attrs:
             raise self.error("not a stepbench study (an HDF5 file without format_version)")
@@ -343,17 +437,41 @@ class _Reader:
         timed = int(attrs["timing"]) == 1
         if timed:
             self.need_attrs(f, TIMED_ROOT_ATTRS)
-        problems = [self.problem(g, timed) for g in self.need_group(f, "problems").values()
-                    if isinstance(g, h5py.Group)]
-        if not problems:
+        groups = [g for g in self.need_group(f, "problems").values() if isinstance(g, h5py.Group)]
+        if not groups:
             raise self.error("/problems holds no problem")
-        stability = self.stability()
-        gaps = _gaps(problems)
-        if stability is None:
-            gaps.append("no /stability group (the stability limits and regions)")
-        return Study(path=str(self.path), attrs=attrs, problems=problems, gaps=gaps,
-                     stability=stability, loop=loop_section.read(self, f),
-                     energy_runs=energy_section.read(self, f), substeps=substeps_section.read(self, f))
+        problems = [self.problem(g, timed) for g in groups[_problem_share(share, shares)]]
+        if share > 0:
+            return Study(path=str(self.path), attrs=attrs, problems=problems)
+        return Study(path=str(self.path), attrs=attrs, problems=problems, stability=self.stability(),
+                     loop=loop_section.read(self, f), energy_runs=energy_section.read(self, f),
+                     substeps=substeps_section.read(self, f))
+
+
+def _problem_share(share, shares):
+    """The positions in /problems of the problems share `share` of `shares` reads: they
+    are dealt in turn starting with the last share, so that share 0, which reads the rest
+    of the file too, has the fewest."""
+    return slice(shares - 1 - share, None, shares)
+
+
+def _merged(shares):
+    """The study from its shares (Reader.study): share 0's, with every share's problems in
+    the order of /problems, and what it lacks (_gaps)."""
+    study = shares[0]
+    problems = [None] * sum(len(s.problems) for s in shares)
+    for k, share in enumerate(shares):
+        problems[_problem_share(k, len(shares))] = share.problems
+    study.problems = problems
+    study.gaps = _gaps(problems)
+    if study.stability is None:
+        study.gaps.append("no /stability group (the stability limits and regions)")
+    return study
+
+
+# Child processes reading a study at once (see load), one a core: with two, a full study
+# reads in 60 % of the time one child takes.
+READERS = min(2, os.cpu_count() or 1)
 
 
 def load(path):
@@ -361,55 +479,138 @@ def load(path):
 
     HDF5 1.10 trusts sizes stored in the file where h5py cannot check them first (a
     global heap object's length, an attribute message's size): a damaged file can crash
-    it. So the file is read in a child process, which hands back the study (or the error)
-    pickled; a child ended by a signal is a damaged file, not a dead report."""
+    it. So the file is read in child processes, which hand back what they read (or the
+    error) pickled; a child ended by a signal is a damaged file, not a dead report.
+    READERS children read at once, each its share of the problems (the bulk of the file;
+    Reader.study). Which error a damaged file raises depends on the order it is read in,
+    so when a share fails the file is read again by one child, in order, for the error."""
+    shares = _read_shares(path, READERS)
+    if READERS > 1 and any(isinstance(share, Exception) for share in shares):
+        shares = _read_shares(path, 1)
+    for share in shares:
+        if isinstance(share, Exception):
+            raise share
+    return _merged(shares)
+
+
+def _read_shares(path, shares):
+    """Each of the `shares` shares of the study at `path` (or the exception reading it
+    raised), read by a child process of its own, all at once."""
+    children = [_start_reader(path, share, shares) for share in range(shares)]
+    return [_finish_reader(path, *child) for child in children]
+
+
+def _start_reader(path, share, shares):
+    """Forks a child that reads share `share` of `shares` of the study at `path` and sends
+    it (or the exception reading it raised) pickled down a pipe; (its pid, the pipe)."""
     readable, writable = os.pipe()
+    try:  # a full study in a few writes, not the 90 of a pipe's default 64 KiB
+        fcntl.fcntl(writable, fcntl.F_SETPIPE_SZ, 1 << 20)
+    except (AttributeError, OSError):  # not Linux, or above its /proc/sys/fs/pipe-max-size
+        pass
     pid = os.fork()
     if pid == 0:
         os.close(readable)
         os.dup2(os.open(os.devnull, os.O_WRONLY), 2)  # HDF5's own diagnostics: the error says it
         try:
-            result = _load(path)
+            # The file stays open: the child ends by os._exit, so HDF5 need not spend ~12 ms
+            # closing it (freeing every cached object header) before the parent has the study.
+            result = _read(path, _open(path), share, shares)
         except Exception as e:  # noqa: BLE001 -- raised again in the parent
             result = e
         with os.fdopen(writable, "wb") as out:
             pickle.dump(result, out, protocol=pickle.HIGHEST_PROTOCOL)
         os._exit(0)
     os.close(writable)
+    return pid, readable
+
+
+def _finish_reader(path, pid, readable):
+    """What the child `pid` sent down `readable`; a StudyError if it died before sending it."""
     with os.fdopen(readable, "rb") as inp:
-        data = inp.read()
+        try:  # unpickled as it arrives, while the child is still pickling
+            result = pickle.load(inp)
+        except (EOFError, pickle.UnpicklingError):  # nothing, or not all of it
+            result = None
     status = os.waitpid(pid, 0)[1]
-    if os.WIFSIGNALED(status) or not data:
+    if os.WIFSIGNALED(status) or result is None:
         end = signal.Signals(os.WTERMSIG(status)).name if os.WIFSIGNALED(status) else f"exit {status >> 8}"
-        raise StudyError(f"cannot read study file '{path}': damaged: reading it crashes the HDF5 library ({end})")
-    result = pickle.loads(data)
-    if isinstance(result, Exception):
-        raise result
+        return StudyError(f"cannot read study file '{path}': damaged: reading it crashes the HDF5 library ({end})")
     return result
 
 
-def _load(path):
-    def error(what):
-        return StudyError(f"cannot read study file '{path}': {what}")
+def _open(path):
+    """The study file `path` opened for reading; StudyError when it cannot be."""
     if not os.path.exists(path):
-        raise error("no such file")
+        raise _error(path, "no such file")
     if os.path.isdir(path):
-        raise error("it is a directory")
+        raise _error(path, "it is a directory")
     try:
         if not h5py.is_hdf5(path):
-            raise error("not an HDF5 file")
-        f = h5py.File(path, "r")
+            raise _error(path, "not an HDF5 file")
+        return h5py.File(path, "r")
     except StudyError:
         raise
     except OSError as e:  # HDF5's signature is there but the file cannot be opened
-        raise error(f"damaged or truncated HDF5 file: {_first_line(e)}") from None
+        raise _error(path, f"damaged or truncated HDF5 file: {_first_line(e)}") from None
+
+
+def _read(path, f, share, shares):
+    """Share `share` of `shares` of the study in the open file `f` (Reader.study), checked."""
     try:
-        with f:
-            return _Reader(path, f).study()
+        return _Reader(path, f).study(share, shares)
     except StudyError:
         raise
     except (OSError, KeyError, ValueError, RuntimeError, TypeError, MemoryError) as e:  # h5py's on a damaged object
-        raise error(f"damaged or truncated HDF5 file: {_first_line(e)}") from None
+        raise _error(path, f"damaged or truncated HDF5 file: {_first_line(e)}") from None
+
+
+def _error(path, what):
+    return StudyError(f"cannot read study file '{path}': {what}")
+
+
+TRANSFER_BUFFER = 64 << 10  # bytes
+
+
+def _small_buffer_transfer():
+    """A dataset transfer property list with a TRANSFER_BUFFER-byte type-conversion buffer
+    (H5Pset_buffer) instead of HDF5's 1 MiB; None where it cannot be made.
+
+    HDF5 1.10 allocates that buffer, and a background buffer of the same size zeroed by
+    calloc, on every read that converts a compound type, which every table with a string
+    field needs; freed, the two MiB go back to the kernel, so each of a study's ~400 table
+    reads faulted them in and zeroed them afresh: about 0.6 ms a read, 0.2 s a full study.
+    h5py does not wrap H5Pset_buffer: it is called through ctypes in the HDF5 library h5py
+    loaded (found in /proc/self/maps). Without it the tables read the same, only slower."""
+    transfer = h5p.create(h5p.DATASET_XFER)
+    try:
+        with open("/proc/self/maps") as maps:
+            libraries = {line.split()[-1] for line in maps if "/libhdf5" in line and ".so" in line}
+    except OSError:
+        return None
+    for path in sorted(libraries):
+        try:
+            set_buffer = ctypes.CDLL(path).H5Pset_buffer
+        except (OSError, AttributeError):
+            continue
+        set_buffer.argtypes = (ctypes.c_int64, ctypes.c_size_t, ctypes.c_void_p, ctypes.c_void_p)
+        set_buffer.restype = ctypes.c_int
+        if set_buffer(transfer.id, TRANSFER_BUFFER, None, None) >= 0:
+            return transfer
+    return None
+
+
+def _attribute_holder(obj):
+    """The low-level id whose attributes are `obj.attrs` (a file's are its root group's)."""
+    return obj["/"].id if isinstance(obj, h5py.File) else obj.id
+
+
+def _name(encoded):
+    """An HDF5 name as h5py gives it: str (_interned) when it is UTF-8, else the bytes."""
+    try:
+        return _interned(encoded.decode("utf8"))
+    except UnicodeDecodeError:
+        return encoded
 
 
 def _first_line(e):

@@ -4,6 +4,7 @@
 #include <fmt/ranges.h>
 
 #include <iostream>
+#include <memory>
 #include <nlohmann/json.hpp>
 
 #include "cli/args.hpp"
@@ -23,15 +24,26 @@ struct run_args {
   bool json = false;
 };
 
-int run_run(const run_args& a) {
-  auto problem = make_problem(a.problem);
-  const method_info& m = find_method(a.method);
+// What `run` was asked, checked: the problem with its --set overrides, the method, its
+// dt or tolerance, and the horizon. Throws std::invalid_argument naming the problem.
+struct run_request {
+  std::unique_ptr<problem_instance> problem;
+  const method_info* method = nullptr;
+  bool fixed = true;
+  double param = 0.0, horizon = 0.0;
+};
+
+run_request checked_request(const run_args& a) {
+  run_request r;
+  r.problem = make_problem(a.problem);
+  r.method = &find_method(a.method);
+  const method_info& m = *r.method;
   parameter_overrides overrides;
   for (const auto& s : a.sets) add_override(overrides, s, std::vector{a.problem});
-  for (const auto& [name, value] : overrides[a.problem]) problem->set(name, value);
-  if (auto err = problem->validate(); !err.empty())
+  for (const auto& [name, value] : overrides[a.problem]) r.problem->set(name, value);
+  if (auto err = r.problem->validate(); !err.empty())
     throw std::invalid_argument(fmt::format("problem {}: {}", a.problem, err));
-  const bool fixed = m.kind == method_kind::fixed_step;
+  const bool fixed = r.fixed = m.kind == method_kind::fixed_step;
   if (fixed && a.dt_text.empty())
     throw std::invalid_argument(fmt::format("{} is a fixed-step method: give --dt", m.name));
   if (!fixed && a.tol_text.empty()) throw std::invalid_argument(fmt::format("{} is adaptive: give --tol", m.name));
@@ -39,30 +51,39 @@ int run_run(const run_args& a) {
     throw std::invalid_argument(fmt::format("{} is a fixed-step method: --tol does not apply", m.name));
   if (!fixed && !a.dt_text.empty())
     throw std::invalid_argument(fmt::format("{} is adaptive: --dt does not apply", m.name));
-  const double param = parse_number(fixed ? a.dt_text : a.tol_text, fixed ? "--dt" : "--tol");
+  const double param = r.param = parse_number(fixed ? a.dt_text : a.tol_text, fixed ? "--dt" : "--tol");
   if (!(param > 0.0))
     throw std::invalid_argument(
         fmt::format("{} must be > 0, got {}", fixed ? "--dt" : "--tol", fixed ? a.dt_text : a.tol_text));
   if (!fixed && !(param < 1.0)) throw std::invalid_argument(fmt::format("--tol must be < 1, got {}", a.tol_text));
-  double horizon = problem->horizon();
+  r.horizon = r.problem->horizon();
   if (!a.horizon_text.empty()) {
-    horizon = parse_number(a.horizon_text, "--horizon");
-    if (!(horizon > 0.0)) throw std::invalid_argument(fmt::format("--horizon must be > 0, got {}", a.horizon_text));
+    r.horizon = parse_number(a.horizon_text, "--horizon");
+    if (!(r.horizon > 0.0)) throw std::invalid_argument(fmt::format("--horizon must be > 0, got {}", a.horizon_text));
   }
-  if (fixed && horizon / param > 1e9)
-    throw std::invalid_argument(fmt::format("--dt {} needs more than 1e9 steps to reach {}", param, horizon));
+  if (fixed && r.horizon / param > 1e9)
+    throw std::invalid_argument(fmt::format("--dt {} needs more than 1e9 steps to reach {}", param, r.horizon));
+  return r;
+}
+
+int run_run(const run_args& a) {
+  const run_request req = checked_request(a);
+  const problem_instance& problem = *req.problem;
+  const method_info& m = *req.method;
+  const bool fixed = req.fixed;
+  const double param = req.param, horizon = req.horizon;
 
   // Fixed steps are measured at the grid times nearest j T / 32, so the run itself is
   // the one a user would make; adaptive runs at j T / 32 exactly.
   constexpr int sample_count = 32;
   const auto times = fixed ? nearest_grid_times(horizon, param, sample_count) : sample_times(horizon, sample_count);
-  const run_result run = problem->run(m.name, param, horizon, times);
+  const run_result run = problem.run(m.name, param, horizon, times);
   truth_options topts;
-  topts.run_references = !problem->has_closed_form();
-  const truth_table truth = build_truth(*problem, times, topts);
-  const run_metrics metrics = measure(*problem, run, truth);
+  topts.run_references = !problem.has_closed_form();
+  const truth_table truth = build_truth(problem, times, topts);
+  const run_metrics metrics = measure(problem, run, truth);
 
-  const int dim = problem->dim();
+  const int dim = problem.dim();
   auto part = [&](const std::vector<double>& y, int offset) {
     return y.empty() ? std::vector<double>{} : std::vector<double>(y.begin() + offset, y.begin() + offset + dim);
   };
@@ -105,7 +126,7 @@ int run_run(const run_args& a) {
   fmt::print("  velocity       {::.12g}   (true {::.12g})\n", part(run.final_y, dim), part(truth.y.back(), dim));
   fmt::print("  err_pos_final  {:.6e}\n  err_vel_final  {:.6e}\n  err_pos_max    {:.6e}\n  err_pos_rms    {:.6e}\n",
              metrics.err_pos_final, metrics.err_vel_final, metrics.err_pos_max, metrics.err_pos_rms);
-  if (problem->has_energy()) fmt::print("  energy_drift   {:+.6e} (relative, at the horizon)\n", metrics.energy_drift);
+  if (problem.has_energy()) fmt::print("  energy_drift   {:+.6e} (relative, at the horizon)\n", metrics.energy_drift);
   if (metrics.diverged) fmt::print("  DIVERGED: {}\n", metrics.note);
   if (metrics.failed) fmt::print("  FAILED: {}\n", metrics.note);
   return metrics.failed ? 1 : 0;

@@ -322,6 +322,41 @@ STEPBENCH_FLATTEN drive_result<typename P::vec> drive(const P& problem, const I&
   return out;
 }
 
+// Locate mode in the adaptive loop: a step that ends penetrated, from t_old to t_end,
+// has its contact found on the method's dense output (Illinois on the gap of the
+// interpolated state); the state is moved there and the rest of the step discarded (the
+// next attempt starts from the contact). The bracket is the first sample of the dense
+// output (16 a step) where the gap turns from positive to not: a step that starts from
+// a contact (gap 0, moving away) and ends past the next one has no sign change between
+// its ends alone. Returns the contact time (t_end when no sample bracketed one).
+template <problem P, class Stepper, class Vec>
+inline double locate_on_dense_output(const P& problem, Stepper& stepper, double t_old, double t_end, step_state<Vec>& s,
+                                     Vec& x_dense, Vec& v_dense) {
+  auto gap_at = [&](double theta) {
+    stepper.interpolate(theta, x_dense, v_dense);
+    return problem.contact_gap(t_old + theta * (t_end - t_old), x_dense, v_dense);
+  };
+  constexpr int samples = 16;
+  double lo = 0.0, hi = 1.0, g_lo = gap_at(0.0), g_hi = problem.contact_gap(t_end, s.x, s.v);
+  for (int j = 1; j <= samples; ++j) {
+    const double theta_j = static_cast<double>(j) / samples;
+    const double g = j == samples ? g_hi : gap_at(theta_j);
+    if (g_lo > 0.0 && !(g > 0.0)) {
+      hi = theta_j, g_hi = g;
+      break;
+    }
+    lo = theta_j, g_lo = g;
+  }
+  if (!(g_lo > 0.0)) return t_end;
+  double last = hi;
+  const double theta = illinois_contact(lo, hi, g_lo, g_hi, 1e-12, gap_at, last);
+  if (last != theta) stepper.interpolate(theta, x_dense, v_dense);
+  s.x = x_dense;
+  s.v = v_dense;
+  s.f_current = false;
+  return t_old + theta * (t_end - t_old);
+}
+
 // The adaptive loop. Steps are the method's own, shortened only to land on the horizon
 // and, for a method without dense output, on each record time (a method with dense
 // output interpolates the record times inside its steps instead). A run stops with a
@@ -379,40 +414,11 @@ STEPBENCH_FLATTEN drive_result<typename P::vec> drive_adaptive(const P& problem,
     const double t_step_end = t;  // the end of the step the dense output covers
     ++out.steps;
     // locate: a contact inside the accepted step is found on the method's dense output
-    // (Illinois on the gap of the interpolated state); the state there is resolved and
-    // the rest of the step is discarded (the next attempt starts from the contact). A
-    // method without dense output resolves at the end of its step, as end_of_step does.
+    // (locate_on_dense_output) and resolved there; a method without dense output resolves
+    // at the end of its step, as end_of_step does.
     if constexpr (has_contacts<P>) {
       if (problem.locate_contacts() && problem.contact_gap(t, s.x, s.v) < 0.0) {
-        if constexpr (dense) {
-          // The bracket: the first sample of the dense output (16 a step) where the gap turns
-          // from positive to not. A step that starts from a contact (gap 0, moving away) and
-          // ends past the next one has no sign change between its ends alone.
-          auto gap_at = [&](double theta) {
-            stepper.interpolate(theta, x_dense, v_dense);
-            return problem.contact_gap(t_old + theta * (t_step_end - t_old), x_dense, v_dense);
-          };
-          constexpr int samples = 16;
-          double lo = 0.0, hi = 1.0, g_lo = gap_at(0.0), g_hi = problem.contact_gap(t, s.x, s.v);
-          for (int j = 1; j <= samples; ++j) {
-            const double theta_j = static_cast<double>(j) / samples;
-            const double g = j == samples ? g_hi : gap_at(theta_j);
-            if (g_lo > 0.0 && !(g > 0.0)) {
-              hi = theta_j, g_hi = g;
-              break;
-            }
-            lo = theta_j, g_lo = g;
-          }
-          if (g_lo > 0.0) {
-            double last = hi;
-            const double theta = illinois_contact(lo, hi, g_lo, g_hi, 1e-12, gap_at, last);
-            if (last != theta) stepper.interpolate(theta, x_dense, v_dense);
-            t = t_old + theta * (t_step_end - t_old);
-            s.x = x_dense;
-            s.v = v_dense;
-            s.f_current = false;
-          }
-        }
+        if constexpr (dense) t = locate_on_dense_output(problem, stepper, t_old, t_step_end, s, x_dense, v_dense);
         resolve_here(problem, t, s, out);
       }
     }

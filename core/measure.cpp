@@ -73,6 +73,97 @@ agreement compare(std::span<const std::vector<double>> a, std::span<const std::v
   return out;
 }
 
+namespace {
+
+// Every reference source on the problem: solved, failed with its reason, or unsupported.
+std::vector<reference_check> run_references(const problem_instance& problem, std::span<const double> times,
+                                            const truth_options& opts) {
+  std::vector<reference_check> out;
+  const ode_system sys = problem.ode();
+  for (const char* source : reference_sources) {
+    reference_check rc;
+    rc.source = source;
+    if (sys.has_contacts() && !reference_handles_contacts(source)) {
+      rc.status = "unsupported";
+      rc.reason = "the problem has contacts, and this reference has no root finding to stop at them";
+      out.push_back(std::move(rc));
+      continue;
+    }
+    try {
+      rc.solution = solve_reference(source, sys, times, opts.tol);
+    } catch (const std::runtime_error& e) {
+      rc.status = "failed";
+      rc.reason = e.what();
+    }
+    out.push_back(std::move(rc));
+  }
+  return out;
+}
+
+// Marks a reference that strays from what it was compared with beyond the limit.
+void judge_agreement(reference_check& r, const truth_table& t) {
+  if (!(r.vs.worst() <= t.agreement_limit)) r.status = "disagrees", r.reason = disagreement(r.vs, t.agreement_limit);
+}
+
+// The truth from the closed form; each completed reference is checked against it.
+void truth_from_closed_form(const problem_instance& problem, truth_table& t, const std::vector<reference_check*>& ok) {
+  t.source = "closed_form";
+  for (double time : t.times) t.y.push_back(problem.exact(time));
+  for (std::size_t j = 0; j < t.y.size(); ++j)
+    for (double value : t.y[j])
+      if (!std::isfinite(value))
+        throw std::runtime_error(
+            fmt::format("the closed form of problem {} is not finite at t = {:g}: are the parameters in range?",
+                        problem.name(), t.times[j]));
+  set_scales(problem, t);
+  for (auto* r : ok) {
+    r->compared_with = t.source;
+    r->vs = compare(r->solution.y, t.y, problem.dim(), t.pos_scale, t.vel_scale);
+    judge_agreement(*r, t);
+  }
+}
+
+// The truth from the best-agreeing pair of completed references (on scales from the
+// first of them), trusted when they agree within the limit; else no trusted truth.
+void truth_from_references(const problem_instance& problem, truth_table& t, const std::vector<reference_check*>& ok) {
+  const int dim = problem.dim();
+  if (!ok.empty()) {
+    t.y = ok.front()->solution.y;
+    set_scales(problem, t);
+  }
+  std::size_t best_i = 0, best_k = 0;
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < ok.size(); ++i)
+    for (std::size_t k = i + 1; k < ok.size(); ++k) {
+      const double w = compare(ok[i]->solution.y, ok[k]->solution.y, dim, t.pos_scale, t.vel_scale).worst();
+      if (w < best) best = w, best_i = i, best_k = k;
+    }
+  if (ok.size() < 2 || !(best <= t.agreement_limit)) {
+    t.trusted = false;
+    t.source = "none";
+    t.note = ok.size() < 2 ? fmt::format("only {} of {} references completed, and no closed form to check them",
+                                         ok.size(), t.references.size())
+                           : fmt::format("no two references agree within {:.1e} (best pair {} and {}: {:.3e})",
+                                         t.agreement_limit, ok[best_i]->source, ok[best_k]->source, best);
+    t.y.assign(t.times.size(), std::vector<double>(2 * dim, nan));
+    for (auto* r : ok) r->status = "disagrees", r->reason = t.note;
+    return;
+  }
+  reference_check& truth = *ok[best_i];
+  t.source = truth.source;
+  t.y = truth.solution.y;
+  set_scales(problem, t);
+  for (auto* r : ok) {
+    // The truth itself is reported against its partner, so its own row is not a 0.
+    const auto& other = r == &truth ? *ok[best_k] : truth;
+    r->compared_with = other.source;
+    r->vs = compare(r->solution.y, other.solution.y, dim, t.pos_scale, t.vel_scale);
+    judge_agreement(*r, t);
+  }
+}
+
+}  // namespace
+
 truth_table build_truth(const problem_instance& problem, std::span<const double> times, const truth_options& opts) {
   truth_table t;
   t.times.assign(times.begin(), times.end());
@@ -80,85 +171,14 @@ truth_table build_truth(const problem_instance& problem, std::span<const double>
   const bool closed = opts.use_closed_form && problem.has_closed_form();
   if (!closed && !opts.run_references)
     throw std::invalid_argument(fmt::format("problem {}: no closed form and references disabled", problem.name()));
-  const int dim = problem.dim();
-
-  if (opts.run_references) {
-    const ode_system sys = problem.ode();
-    for (const char* source : reference_sources) {
-      reference_check rc;
-      rc.source = source;
-      if (sys.has_contacts() && !reference_handles_contacts(source)) {
-        rc.status = "unsupported";
-        rc.reason = "the problem has contacts, and this reference has no root finding to stop at them";
-        t.references.push_back(std::move(rc));
-        continue;
-      }
-      try {
-        rc.solution = solve_reference(source, sys, times, opts.tol);
-      } catch (const std::runtime_error& e) {
-        rc.status = "failed";
-        rc.reason = e.what();
-      }
-      t.references.push_back(std::move(rc));
-    }
-  }
+  if (opts.run_references) t.references = run_references(problem, times, opts);
   std::vector<reference_check*> ok;
   for (auto& r : t.references)
     if (r.status == "ok") ok.push_back(&r);
-
-  if (closed) {
-    t.source = "closed_form";
-    for (double time : times) t.y.push_back(problem.exact(time));
-    for (std::size_t j = 0; j < t.y.size(); ++j)
-      for (double value : t.y[j])
-        if (!std::isfinite(value))
-          throw std::runtime_error(
-              fmt::format("the closed form of problem {} is not finite at t = {:g}: are the parameters in range?",
-                          problem.name(), t.times[j]));
-    set_scales(problem, t);
-    for (auto* r : ok) {
-      r->compared_with = t.source;
-      r->vs = compare(r->solution.y, t.y, dim, t.pos_scale, t.vel_scale);
-      if (!(r->vs.worst() <= t.agreement_limit))
-        r->status = "disagrees", r->reason = disagreement(r->vs, t.agreement_limit);
-    }
-  } else {
-    // The best-agreeing pair, on scales from the first usable reference.
-    if (!ok.empty()) {
-      t.y = ok.front()->solution.y;
-      set_scales(problem, t);
-    }
-    std::size_t best_i = 0, best_k = 0;
-    double best = std::numeric_limits<double>::infinity();
-    for (std::size_t i = 0; i < ok.size(); ++i)
-      for (std::size_t k = i + 1; k < ok.size(); ++k) {
-        const double w = compare(ok[i]->solution.y, ok[k]->solution.y, dim, t.pos_scale, t.vel_scale).worst();
-        if (w < best) best = w, best_i = i, best_k = k;
-      }
-    if (ok.size() < 2 || !(best <= t.agreement_limit)) {
-      t.trusted = false;
-      t.source = "none";
-      t.note = ok.size() < 2 ? fmt::format("only {} of {} references completed, and no closed form to check them",
-                                           ok.size(), t.references.size())
-                             : fmt::format("no two references agree within {:.1e} (best pair {} and {}: {:.3e})",
-                                           t.agreement_limit, ok[best_i]->source, ok[best_k]->source, best);
-      t.y.assign(times.size(), std::vector<double>(2 * dim, nan));
-      for (auto* r : ok) r->status = "disagrees", r->reason = t.note;
-    } else {
-      reference_check& truth = *ok[best_i];
-      t.source = truth.source;
-      t.y = truth.solution.y;
-      set_scales(problem, t);
-      for (auto* r : ok) {
-        // The truth itself is reported against its partner, so its own row is not a 0.
-        const auto& other = r == &truth ? *ok[best_k] : truth;
-        r->compared_with = other.source;
-        r->vs = compare(r->solution.y, other.solution.y, dim, t.pos_scale, t.vel_scale);
-        if (!(r->vs.worst() <= t.agreement_limit))
-          r->status = "disagrees", r->reason = disagreement(r->vs, t.agreement_limit);
-      }
-    }
-  }
+  if (closed)
+    truth_from_closed_form(problem, t, ok);
+  else
+    truth_from_references(problem, t, ok);
   if (problem.has_exact_contacts() && !t.times.empty()) {
     const exact_contact_list c = problem.exact_contacts(t.times.back());
     t.contact_count = c.count;

@@ -99,6 +99,52 @@ void check_truth_times(const truth_table& truth, const loop_result& run) {
   if (truth.times != run.display_t) throw std::logic_error("measure_loop: the truth's times are not the run's frames");
 }
 
+// Steps per frame over the counted frames, the stall's burst, the clamp, the clock's lag
+// and the interpolation factor's range.
+void count_steps(loop_row& row, const loop_config& config, const loop_result& run, std::size_t counted) {
+  long steps = 0;
+  row.alpha_min = row.alpha_max = nan;
+  double lag_clock = 0.0;
+  for (std::size_t j = 0; j < counted; ++j) {
+    steps += run.steps[j];
+    row.steps_per_frame_max = std::max<long>(row.steps_per_frame_max, run.steps[j]);
+    if (run.stall[j]) row.stall_burst_steps = run.steps[j];
+    row.clamp_hits += run.clamped[j];
+    lag_clock += run.display_t[j] - run.shown_t[j];
+    if (uses_accumulator(config.design)) {
+      row.alpha_min = j == 0 ? run.alpha[j] : std::min(row.alpha_min, run.alpha[j]);
+      row.alpha_max = j == 0 ? run.alpha[j] : std::max(row.alpha_max, run.alpha[j]);
+    }
+  }
+  row.steps_per_frame_mean = counted ? static_cast<double>(steps) / static_cast<double>(counted) : nan;
+  row.lag_clock_s = counted ? lag_clock / static_cast<double>(counted) : nan;
+}
+
+// Judder: the spread (RMS about the mean) of (shown - exact) velocity over the counted
+// frames, each velocity the finite difference of positions over the display time
+// between consecutive frames. NaN with fewer than two pairs of frames.
+double judder(const loop_result& run, const truth_table& truth, std::size_t counted) {
+  const int dim = run.dim;
+  std::vector<double> d;  // (shown - exact) velocity differences, dim per pair
+  for (std::size_t j = 1; j < counted; ++j) {
+    const double h = run.display_t[j] - run.display_t[j - 1];
+    for (int i = 0; i < dim; ++i) {
+      const double shown = run.shown[j * dim + i] - run.shown[(j - 1) * dim + i];
+      const double exact = truth.y[j][i] - truth.y[j - 1][i];
+      d.push_back((shown - exact) / h);
+    }
+  }
+  const std::size_t pairs = d.size() / std::max(dim, 1);
+  if (pairs < 2) return nan;
+  std::vector<double> mean(dim, 0.0);
+  for (std::size_t p = 0; p < pairs; ++p)
+    for (int i = 0; i < dim; ++i) mean[i] += d[p * dim + i] / static_cast<double>(pairs);
+  double var = 0.0;
+  for (std::size_t p = 0; p < pairs; ++p)
+    for (int i = 0; i < dim; ++i) var += (d[p * dim + i] - mean[i]) * (d[p * dim + i] - mean[i]);
+  return std::sqrt(var / static_cast<double>(pairs));
+}
+
 }  // namespace
 
 truth_table loop_truth(const problem_instance& problem, const loop_result& run) {
@@ -130,23 +176,7 @@ loop_row measure_loop(const loop_config& config, std::string clock, const loop_r
   }
   row.frames = static_cast<long>(counted);
 
-  // Steps per frame, the stall's burst, the clamp.
-  long steps = 0;
-  row.alpha_min = row.alpha_max = nan;
-  double lag_clock = 0.0;
-  for (std::size_t j = 0; j < counted; ++j) {
-    steps += run.steps[j];
-    row.steps_per_frame_max = std::max<long>(row.steps_per_frame_max, run.steps[j]);
-    if (run.stall[j]) row.stall_burst_steps = run.steps[j];
-    row.clamp_hits += run.clamped[j];
-    lag_clock += run.display_t[j] - run.shown_t[j];
-    if (uses_accumulator(config.design)) {
-      row.alpha_min = j == 0 ? run.alpha[j] : std::min(row.alpha_min, run.alpha[j]);
-      row.alpha_max = j == 0 ? run.alpha[j] : std::max(row.alpha_max, run.alpha[j]);
-    }
-  }
-  row.steps_per_frame_mean = counted ? static_cast<double>(steps) / static_cast<double>(counted) : nan;
-  row.lag_clock_s = counted ? lag_clock / static_cast<double>(counted) : nan;
+  count_steps(row, config, run, counted);
 
   // Frame-rate independence: the state at the horizon against the reference clock's.
   row.clock_dependence = row.physics_clock_dependence = nan;
@@ -185,29 +215,7 @@ loop_row measure_loop(const loop_config& config, std::string clock, const loop_r
   row.final_shown_err = frames ? distance(run.shown.data() + (frames - 1) * dim, truth.y.back().data(), dim) : nan;
   row.lag_s = lag_den > 0.0 ? -lag_num / lag_den : nan;
 
-  // Judder: the spread of (shown - exact) velocity, each the finite difference of
-  // positions over the display time between consecutive frames.
-  std::vector<double> d;  // (shown - exact) velocity differences, dim per pair
-  for (std::size_t j = 1; j < counted; ++j) {
-    const double h = run.display_t[j] - run.display_t[j - 1];
-    for (int i = 0; i < dim; ++i) {
-      const double shown = run.shown[j * dim + i] - run.shown[(j - 1) * dim + i];
-      const double exact = truth.y[j][i] - truth.y[j - 1][i];
-      d.push_back((shown - exact) / h);
-    }
-  }
-  const std::size_t pairs = d.size() / std::max(dim, 1);
-  if (pairs >= 2) {
-    std::vector<double> mean(dim, 0.0);
-    for (std::size_t p = 0; p < pairs; ++p)
-      for (int i = 0; i < dim; ++i) mean[i] += d[p * dim + i] / static_cast<double>(pairs);
-    double var = 0.0;
-    for (std::size_t p = 0; p < pairs; ++p)
-      for (int i = 0; i < dim; ++i) var += (d[p * dim + i] - mean[i]) * (d[p * dim + i] - mean[i]);
-    row.judder = std::sqrt(var / static_cast<double>(pairs));
-  } else {
-    row.judder = nan;
-  }
+  row.judder = judder(run, truth, counted);
 
   if (!(row.shown_err_max <= blowup_factor * truth.pos_scale)) {
     row.diverged = true;

@@ -252,69 +252,81 @@ std::pair<double, double> bisect(double lo, double hi, double rtol, Stable&& sta
   return {lo, hi};
 }
 
-template <class I, class P>
-stability_limit limit_of(const P& p, stability_test test, const stability_settings& s) {
-  stability_limit out{std::string(I::name), test, nan, nan, false, false, false, nan, {}};
-  std::string why, first_why;  // the method's message at the first failed step
-  const auto failed_at = [&](double y) {
+// One method's limit being found: the result so far, and the method's message at the
+// first failed step.
+struct limit_search {
+  stability_limit out;
+  std::string why, first_why;
+  void failed_at(double y) {
     if (!(y >= out.step_failed_at)) first_why = why;
     out.step_failed_at = std::fmin(out.step_failed_at, y);
-  };
+  }
+};
 
-  // (a) rho(M(y)) - 1 against the allowance rho_tol.
-  const auto excess = [&](double y) { return spectral_radius(amplification<I>(p, y, &why)) - 1.0; };
+// (a) From the amplification matrix: rho(M(y)) - 1 against the allowance rho_tol, over
+// the scan grid, then bisected to the first change from stable to unstable. Sets
+// out.theory, or out.unstable_for_all_dt or out.unconditionally_stable; false when the
+// verdict ends here (the step fails, or rho is too close to the allowance to classify).
+template <class I, class P>
+bool theory_limit(const P& p, const stability_settings& s, limit_search& f) {
+  stability_limit& out = f.out;
+  const auto excess = [&](double y) { return spectral_radius(amplification<I>(p, y, &f.why)) - 1.0; };
   const auto judge = [&](double y) {
     const double e = excess(y);
-    if (std::isnan(e)) return failed_at(y), verdict::step_failed;
+    if (std::isnan(e)) return f.failed_at(y), verdict::step_failed;
     return e <= s.rho_tol ? verdict::stable : verdict::unstable;
   };
   const auto ys = scan_grid(s);
   const double e0 = excess(ys.front());
   if (std::isnan(e0)) {
-    failed_at(ys.front());
-    out.note = fmt::format("the step fails at y = {:g} ({})", ys.front(), why);
-    return out;
+    f.failed_at(ys.front());
+    out.note = fmt::format("the step fails at y = {:g} ({})", ys.front(), f.why);
+    return false;
   }
   if (e0 > s.rho_tol) {
     if (!(e0 > s.clear_factor * s.rho_tol)) {
       out.note =
           fmt::format("rho - 1 = {:.3g} at y = {:g}: too close to the round-off allowance to classify", e0, ys.front());
-      return out;
+      return false;
     }
     out.unstable_for_all_dt = true;
-  } else {
-    double last_stable = ys.front();
-    int failures = 0;
-    for (std::size_t k = 1; k < ys.size() && std::isnan(out.theory); ++k) {
-      const verdict v = judge(ys[k]);
-      if (v == verdict::step_failed) {
-        ++failures;
-      } else if (v == verdict::stable) {
-        last_stable = ys[k];
-      } else {
-        const auto [lo, hi] =
-            bisect(last_stable, ys[k], s.root_rtol, [&](double y) { return judge(y) == verdict::stable; });
-        out.theory = 0.5 * (lo + hi);
-      }
-    }
-    if (std::isnan(out.theory)) {
-      if (failures == 0) {
-        out.unconditionally_stable = true;
-      } else {
-        // Stable wherever the step exists: no verdict on the rest.
-        out.note = fmt::format(
-            "stable at every y of the scan where the step exists; the step fails at {} of {} "
-            "scan points, from y = {:.4g} ({})",
-            failures, ys.size(), out.step_failed_at, first_why);
-        return out;
-      }
+    return true;
+  }
+  double last_stable = ys.front();
+  int failures = 0;
+  for (std::size_t k = 1; k < ys.size() && std::isnan(out.theory); ++k) {
+    const verdict v = judge(ys[k]);
+    if (v == verdict::step_failed) {
+      ++failures;
+    } else if (v == verdict::stable) {
+      last_stable = ys[k];
+    } else {
+      const auto [lo, hi] =
+          bisect(last_stable, ys[k], s.root_rtol, [&](double y) { return judge(y) == verdict::stable; });
+      out.theory = 0.5 * (lo + hi);
     }
   }
+  if (!std::isnan(out.theory)) return true;
+  if (failures == 0) {
+    out.unconditionally_stable = true;
+    return true;
+  }
+  // Stable wherever the step exists: no verdict on the rest.
+  out.note = fmt::format(
+      "stable at every y of the scan where the step exists; the step fails at {} of {} "
+      "scan points, from y = {:.4g} ({})",
+      failures, ys.size(), out.step_failed_at, f.first_why);
+  return false;
+}
 
-  // (b) Long runs.
+// (b) From long runs of the compiled step: confirms a verdict of (a), or measures the
+// limit by walking from run_y_start to the first change of verdict and bisecting.
+template <class I, class P>
+void measured_limit(const P& p, const stability_settings& s, limit_search& f) {
+  stability_limit& out = f.out;
   const auto run = [&](double y) {
-    const verdict v = long_run<I>(p, y, s, why);
-    if (v == verdict::step_failed) failed_at(y);
+    const verdict v = long_run<I>(p, y, s, f.why);
+    if (v == verdict::step_failed) f.failed_at(y);
     return v;
   };
   const auto words = [&](verdict v) {
@@ -324,16 +336,15 @@ stability_limit limit_of(const P& p, stability_test test, const stability_settin
     const verdict v = run(s.confirm_y);
     out.run_confirms = v == verdict::unstable;
     out.note = fmt::format("{} steps at y = {:g}: {}", s.run_steps, s.confirm_y, words(v));
-    return out;
+    return;
   }
   if (out.unconditionally_stable) {
     const verdict at_max = run(s.y_max), at_unconditional = run(s.y_unconditional);
     out.run_confirms = at_max == verdict::stable && at_unconditional == verdict::stable;
     out.note = fmt::format("{} steps at y = {:g}: {}; at y = {:g}: {}", s.run_steps, s.y_max, words(at_max),
                            s.y_unconditional, words(at_unconditional));
-    return out;
+    return;
   }
-  // A finite limit: walk from run_y_start to the first change of verdict, then bisect.
   const auto bounded = [&](double y) { return run(y) == verdict::stable; };
   const double factor = std::pow(10.0, 1.0 / s.run_per_decade);
   double lo, hi;
@@ -353,7 +364,13 @@ stability_limit limit_of(const P& p, stability_test test, const stability_settin
     out.note = fmt::format("{} steps: no change of verdict between y = {:g} and {:g}", s.run_steps, s.y_min,
                            s.y_unconditional);
   }
-  return out;
+}
+
+template <class I, class P>
+stability_limit limit_of(const P& p, stability_test test, const stability_settings& s) {
+  limit_search f{{std::string(I::name), test, nan, nan, false, false, false, nan, {}}, {}, {}};
+  if (theory_limit<I>(p, s, f)) measured_limit<I>(p, s, f);
+  return f.out;
 }
 
 template <class I>

@@ -62,7 +62,9 @@ void print_list(const json& out) {
     fmt::print("\nnames {} takes:\n{}", param, render_text(named));
   }
   for (const auto origin : {method_origin::ours, method_origin::peer, method_origin::baseline}) {
-    table methods{{{"method"}, {"kind"}, right_column("order"), {"description"}, {"capabilities"}}, {}};
+    table methods{
+        {{"method"}, {"kind"}, right_column("order"), right_column("evals/step"), {"description"}, {"capabilities"}},
+        {}};
     for (const auto& m : all_methods()) {
       if (m.origin != origin) continue;
       std::string caps;
@@ -70,7 +72,8 @@ void print_list(const json& out) {
       for (const auto& [key, on] : declared.items())
         if (on.get<bool>()) caps += (caps.empty() ? "" : ", ") + key;
       methods.add({m.name, std::string(to_string(m.kind)),
-                   std::isfinite(m.declared_order) ? fmt::format("{:g}", m.declared_order) : "-", m.description, caps});
+                   std::isfinite(m.declared_order) ? fmt::format("{:g}", m.declared_order) : "-",
+                   std::isfinite(m.evals_per_step) ? fmt::format("{:g}", m.evals_per_step) : "-", m.description, caps});
     }
     fmt::print("\n{}:\n{}",
                origin == method_origin::ours   ? "integrators (ours)"
@@ -118,6 +121,7 @@ int run_list(bool as_json) {
               {"library", m.library},
               {"capabilities", capabilities_json(m.traits)}};
     j["declared_order"] = std::isfinite(m.declared_order) ? json(m.declared_order) : json(nullptr);
+    j["evals_per_step"] = std::isfinite(m.evals_per_step) ? json(m.evals_per_step) : json(nullptr);
     out["methods"].push_back(j);
   }
   if (as_json) {

@@ -44,12 +44,27 @@ struct run_limits {
   }
 };
 
+// Where a method runs: on every problem, unless it declares
+// `template <problem P> static constexpr bool applies` (Odeint's peers need a state size
+// known at compile time, the baselines their own two problems).
+template <class M, class P>
+consteval bool method_applies() {
+  if constexpr (requires { M::template applies<P>; })
+    return M::template applies<P>;
+  else
+    return true;
+}
+
 struct method_info {
   std::string name;
   std::string description;
   method_origin origin = method_origin::ours;
   method_kind kind = method_kind::fixed_step;
   double declared_order = std::numeric_limits<double>::quiet_NaN();  // NaN: the method declares none
+  // Force evaluations a step (an adaptive method's: an accepted attempt's), by its
+  // construction; NaN where they depend on the problem or the solve (a velocity-dependent
+  // force, Newton iterations, a library's own choices). The study measures them anyway.
+  double evals_per_step = std::numeric_limits<double>::quiet_NaN();
   capabilities traits{};
   std::string library;  // "stepbench", "GSL", "SUNDIALS CVODE", "Boost.Odeint"
 };

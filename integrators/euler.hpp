@@ -12,6 +12,7 @@ struct euler {
   static constexpr std::string_view description = "explicit Euler: position with the old velocity";
   static constexpr int order = 1;
   static constexpr capabilities traits{};
+  static constexpr int force_evals_per_step = 1;
 
   template <class Sys, class Vec>
   void step(const Sys& sys, double t, step_state<Vec>& s, double dt) const {

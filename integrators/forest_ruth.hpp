@@ -16,6 +16,7 @@ struct forest_ruth {
   static constexpr std::string_view description = "Forest-Ruth: Yoshida's triple jump of velocity Verlet, order 4";
   static constexpr int order = 4;
   static constexpr capabilities traits{.symplectic = true, .reuses_last_force = true};
+  static constexpr int force_evals_per_step = 3;
 
   template <class Sys>
   struct stepper : composition_stepper<triple_jump4_kick_drift, Sys> {

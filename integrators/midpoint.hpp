@@ -13,6 +13,7 @@ struct midpoint {
   static constexpr std::string_view description = "explicit midpoint (RK2)";
   static constexpr int order = 2;
   static constexpr capabilities traits{};
+  static constexpr int force_evals_per_step = 2;
 
   template <class Sys>
   struct stepper {

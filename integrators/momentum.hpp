@@ -14,6 +14,7 @@ struct momentum {
   static constexpr std::string_view description = "momentum form: p += F dt, v = p / m, x += v dt";
   static constexpr int order = 1;
   static constexpr capabilities traits{.symplectic = true};
+  static constexpr int force_evals_per_step = 1;
 
   template <class Sys>
   struct stepper {

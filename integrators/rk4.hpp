@@ -15,6 +15,7 @@ struct rk4 {
   static constexpr std::string_view description = "classic fourth-order Runge-Kutta";
   static constexpr int order = 4;
   static constexpr capabilities traits{};
+  static constexpr int force_evals_per_step = 4;
 
   template <class Sys>
   struct stepper {

@@ -17,6 +17,7 @@ struct rk8 {
   static constexpr std::string_view description = "eighth-order Runge-Kutta: the 12-stage DOP853 step at fixed dt";
   static constexpr int order = 8;
   static constexpr capabilities traits{};
+  static constexpr int force_evals_per_step = 12;
 
   template <class Sys>
   struct stepper {

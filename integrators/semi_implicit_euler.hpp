@@ -12,6 +12,7 @@ struct semi_implicit_euler {
   static constexpr std::string_view description = "semi-implicit Euler: velocity first, then position";
   static constexpr int order = 1;
   static constexpr capabilities traits{.symplectic = true};
+  static constexpr int force_evals_per_step = 1;
 
   template <class Sys, class Vec>
   void step(const Sys& sys, double t, step_state<Vec>& s, double dt) const {

@@ -58,6 +58,7 @@ struct baseline_rk4 {
             .description = "hand-written RK4 on plain doubles, fully inlined: the speed-of-light step, for scale",
             .origin = method_origin::baseline,
             .declared_order = 4.0,
+            .evals_per_step = 4.0,
             .library = "hand-written"};
   }
   template <problem P>

@@ -31,6 +31,7 @@ struct baseline_rk8 {
                 "step, for scale",
             .origin = method_origin::baseline,
             .declared_order = 8.0,
+            .evals_per_step = 12.0,
             .library = "hand-written"};
   }
   template <problem P>

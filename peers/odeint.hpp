@@ -57,12 +57,14 @@ void split_state(const std::array<double, N>& y, Vec& x, Vec& v) {
 struct odeint_rk4_step {
   static constexpr const char* name = "odeint_rk4";
   static constexpr const char* description = "Boost.Odeint runge_kutta4 on std::array";
+  static constexpr double evals_per_step = 4.0;
   template <class S>
   using stepper = boost::numeric::odeint::runge_kutta4<S>;
 };
 struct odeint_rkf78_step {
   static constexpr const char* name = "odeint_rkf78";
   static constexpr const char* description = "Boost.Odeint runge_kutta_fehlberg78 at fixed dt, on std::array";
+  static constexpr double evals_per_step = 13.0;
   template <class S>
   using stepper = boost::numeric::odeint::runge_kutta_fehlberg78<S>;
 };
@@ -76,6 +78,7 @@ struct odeint_fixed {
             .description = Tag::description,
             .origin = method_origin::peer,
             .declared_order = static_cast<double>(Tag::template stepper<std::array<double, 2>>::order_value),
+            .evals_per_step = Tag::evals_per_step,
             .library = "Boost.Odeint"};
   }
   template <problem P>

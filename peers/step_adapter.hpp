@@ -35,14 +35,6 @@
 namespace stepbench::peers {
 
 namespace adapter_detail {
-template <class Peer, class P>
-consteval bool applies() {
-  if constexpr (requires { Peer::template applies<P>; })
-    return Peer::template applies<P>;
-  else
-    return true;
-}
-
 // The state at t recorded; false (and the run marked non-finite) when it is not finite.
 template <class Vec, class Adapter>
 [[gnu::always_inline]] inline bool record_if_finite(drive_result<Vec>& out, const Adapter& a, double t, Vec& x,
@@ -67,16 +59,21 @@ template <class Vec, class Adapter>
 // A fixed-step peer at our dt, on core/drive.hpp's fixed-step loop (the same grid,
 // landing and recording as our methods'). Flattened: the adapter's step inlines into the
 // loop, as ours does into drive().
-template <class Peer>
-struct fixed_step_peer {
+// What every peer entry declares: its descriptor with the kind of its loop, and where
+// it runs.
+template <class Peer, method_kind Kind>
+struct peer_entry {
   static method_info info() {
     method_info m = Peer::describe();
-    m.kind = method_kind::fixed_step;
+    m.kind = Kind;
     return m;
   }
   template <problem P>
-  static constexpr bool applies = adapter_detail::applies<Peer, P>();
+  static constexpr bool applies = method_applies<Peer, P>();
+};
 
+template <class Peer>
+struct fixed_step_peer : peer_entry<Peer, method_kind::fixed_step> {
   template <problem P>
   static auto prepare(const P& p, double dt, double horizon, std::span<const double> times, const run_limits&) {
     return [p, dt, horizon, plan = plan_records(horizon, dt, times)] { return run(p, dt, horizon, plan); };
@@ -109,15 +106,7 @@ struct fixed_step_peer {
 // as over budget (skipped, not failed) after the adaptive step budget (run_limits) for
 // the peer's `evals_per_step`.
 template <class Peer>
-struct adaptive_peer {
-  static method_info info() {
-    method_info m = Peer::describe();
-    m.kind = method_kind::adaptive;
-    return m;
-  }
-  template <problem P>
-  static constexpr bool applies = adapter_detail::applies<Peer, P>();
-
+struct adaptive_peer : peer_entry<Peer, method_kind::adaptive> {
   template <problem P>
   static auto prepare(const P& p, double tol, double horizon, std::span<const double> times, const run_limits& limits) {
     const long max_steps = limits.adaptive_steps(p.dim(), Peer::evals_per_step);

@@ -31,12 +31,20 @@ namespace stepbench::registry_detail {
 // What every one of our integrators declares (its name, description, order and
 // capabilities), as a registry entry of the given kind.
 template <class I>
+constexpr double evals_per_step_of() {
+  if constexpr (requires { I::force_evals_per_step; })
+    return I::force_evals_per_step;
+  else
+    return std::numeric_limits<double>::quiet_NaN();
+}
+template <class I>
 method_info ours_info(method_kind kind) {
   return {.name = std::string(I::name),
           .description = std::string(I::description),
           .origin = method_origin::ours,
           .kind = kind,
           .declared_order = static_cast<double>(I::order),
+          .evals_per_step = evals_per_step_of<I>(),
           .traits = I::traits,
           .library = "stepbench"};
 }
@@ -93,17 +101,8 @@ template <class I>
 inline constexpr bool is_ours<ours_fixed<I>> = true;
 template <class I>
 inline constexpr bool is_ours<ours_adaptive<I>> = true;
-// A method applies to every problem unless it declares `applies<P>` (Odeint's peers
-// need a state size known at compile time, the baselines their own two problems).
 template <class M, class P>
-consteval bool applies_to() {
-  if constexpr (requires { M::template applies<P>; })
-    return M::template applies<P>;
-  else
-    return true;
-}
-template <class M, class P>
-inline constexpr bool runs_on = applies_to<M, P>() && (!has_contacts<P> || is_ours<M>);
+inline constexpr bool runs_on = method_applies<M, P>() && (!has_contacts<P> || is_ours<M>);
 
 template <class M>
 const method_info& info_of() {

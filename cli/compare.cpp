@@ -135,8 +135,8 @@ int run_compare(const compare_args& a) {
     opts.gate_timing = a.gate_timing;
     if (a.json && a.format == "md") throw std::invalid_argument("--json and --format md: choose one");
     const std::string format = a.json ? "json" : a.format;
-    const study_data base = read_study(a.base);
-    const study_data next = read_study(a.next);
+    const std::vector<study_data> files = read_studies({a.base, a.next});  // read at once
+    const study_data &base = files[0], &next = files[1];
     const comparison c = compare_studies(base, next, opts);
     if (format == "json")
       std::cout << comparison_json(c).dump(2) << "\n";

@@ -7,10 +7,16 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <concepts>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <map>
 #include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <vector>
 
 #include "core/measure.hpp"
 #include "study/h5.hpp"
@@ -149,56 +155,245 @@ study_data read_file(const std::string& path) {
   return out;
 }
 
+// The reader's answer carried from the child process to the parent ("wire"): the
+// study's fields in a flat binary form, each struct's fields listed once (fields()
+// below) for both directions. Both ends are this build, so native sizes and byte order.
+template <class A, class S>
+void fields(A& a, S& m) requires std::same_as<std::remove_const_t<S>, study_method> {
+  a(m.name, m.origin, m.kind, m.description, m.library, m.declared_order, m.fit_status, m.fit_slope,
+    m.declared_order_holds, m.fit_levels, m.columns, m.notes);
+}
+template <class A, class S>
+void fields(A& a, S& r) requires std::same_as<std::remove_const_t<S>, study_reference> {
+  a(r.source, r.status, r.reason, r.compared_with, r.err_pos_rel, r.err_vel_rel, r.is_truth);
+}
+template <class A, class S>
+void fields(A& a, S& p) requires std::same_as<std::remove_const_t<S>, study_problem> {
+  a(p.name, p.unit, p.truth_source, p.truth_trusted, p.horizon, p.pos_scale, p.vel_scale, p.params, p.references,
+    p.methods);
+}
+template <class A, class S>
+void fields(A& a, S& l) requires std::same_as<std::remove_const_t<S>, study_stability_limit> {
+  a(l.integrator, l.test, l.theory, l.measured, l.unstable_for_all_dt, l.unconditionally_stable);
+}
+template <class A, class S>
+void fields(A& a, S& d) requires std::same_as<std::remove_const_t<S>, study_data> {
+  a(d.path, d.format_version, d.meta, d.settings, d.timed, d.problems, d.stability);
+}
+template <class T>
+concept wire_scalar = std::is_arithmetic_v<T> || std::is_enum_v<T>;
+
+struct wire_writer {
+  std::string out;
+  template <class... T>
+  void operator()(const T&... v) {
+    (put(v), ...);
+  }
+  template <wire_scalar T>
+  void put(const T& v) {
+    out.append(reinterpret_cast<const char*>(&v), sizeof v);
+  }
+  void put(const std::string& v) {
+    put(v.size());
+    out.append(v);
+  }
+  template <class T>
+  void put(const std::vector<T>& v) {
+    put(v.size());
+    if constexpr (wire_scalar<T>)
+      out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+    else
+      for (const auto& x : v) put(x);
+  }
+  template <class K, class V>
+  void put(const std::map<K, V>& m) {
+    put(m.size());
+    for (const auto& [k, v] : m) put(k), put(v);
+  }
+  template <class T>
+  void put(const T& v) requires(!wire_scalar<T>) {
+    fields(*this, v);
+  }
+};
+
+struct wire_reader {
+  const char* p;
+  const char* end;
+  void need(std::size_t n) const {
+    if (static_cast<std::size_t>(end - p) < n) throw std::runtime_error("the checking process's answer is cut short");
+  }
+  template <class... T>
+  void operator()(T&... v) {
+    (get(v), ...);
+  }
+  template <wire_scalar T>
+  void get(T& v) {
+    need(sizeof v);
+    std::memcpy(&v, p, sizeof v);
+    p += sizeof v;
+  }
+  std::size_t size() {
+    std::size_t n = 0;
+    get(n);
+    return n;
+  }
+  void get(std::string& v) {
+    const std::size_t n = size();
+    need(n);
+    v.assign(p, n);
+    p += n;
+  }
+  template <class T>
+  void get(std::vector<T>& v) {
+    const std::size_t n = size();
+    if constexpr (wire_scalar<T>) {
+      need(n * sizeof(T));
+      v.resize(n);
+      std::memcpy(v.data(), p, n * sizeof(T));
+      p += n * sizeof(T);
+    } else {
+      v.resize(n);
+      for (auto& x : v) get(x);
+    }
+  }
+  template <class K, class V>
+  void get(std::map<K, V>& m) {
+    for (std::size_t n = size(); n > 0; --n) {
+      K k;
+      get(k);
+      get(m[k]);
+    }
+  }
+  template <class T>
+  void get(T& v) requires(!wire_scalar<T>) {
+    fields(*this, v);
+  }
+};
+
 // HDF5 1.10 trusts sizes stored in the file where no call of its API can check them
 // first (a global heap object's length when it reads a variable-length string, an
 // attribute message's size when it looks an attribute up): a damaged file can make it
-// copy out of bounds and crash. So the file is read first in a child process, its output
-// discarded; the child ends normally whether it read the file or refused it. Returns
-// how it ended when it did not ("SIGSEGV"; "exit 1": a sanitizer's report), else "".
-std::string crash_reading(const std::string& path) {
+// copy out of bounds and crash. So the file is read in a child process, which sends the
+// study back through a pipe (wire_writer) or why it could not read it; the parent never
+// calls HDF5 on the file. The first byte of the answer: 'S' the study, 'H' an HDF5
+// error's detail, 'R' another error's text. The children of several files run at once.
+struct reading_child {
+  std::string path;
+  pid_t pid = -1;
+  int fd = -1;
+};
+
+void write_all(int fd, const std::string& bytes) {
+  for (std::size_t done = 0; done < bytes.size();) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return;  // the parent is gone: nothing to tell
+    done += static_cast<std::size_t>(n);
+  }
+}
+
+reading_child start_reading(const std::string& path) {
+  int fds[2];
+  if (::pipe(fds) != 0)
+    throw std::runtime_error(fmt::format("cannot start the process that reads it: {}", std::strerror(errno)));
   std::fflush(nullptr);
   const pid_t child = ::fork();
-  if (child < 0)
-    throw std::runtime_error(fmt::format("cannot start the process that checks it: {}", std::strerror(errno)));
+  if (child < 0) {
+    ::close(fds[0]), ::close(fds[1]);
+    throw std::runtime_error(fmt::format("cannot start the process that reads it: {}", std::strerror(errno)));
+  }
   if (child == 0) {
+    ::close(fds[0]);
     const int null = ::open("/dev/null", O_WRONLY);
     ::dup2(null, STDOUT_FILENO);
     ::dup2(null, STDERR_FILENO);
+    wire_writer w;
     try {
-      read_file(path);
-    } catch (...) {
+      const study_data study = read_file(path);
+      w.out = "S";
+      w.put(study);
+    } catch (const H5::Exception& e) {
+      w.out = "H" + e.getDetailMsg();
+    } catch (const std::exception& e) {
+      w.out = std::string("R") + e.what();
     }
+    write_all(fds[1], w.out);
     std::_Exit(0);
   }
-  int status = 0;
-  while (::waitpid(child, &status, 0) < 0)
-    if (errno != EINTR)
-      throw std::runtime_error(fmt::format("cannot wait for the process that checks it: {}", std::strerror(errno)));
-  if (WIFSIGNALED(status)) return fmt::format("SIG{}", sigabbrev_np(WTERMSIG(status)));
-  if (WEXITSTATUS(status) != 0) return fmt::format("exit {}", WEXITSTATUS(status));
-  return {};
+  ::close(fds[1]);
+  return {path, child, fds[0]};
 }
+
+// The child's answer, once it has ended; throws the line read_study prints.
+study_data finish_reading(reading_child& c) {
+  const auto fail = [&](const std::string& what) {
+    return std::runtime_error(fmt::format("cannot read study file '{}': {}", c.path, what));
+  };
+  std::string answer;
+  char buf[1 << 16];
+  for (;;) {
+    const ssize_t n = ::read(c.fd, buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    answer.append(buf, static_cast<std::size_t>(n));
+  }
+  ::close(c.fd);
+  c.fd = -1;
+  int status = 0;
+  while (::waitpid(c.pid, &status, 0) < 0)
+    if (errno != EINTR) throw fail(fmt::format("cannot wait for the process that reads it: {}", std::strerror(errno)));
+  c.pid = -1;
+  // How the child ended when it did not end normally: a signal ("SIGSEGV"), or a
+  // sanitizer's report ("exit 1").
+  if (WIFSIGNALED(status))
+    throw fail(fmt::format("damaged: reading it crashes the HDF5 library (SIG{})", sigabbrev_np(WTERMSIG(status))));
+  if (WEXITSTATUS(status) != 0)
+    throw fail(fmt::format("damaged: reading it crashes the HDF5 library (exit {})", WEXITSTATUS(status)));
+  if (answer.empty()) throw fail("the process that reads it gave no answer");
+  const std::string rest = answer.substr(1);
+  if (answer[0] == 'H') throw fail(fmt::format("HDF5: {} (truncated or corrupt?)", rest));
+  if (answer[0] != 'S') throw fail(rest);
+  study_data out;
+  wire_reader r{answer.data() + 1, answer.data() + answer.size()};
+  r.get(out);
+  return out;
+}
+
+// Children still running when reading stops early (an error in an earlier file) are
+// stopped and reaped.
+struct reading_children {
+  std::vector<reading_child> all;
+  ~reading_children() {
+    for (auto& c : all) {
+      if (c.fd >= 0) ::close(c.fd);
+      if (c.pid > 0) {
+        ::kill(c.pid, SIGKILL);
+        while (::waitpid(c.pid, nullptr, 0) < 0 && errno == EINTR) {
+        }
+      }
+    }
+  }
+};
 
 }  // namespace
 
-study_data read_study(const std::string& path) {
-  const auto fail = [&](const std::string& what) {
-    return std::runtime_error(fmt::format("cannot read study file '{}': {}", path, what));
-  };
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw fail("no such file");
-  if (std::filesystem::is_directory(path, ec)) throw fail("it is a directory");
-  H5::Exception::dontPrint();
-  try {
-    if (const std::string crash = crash_reading(path); !crash.empty())
-      throw std::runtime_error(fmt::format("damaged: reading it crashes the HDF5 library ({})", crash));
-    return read_file(path);
-  } catch (const H5::Exception& e) {
-    throw fail(fmt::format("HDF5: {} (truncated or corrupt?)", e.getDetailMsg()));
-  } catch (const std::runtime_error& e) {
-    throw fail(e.what());
+std::vector<study_data> read_studies(const std::vector<std::string>& paths) {
+  for (const auto& path : paths) {
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec))
+      throw std::runtime_error(fmt::format("cannot read study file '{}': no such file", path));
+    if (std::filesystem::is_directory(path, ec))
+      throw std::runtime_error(fmt::format("cannot read study file '{}': it is a directory", path));
   }
+  H5::Exception::dontPrint();
+  reading_children children;
+  for (const auto& path : paths) children.all.push_back(start_reading(path));
+  std::vector<study_data> out;
+  for (auto& c : children.all) out.push_back(finish_reading(c));
+  return out;
 }
+
+study_data read_study(const std::string& path) { return std::move(read_studies({path}).front()); }
 
 std::vector<wp_method> work_precision_input(const study_problem& p, const std::string& metric, bool timed) {
   std::vector<wp_method> out;

@@ -70,6 +70,9 @@ inline constexpr long study_format_read_min = 3;
 // '<path>': <what is wrong>", for a missing, non-HDF5, truncated, corrupt or foreign
 // file, a format_version this build does not read, or a missing attribute or field.
 study_data read_study(const std::string& path);
+// Several files, read at once (one process each); the first that cannot be read, in the
+// order given, throws as read_study does.
+std::vector<study_data> read_studies(const std::vector<std::string>& paths);
 
 // The rows of a problem's methods in the shape the work-precision rule takes.
 std::vector<wp_method> work_precision_input(const study_problem& p, const std::string& metric, bool timed);

@@ -200,10 +200,11 @@ struct wire_writer {
   template <class T>
   void put(const std::vector<T>& v) {
     put(v.size());
-    if constexpr (wire_scalar<T>)
-      out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
-    else
+    if constexpr (wire_scalar<T>) {
+      if (!v.empty()) out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+    } else {
       for (const auto& x : v) put(x);
+    }
   }
   template <class K, class V>
   void put(const std::map<K, V>& m) {
@@ -249,7 +250,7 @@ struct wire_reader {
     if constexpr (wire_scalar<T>) {
       need(n * sizeof(T));
       v.resize(n);
-      std::memcpy(v.data(), p, n * sizeof(T));
+      if (n > 0) std::memcpy(v.data(), p, n * sizeof(T));  // an empty vector's data() may be null
       p += n * sizeof(T);
     } else {
       v.resize(n);

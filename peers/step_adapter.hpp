@@ -56,9 +56,6 @@ template <class Vec, class Adapter>
 }
 }  // namespace adapter_detail
 
-// A fixed-step peer at our dt, on core/drive.hpp's fixed-step loop (the same grid,
-// landing and recording as our methods'). Flattened: the adapter's step inlines into the
-// loop, as ours does into drive().
 // What every peer entry declares: its descriptor with the kind of its loop, and where
 // it runs.
 template <class Peer, method_kind Kind>
@@ -72,6 +69,9 @@ struct peer_entry {
   static constexpr bool applies = method_applies<Peer, P>();
 };
 
+// A fixed-step peer at our dt, on core/drive.hpp's fixed-step loop (the same grid,
+// landing and recording as our methods'). Flattened: the adapter's step inlines into the
+// loop, as ours does into drive().
 template <class Peer>
 struct fixed_step_peer : peer_entry<Peer, method_kind::fixed_step> {
   template <problem P>

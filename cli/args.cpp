@@ -4,22 +4,17 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
-#include <charconv>
-#include <cmath>
 #include <stdexcept>
 #include <vector>
 
+#include "core/number.hpp"
 #include "study/registry.hpp"
 
 namespace stepbench {
 
 double parse_number(std::string_view text, std::string_view what) {
-  double value = 0.0;
-  const char* end = text.data() + text.size();
-  auto [ptr, ec] = std::from_chars(text.data(), end, value);
-  if (text.empty() || ec != std::errc() || ptr != end || !std::isfinite(value))
-    throw std::invalid_argument(fmt::format("{} must be a finite number, got '{}'", what, text));
-  return value;
+  if (const auto value = finite_number(text)) return *value;
+  throw std::invalid_argument(fmt::format("{} must be a finite number, got '{}'", what, text));
 }
 
 void add_override(parameter_overrides& out, std::string_view text, std::span<const std::string> selected) {

@@ -3,8 +3,9 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include <charconv>
 #include <stdexcept>
+
+#include "core/number.hpp"
 
 namespace stepbench {
 
@@ -47,10 +48,7 @@ std::string param_value::check(double v) const {
 double param_value::parse(std::string_view text, std::string_view qualified_name) const {
   for (const auto& n : names)
     if (n.name == text) return n.value;
-  double v = 0.0;
-  const char* end = text.data() + text.size();
-  const auto [ptr, ec] = std::from_chars(text.data(), end, v);
-  if (!text.empty() && ec == std::errc() && ptr == end && std::isfinite(v)) return v;
+  if (const auto v = finite_number(text)) return *v;
   if (names.empty())
     throw std::invalid_argument(fmt::format("--set {} must be a finite number, got '{}'", qualified_name, text));
   std::vector<std::string_view> valid;

@@ -25,4 +25,17 @@ constexpr std::size_t type_list_size(type_list<Ts...>) {
   return sizeof...(Ts);
 }
 
+// The types of several lists, in order: type_list_cat_t<type_list<A, B>, type_list<C>>
+// is type_list<A, B, C>.
+template <class... Lists>
+struct type_list_cat;
+template <class... Ts>
+struct type_list_cat<type_list<Ts...>> {
+  using type = type_list<Ts...>;
+};
+template <class... Ts, class... Us, class... Rest>
+struct type_list_cat<type_list<Ts...>, type_list<Us...>, Rest...> : type_list_cat<type_list<Ts..., Us...>, Rest...> {};
+template <class... Lists>
+using type_list_cat_t = typename type_list_cat<Lists...>::type;
+
 }  // namespace stepbench

@@ -1,24 +1,14 @@
 #pragma once
-// The integrator registry: adding an integrator is its header plus one entry here.
+// The integrator registry: adding an integrator is its header plus one entry in its
+// group's list (integrators/group_*.hpp). The registry's order is the groups' in turn.
 // Fixed-step methods run over the dt ladder, adaptive ones over the tolerance ladder.
 #include "core/type_list.hpp"
-#include "integrators/adaptive_euler.hpp"
-#include "integrators/dop853.hpp"
-#include "integrators/euler.hpp"
-#include "integrators/forest_ruth.hpp"
-#include "integrators/implicit_euler.hpp"
-#include "integrators/implicit_midpoint.hpp"
-#include "integrators/midpoint.hpp"
-#include "integrators/momentum.hpp"
-#include "integrators/rk4.hpp"
-#include "integrators/rk45.hpp"
-#include "integrators/rk8.hpp"
-#include "integrators/semi_implicit_euler.hpp"
-#include "integrators/velocity_verlet.hpp"
+#include "integrators/group_adaptive_high_order.hpp"
+#include "integrators/group_explicit.hpp"
+#include "integrators/group_implicit.hpp"
 
 namespace stepbench {
 
-using all_integrators = type_list<euler, semi_implicit_euler, midpoint, rk4, momentum, velocity_verlet, forest_ruth,
-                                  implicit_euler, implicit_midpoint, adaptive_euler, rk45, rk8, dop853>;
+using all_integrators = type_list_cat_t<explicit_integrators, implicit_integrators, adaptive_high_order_integrators>;
 
 }  // namespace stepbench

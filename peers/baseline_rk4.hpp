@@ -6,12 +6,11 @@
 // same latency ordering as ours. Same recording of samples as our loop, so the
 // comparison is of the step alone.
 #include <cmath>
+#include <string_view>
 #include <utility>
 
 #include "core/method.hpp"
 #include "peers/step_adapter.hpp"
-#include "problems/damped_spring.hpp"
-#include "problems/pendulum.hpp"
 
 namespace stepbench::peers {
 
@@ -19,11 +18,15 @@ namespace stepbench::peers {
 // locals first, as a programmer writing one scalar loop by hand would: a = -(k/m) x -
 // (c/m) v, no division, no separate multiplication by 1/m. (Constants read from the
 // problem inside the loop would be reloaded every stage: the loop stores samples, which
-// the compiler must assume could alias the problem.)
-inline auto baseline_acceleration(const damped_spring& p) {
+// the compiler must assume could alias the problem.) Each is written for one problem,
+// chosen by its name, so that this header includes no problem (an edit to a problem
+// rebuilds its own units, not every peer's).
+template <problem P>
+requires(P::name == std::string_view("damped_spring")) auto baseline_acceleration(const P& p) {
   return [km = p.k_s / p.mass_kg, cm = p.k_d / p.mass_kg](double x, double v) { return -cm * v - km * x; };
 }
-inline auto baseline_acceleration(const pendulum& p) {
+template <problem P>
+requires(P::name == std::string_view("pendulum")) auto baseline_acceleration(const P& p) {
   return [g_over_l = p.gravity / p.length_m](double x, double) { return -g_over_l * std::sin(x); };
 }
 

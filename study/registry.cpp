@@ -6,8 +6,10 @@
 #include <memory>
 #include <stdexcept>
 
+#include "integrators/all.hpp"
+#include "peers/all.hpp"
 #include "problem_entries.hpp"  // generated from STEPBENCH_PROBLEMS (CMakeLists.txt)
-#include "study/problem_model.hpp"
+#include "study/method_entry.hpp"
 
 namespace stepbench {
 
@@ -28,7 +30,9 @@ std::unique_ptr<problem_instance> make_problem(std::string_view name) {
 const std::vector<method_info>& all_methods() {
   static const std::vector<method_info> all = [] {
     std::vector<method_info> out;
-    for_each_method([&]<class M>() { out.push_back(info_of<M>()); });
+    // Ours, then the peers: the registry's order (the study file's, `stepbench list`'s).
+    for_each_type(type_list_cat_t<all_integrators, all_peers>{},
+                  [&]<class M>() { out.push_back(info_of<entry_t<M>>()); });
     return out;
   }();
   return all;

@@ -1,20 +1,24 @@
-// No heap allocation inside the step loop, for any integrator on any problem: the
-// integrators keep their workspace, sized once per run. This binary replaces the global
-// operator new and, because Eigen allocates with malloc rather than new, interposes
-// malloc, calloc, realloc and the aligned variants too (glibc resolves them in the
-// executable first), counting every call. A run of 2N steps must then allocate exactly
-// as often as a run of N steps: whatever a run allocates (the recorded samples, the
-// workspace) is per run, not per step.
+// No heap allocation inside the step loop, for any of our integrators on any problem:
+// the integrators keep their workspace, sized once per run. This binary replaces the
+// global operator new and, because Eigen allocates with malloc rather than new,
+// interposes malloc, calloc, realloc and the aligned variants too (glibc resolves them in
+// the executable first), counting every call. A run of 2N steps must then allocate
+// exactly as often as a run of N steps: whatever a run allocates (the recorded samples,
+// the workspace, the result's vectors) is per run, not per step. The runs go through the
+// registry (problem_instance::run), the path the study takes, so that this test compiles
+// none of the methods itself: they are compiled once, in the study's method units.
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <cstdlib>
+#include <memory>
 #include <new>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "core/drive.hpp"
-#include "integrators/all.hpp"
-#include "problems/all.hpp"
+#include "study/registry.hpp"
 
 extern "C" {
 void* __libc_malloc(std::size_t);
@@ -79,14 +83,22 @@ long allocations_during(F&& run) {
 // diverges stops early, and this test wants every step taken.
 template <class F>
 void for_each_scene(F&& f) {
-  for_each_type(all_problems{}, [&]<class P>() {
-    P p{};
-    if constexpr (std::is_same_v<P, spring_chain>) {
-      p.masses = 64;
-      p.k_s = 10.0;
+  for (const auto& name : problem_names()) {
+    auto p = make_problem(name);
+    if (name == "spring_chain") {
+      p->set("masses", 64);
+      p->set("k_s", 10.0);
     }
-    f(p);
-  });
+    f(*p);
+  }
+}
+
+// Our methods of the given kind that run on the problem.
+std::vector<std::string> ours(const problem_instance& p, method_kind kind) {
+  std::vector<std::string> out;
+  for (const auto& m : p.methods())
+    if (m.origin == method_origin::ours && m.kind == kind) out.push_back(m.name);
+  return out;
 }
 
 }  // namespace
@@ -103,55 +115,58 @@ TEST(allocations, counting_sees_eigen_and_new) {
 }
 
 TEST(allocations, none_per_step_fixed_step) {
-  for_each_scene([&](const auto& p) {
-    using P = std::decay_t<decltype(p)>;
-    const std::vector<double> times = sample_times(p.horizon(), 4);
-    for_each_type(all_integrators{}, [&]<class I>() {
-      if constexpr (integrator<I>) {
-        // A run that fails (implicit Euler's Newton finds no root on the orbit's periapsis
-        // at 400 steps) is not a step loop to count in; the sweep records it as failed.
-        bool failed = false;
-        auto run = [&](long steps) {
-          const double dt = p.horizon() / static_cast<double>(steps);
-          const auto plan = plan_records(p.horizon(), dt, times);
-          return allocations_during([&] {
-            try {
-              const auto r = drive(p, I{}, dt, p.horizon(), plan);
-              EXPECT_EQ(r.steps, steps) << P::name << "/" << I::name;
-            } catch (const std::runtime_error&) {
-              failed = true;
-            }
-          });
-        };
-        const long a = run(400), b = run(800);
-        if (failed) return;
-        EXPECT_EQ(a, b) << P::name << "/" << I::name << ": " << a << " allocations for 400 steps, " << b << " for 800";
-      }
-    });
+  int runs = 0;
+  for_each_scene([&](const problem_instance& p) {
+    const double horizon = p.horizon();
+    const std::vector<double> times = sample_times(horizon, 4);
+    for (const auto& method : ours(p, method_kind::fixed_step)) {
+      // A run that fails (implicit Euler's Newton finds no root on the orbit's periapsis
+      // at 400 steps) is not a step loop to count in; the sweep records it as failed.
+      bool failed = false;
+      auto run = [&](long steps) {
+        const double dt = horizon / static_cast<double>(steps);
+        return allocations_during([&] {
+          const run_result r = p.run(method, dt, horizon, times, run_limits{});
+          failed = failed || !r.stop_reason.empty() || r.non_finite;
+          if (!failed) {
+            EXPECT_EQ(r.steps, steps) << p.name() << "/" << method;
+          }
+        });
+      };
+      const long a = run(400), b = run(800);
+      if (failed) continue;
+      ++runs;
+      EXPECT_EQ(a, b) << p.name() << "/" << method << ": " << a << " allocations for 400 steps, " << b << " for 800";
+    }
   });
+  EXPECT_GE(runs, 100);  // 13 problems, 10 fixed-step methods, few failures
 }
 
 TEST(allocations, none_per_step_adaptive) {
-  for_each_scene([&](const auto& p) {
-    using P = std::decay_t<decltype(p)>;
-    const std::vector<double> times = sample_times(p.horizon(), 4);
-    for_each_type(all_integrators{}, [&]<class I>() {
-      if constexpr (adaptive_integrator<I>) {
-        long steps[2] = {0, 0}, count[2] = {0, 0};
-        bool completed = true;
-        const double tol[2] = {1e-3, 1e-4};
-        for (int k = 0; k < 2; ++k)
-          count[k] = allocations_during([&] {
-            const auto r = drive_adaptive(p, I(tol[k]), p.horizon(), times, 1L << 22);
-            steps[k] = r.steps;
-            completed = completed && r.stop_reason.empty();
-          });
-        if (!completed) return;  // adaptive Euler on the stiff scenes: over its step budget
-        // rk45 is exact on a constant force and takes the same steps at both tolerances.
-        EXPECT_LE(steps[0], steps[1]) << P::name << "/" << I::name;
-        EXPECT_EQ(count[0], count[1]) << P::name << "/" << I::name << ": " << count[0] << " allocations for "
-                                      << steps[0] << " steps, " << count[1] << " for " << steps[1];
-      }
-    });
+  int runs = 0;
+  run_limits limits;
+  limits.work_budget = 1e15;
+  limits.max_steps = 1L << 22;
+  for_each_scene([&](const problem_instance& p) {
+    const double horizon = p.horizon();
+    const std::vector<double> times = sample_times(horizon, 4);
+    for (const auto& method : ours(p, method_kind::adaptive)) {
+      long steps[2] = {0, 0}, count[2] = {0, 0};
+      bool completed = true;
+      const double tol[2] = {1e-3, 1e-4};
+      for (int k = 0; k < 2; ++k)
+        count[k] = allocations_during([&] {
+          const run_result r = p.run(method, tol[k], horizon, times, limits);
+          steps[k] = r.steps;
+          completed = completed && r.stop_reason.empty() && !r.non_finite;
+        });
+      if (!completed) continue;  // adaptive Euler on the stiff scenes: over its step budget
+      ++runs;
+      // rk45 is exact on a constant force and takes the same steps at both tolerances.
+      EXPECT_LE(steps[0], steps[1]) << p.name() << "/" << method;
+      EXPECT_EQ(count[0], count[1]) << p.name() << "/" << method << ": " << count[0] << " allocations for " << steps[0]
+                                    << " steps, " << count[1] << " for " << steps[1];
+    }
   });
+  EXPECT_GE(runs, 30);  // 13 problems, 3 adaptive methods
 }

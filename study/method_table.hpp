@@ -1,0 +1,115 @@
+#pragma once
+// A problem's methods as a table of slots: for each method that runs on P, its info and
+// the functions that run it, time it and (ours at a fixed step) run it in the game loop.
+// The slots are filled by the method units CMake generates from study/method_unit.cpp.in,
+// one per problem and method group (integrators/group_*.hpp, peers/group_*.hpp), so that
+// editing one integrator rebuilds its group's units, not every method on every problem;
+// problem_model<P> (study/problem_model.hpp) reads the table and includes no method.
+#include <fmt/format.h>
+
+#include <exception>
+#include <functional>
+#include <span>
+#include <stdexcept>
+#include <string_view>
+#include <vector>
+
+#include "core/drive.hpp"
+#include "core/game_loop.hpp"
+#include "core/method.hpp"
+#include "core/problem_instance.hpp"
+#include "core/type_list.hpp"
+#include "study/method_entry.hpp"
+
+namespace stepbench::registry_detail {
+
+template <class P>
+struct method_slot {
+  const method_info* info = nullptr;
+  run_result (*run)(const P&, double param, double horizon, std::span<const double> times,
+                    const run_limits&) = nullptr;
+  std::function<double()> (*timed_run)(const P&, double param, double horizon, std::span<const double> times,
+                                       const run_limits&) = nullptr;
+  loop_result (*loop)(const P&, const loop_config&) = nullptr;  // ours at a fixed step only
+};
+template <class P>
+using method_table = std::vector<method_slot<P>>;
+
+template <class Vec>
+std::vector<double> flatten(const Vec& x, const Vec& v) {
+  std::vector<double> y(x.data(), x.data() + x.size());
+  y.insert(y.end(), v.data(), v.data() + v.size());
+  return y;
+}
+
+template <class Vec>
+run_result to_run_result(const drive_result<Vec>& r, double param, double horizon) {
+  run_result out;
+  out.param = param;
+  out.horizon = horizon;
+  out.steps = r.steps;
+  out.rejected_steps = r.rejected_steps;
+  out.work = r.work;
+  out.non_finite = r.non_finite;
+  out.stop_reason = r.stop_reason;
+  out.skipped = r.over_budget;
+  out.sample_t = r.sample_t;
+  for (std::size_t j = 0; j < r.sample_t.size(); ++j) {
+    const auto col = r.samples.col(static_cast<Eigen::Index>(j));
+    out.sample_y.emplace_back(col.data(), col.data() + col.size());
+  }
+  out.final_y = flatten(r.final_state.x, r.final_state.v);
+  out.contacts = r.contacts;
+  out.tunnelled = r.tunnelled;
+  out.max_penetration = r.max_penetration;
+  out.contact_times = r.contact_times;
+  for (std::size_t k = 0; k < r.contact_times.size() && r.contact_x.size() > 0; ++k) {
+    const auto col = r.contact_x.col(static_cast<Eigen::Index>(k));
+    out.contact_positions.emplace_back(col.data(), col.data() + col.size());
+  }
+  return out;
+}
+
+template <class M, problem P>
+run_result run_method(const P& p, double param, double horizon, std::span<const double> times,
+                      const run_limits& limits) {
+  auto run_once = M::prepare(p, param, horizon, times, limits);  // throws std::invalid_argument for bad times
+  try {
+    return to_run_result(run_once(), param, horizon);
+  } catch (const std::invalid_argument&) {
+    throw;
+  } catch (const std::exception& e) {
+    // A solver error is the run's outcome, recorded with its reason; the study goes on.
+    run_result out;
+    out.param = param;
+    out.horizon = horizon;
+    out.stop_reason = e.what();
+    return out;
+  }
+}
+
+template <class M, problem P>
+std::function<double()> timed_method(const P& p, double param, double horizon, std::span<const double> times,
+                                     const run_limits& limits) {
+  return [run_once = M::prepare(p, param, horizon, times, limits)] { return run_once().final_state.x[0]; };
+}
+
+template <integrator I, problem P>
+loop_result loop_method(const P& p, const loop_config& config) {
+  return simulate_loop(p, I{}, config);
+}
+
+// Appends a slot for each method of the group that runs on P, in the group's order.
+template <problem P, class... Ms>
+void append_group(type_list<Ms...>, method_table<P>& table) {
+  for_each_type(type_list<entry_t<Ms>...>{}, [&]<class M>() {
+    if constexpr (runs_on<M, P>) {
+      method_slot<P> slot{.info = &info_of<M>(), .run = &run_method<M, P>, .timed_run = &timed_method<M, P>};
+      if constexpr (requires { typename M::integrator_type; })
+        slot.loop = &loop_method<typename M::integrator_type, P>;
+      table.push_back(slot);
+    }
+  });
+}
+
+}  // namespace stepbench::registry_detail

@@ -18,6 +18,8 @@ options take_own_flags(int& argc, char** argv, std::vector<std::string>& extra) 
     const std::string a = argv[i];
     if (a == "--quick") {
       o.quick = true;
+    } else if (a == "--strict") {
+      o.strict = true;
     } else if (a.rfind("--set=", 0) == 0) {
       sets.push_back(a.substr(6));  // resolved below, once every --problem is known
     } else if (a.rfind("--problem=", 0) == 0) {

@@ -3,6 +3,8 @@
 //   --quick              short minimum time, 8-level ladder, thinned tolerances (CI)
 //   --study_out=PATH     write the study file with each timing next to its accuracy row
 //   --case_budget=S      cut a family's finer cases once one iteration would exceed S s
+//   --strict             exit 3 when some case failed (a finding recorded in the study;
+//                        by default the run that found it succeeded: exit 0)
 //   --set=P.NAME=VALUE   a problem parameter, as every `stepbench` command's --set: a
 //                        number or a name the parameter takes; NAME=VALUE alone with
 //                        exactly one --problem (repeatable)
@@ -18,6 +20,7 @@ namespace stepbench::bench {
 
 struct options {
   bool quick = false;
+  bool strict = false;
   std::string study_out;
   double case_budget_s = 0.5;
   double min_time_s = 0.01;

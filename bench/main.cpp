@@ -78,7 +78,7 @@ int main(int argc, char** argv) {
       fmt::print(stderr, "stepbench_bench: timed {} cases in {:.1f} s ({} mode)\n", book.timed_count(), ts.wall_seconds,
                  ts.mode);
     }
-    return report_study_outcome(s, "stepbench_bench");
+    return report_study_outcome(s, "stepbench_bench", opts.strict);
   } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "stepbench_bench: error: %s\n", e.what());
     return 2;

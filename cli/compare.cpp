@@ -24,7 +24,7 @@ struct compare_args {
   std::string base, next;
   std::string error_factor = "2", order_drop = "0.1";
   std::string format = "text";
-  bool json = false, allow_removed = false, gate_timing = false;
+  bool json = false, allow_removed = false, require_base = false, gate_timing = false;
 };
 
 json value_json(const compare_value& v) {
@@ -73,7 +73,7 @@ json comparison_json(const comparison& c) {
                     {"improvements", c.count(change_kind::improvement)},
                     {"added", c.added.size()},
                     {"removed", c.removed.size()},
-                    {"removed_gates", !o.allow_removed},
+                    {"removed_gates", o.require_base},
                     {"timing_compared", c.timing_compared},
                     {"timing_rows", c.timing.size()},
                     {"timing_slower", c.slower()},
@@ -87,7 +87,7 @@ json comparison_json(const comparison& c) {
                        {"timing_noise_floor", timing_noise_floor},
                        {"timing_single_run_floor", timing_single_run_floor},
                        {"timing_spread_multiple", timing_spread_multiple},
-                       {"allow_removed", o.allow_removed},
+                       {"require_base", o.require_base},
                        {"gate_timing", o.gate_timing},
                        {"description", describe_thresholds(o)}};
   out["differences"] = json::array();
@@ -131,7 +131,9 @@ int run_compare(const compare_args& a) {
     compare_options opts;
     opts.error_factor = parse_number(a.error_factor, "--error-factor");
     opts.order_drop = parse_number(a.order_drop, "--order-drop");
-    opts.allow_removed = a.allow_removed;
+    if (a.allow_removed && a.require_base)
+      throw std::invalid_argument("--allow-removed and --require-base: choose one");
+    opts.require_base = a.require_base;
     opts.gate_timing = a.gate_timing;
     if (a.json && a.format == "md") throw std::invalid_argument("--json and --format md: choose one");
     const std::string format = a.json ? "json" : a.format;
@@ -176,7 +178,10 @@ command add_compare(CLI::App& app) {
   sub->add_option("--order-drop", a->order_drop, "an observed order dropping by more than this regresses (>= 0)")
       ->type_name("DROP")
       ->capture_default_str();
-  sub->add_flag("--allow-removed", a->allow_removed, "what only BASE has is listed, not a regression");
+  sub->add_flag("--require-base", a->require_base,
+                "what only BASE has (a problem, a method, a reference, ladder rows) regresses: for a gate that "
+                "compares a study with one of the same design");
+  sub->add_flag("--allow-removed", a->allow_removed, "the default: what only BASE has is listed, not a regression");
   sub->add_flag("--gate-timing", a->gate_timing, "a flagged slowdown is a regression (exit 1)");
   sub->add_option("--format", a->format, "text, md (Markdown: a CI job summary, a pull-request comment) or json")
       ->check(CLI::IsMember({"text", "md", "json"}))

@@ -31,7 +31,7 @@ struct loop_args {
   std::string problem, method, out, design;
   std::string display_hz, physics_hz, clamp, jitter, stall_at, step_cost, horizon;
   std::vector<std::string> sets;
-  bool json = false, quiet = false;
+  bool json = false, quiet = false, strict = false;
 };
 
 json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
@@ -265,7 +265,7 @@ int run_study(const loop_args& a) {
   std::fflush(stdout);
   fmt::print(stderr, "wrote {} (the loop study of {} with {}, {:.2f} s)\n", out, a.problem, a.method,
              s.loop.wall_seconds);
-  return report_study_outcome(s, "stepbench");
+  return report_study_outcome(s, "stepbench", a.strict);
 }
 
 int run_loop_command(const loop_args& a) {
@@ -304,9 +304,10 @@ command add_loop(CLI::App& app) {
   sub->add_option("--horizon", a->horizon, "end time [s] (default: the problem's)");
   sub->add_flag("--json", a->json, "print JSON (one configuration)");
   sub->add_flag("--quiet", a->quiet, "study form: print only the summary line");
+  sub->add_flag("--strict", a->strict, "study form: exit 3 when a method failed on a case of its sweep");
   sub->footer(
-      "exit codes: 0 done; 1 a file error, or no trusted truth; 2 bad usage; 3 the study was written but a "
-      "case of its sweep failed\n");
+      "exit codes: 0 done (a method's failure on a case is a finding recorded in the study); 1 a file error, or no "
+      "trusted truth; 2 bad usage; 3 with --strict, the study was written but a case of its sweep failed\n");
   return {sub, [a] { return run_loop_command(*a); }};
 }
 

@@ -93,6 +93,35 @@ concept has_contacts = requires(const P& p, double t, typename P::vec& x) {
   { p.locate_contacts() } -> std::convertible_to<bool>;
 };
 
+// A problem with Coulomb friction along its one coordinate, a set-valued force: while
+// the body slides, mu_k |F_n| against the motion; at rest, any force up to mu_s |F_n|
+// (the friction cone). As a function of v the law has no value at rest that a Newton
+// iteration can find a root through, so the implicit methods resolve it as engines do
+// (Box2D, PhysX and Bullet clamp the friction impulse to mu |normal impulse|; implicit
+// Euler with the set-valued law is Moreau-Jean time stepping: Moreau, "Unilateral
+// contact and dry friction in finite freedom dynamics", 1988; Jean, "The non-smooth
+// contact dynamics method", 1999): the step with the smooth forces, then the friction
+// that step needs, clamped to the cone (integrators/implicit_newton.hpp). The problem's
+// `force` stays the lecture's law, which the explicit methods use.
+struct friction_limits {
+  double static_max = 0.0;  // mu_s |F_n| [N]: the most friction can hold at rest
+  double kinetic = 0.0;     // mu_k |F_n| [N]: friction while sliding
+};
+template <class P>
+concept has_set_valued_friction = requires(const P& p, double t, const typename P::vec& x, typename P::vec& f) {
+  {p.smooth_force(t, x, x, f)};  // every force but friction
+  { p.friction(t, x) } -> std::same_as<friction_limits>;
+};
+
+// A problem that can say what happened in its scene at a state (an orbit collapsed into
+// the centre, a body sunk through the ground), for every method alike: where a run stops
+// on a solver's failure, its recorded reason opens with this report, then the solver's
+// symptom (core/drive.hpp).
+template <class P>
+concept has_scene_report = requires(const P& p, double t, const typename P::vec& x) {
+  { p.scene_report(t, x, x) } -> std::convertible_to<std::string>;
+};
+
 // A problem whose exact contacts are known (bouncing_ball: the bounce sequence;
 // bouncing_balls: the event-driven simulation): the contacts with t <= t_end. `positions`
 // (the state's position at each contact) may be empty when there are too many bodies for

@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdio>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -306,7 +307,17 @@ STEPBENCH_FLATTEN drive_result<typename P::vec> drive(const P& problem, const I&
         if constexpr (has_contacts<P>) {
           if (problem.locate_contacts()) return advance_locating(problem, stepper, sys, t, s, h, start, out);
         }
-        stepper.step(sys, t, s, h);
+        if constexpr (has_scene_report<P>) {
+          // A step that fails (an implicit method's Newton finds no root) leaves the state
+          // where the step began: the reason opens with what the scene did there.
+          try {
+            stepper.step(sys, t, s, h);
+          } catch (const std::runtime_error& e) {
+            throw std::runtime_error(problem.scene_report(t, s.x, s.v) + "; then " + e.what());
+          }
+        } else {
+          stepper.step(sys, t, s, h);
+        }
       },
       [&](double t) { out.contact(t, stepbench::after_step(problem, t, s), s.x); },
       [&](double t) {

@@ -44,6 +44,15 @@ struct counted_system {
     ++work.force_evals;
     problem.force(t, x, v, f);
   }
+  // The smooth part of the force and the friction cone, where the problem declares its
+  // friction set-valued (has_set_valued_friction); counted like any force evaluation.
+  void smooth_force(double t, const vec& x, const vec& v, vec& f) const requires has_set_valued_friction<P> {
+    ++work.force_evals;
+    problem.smooth_force(t, x, v, f);
+  }
+  friction_limits friction(double t, const vec& x) const requires has_set_valued_friction<P> {
+    return problem.friction(t, x);
+  }
 
   // A zeroed Jacobian of the right shape (workspace for the implicit methods).
   jacobian_matrix make_jacobian() const {

@@ -28,13 +28,16 @@ struct implicit_euler {
     void resize(const Sys& sys, const Vec& like) { newton.resize(sys, like); }
 
     void step(const Sys& sys, double t, step_state<Vec>& s, double dt) {
-      // Predictor: the velocity at the start of the step.
-      if (!newton.solve(sys, t + dt, dt, s.x, s.v, s.v))
-        throw std::runtime_error("implicit_euler: Newton's method did not converge at t = " + std::to_string(t + dt));
+      // Predictor: the velocity at the start of the step. With set-valued friction, the
+      // step ends at rest where v_{n+1} = 0.
+      if (!newton.solve_stage(sys, t + dt, dt, s.x, s.v, 0.0))
+        throw std::runtime_error("implicit_euler: Newton found no root for the step to t = " + std::to_string(t + dt));
       s.x = newton.x1;
       s.v = newton.v1;
       s.f = newton.f;  // F(t + dt, x_{n+1}, v_{n+1}): the next step's F_n
-      s.f_current = true;
+      // With friction resolved by projection, f holds the friction the step applied, not
+      // the problem's force law at the new state.
+      s.f_current = !has_set_valued_friction<Sys>;
     }
   };
 };

@@ -34,8 +34,10 @@ struct implicit_midpoint {
 
     void step(const Sys& sys, double t, step_state<Vec>& s, double dt) {
       const double h = 0.5 * dt;
-      if (!newton.solve(sys, t + h, h, s.x, s.v, s.v))
-        throw std::runtime_error("implicit_midpoint: Newton's method did not converge at t = " + std::to_string(t + h));
+      // With set-valued friction, the step ends at rest where v_{n+1} = 2 v_m - v_n = 0.
+      if (!newton.solve_stage(sys, t + h, h, s.x, s.v, 0.5))
+        throw std::runtime_error("implicit_midpoint: Newton found no root for the step to t = " +
+                                 std::to_string(t + dt));
       s.x += dt * newton.v1;
       s.v = 2.0 * newton.v1 - s.v;
       s.f_current = false;

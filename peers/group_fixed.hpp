@@ -14,14 +14,15 @@ namespace stepbench {
 // Each entry: a peer's descriptor and step adapter on the fixed-step loop
 // (peers/step_adapter.hpp), or a library's whole run (arkode_fixed: the library owns the
 // loop, as a user would call it).
-using fixed_step_peers = type_list<
-    peers::fixed_step_peer<peers::gsl_fixed<peers::gsl_rk4_tag>>,
-    peers::fixed_step_peer<peers::gsl_fixed<peers::gsl_rk2_tag>>,
-    peers::fixed_step_peer<peers::gsl_fixed<peers::gsl_rkf45_tag>>,
-    peers::fixed_step_peer<peers::gsl_fixed<peers::gsl_rk8pd_tag>>, peers::arkode_fixed<8>, peers::arkode_fixed<5>,
+using fixed_step_peers =
+    type_list<peers::fixed_step_peer<peers::gsl_fixed<peers::gsl_rk4_tag>>,
+              peers::fixed_step_peer<peers::gsl_fixed<peers::gsl_rk2_tag>>,
+              peers::fixed_step_peer<peers::gsl_fixed<peers::gsl_rkf45_tag>>,
+              peers::fixed_step_peer<peers::gsl_fixed<peers::gsl_rk8pd_tag>>, peers::arkode_fixed<8>,
+              peers::arkode_fixed<5>,
 #if STEPBENCH_HAVE_ODEINT
-    peers::odeint_rk4, peers::fixed_step_peer<peers::odeint_velocity_verlet>, peers::odeint_rkf78,
+              peers::odeint_rk4, peers::fixed_step_peer<peers::odeint_velocity_verlet>, peers::odeint_rkf78,
 #endif
-    peers::fixed_step_peer<peers::baseline_rk4>, peers::fixed_step_peer<peers::baseline_rk8>>;
+              peers::fixed_step_peer<peers::baseline_rk4>, peers::fixed_step_peer<peers::baseline_rk8>>;
 
 }  // namespace stepbench

@@ -211,15 +211,21 @@ struct bouncing_balls {
     for_each_near_pair(x, [&](int i, int j) {
       const Eigen::Vector2d d = x.segment<2>(2 * j) - x.segment<2>(2 * i);
       const double dist2 = d.squaredNorm();
-      if (!(dist2 < reach * reach) || dist2 == 0.0) return;  // apart, or no line of centres
+      if (dist2 == 0.0) return;  // no line of centres
+      // The same test as contact_gap's (|d| - 2 r <= 0), touching included, as the walls'
+      // is: a root finder (CVODE's) lands on a gap of exactly 0, and a contact left
+      // unresolved there is a pair passing through each other, after which the one gap
+      // function stays negative and no later contact of any pair is seen.
       const double dist = std::sqrt(dist2), depth = reach - dist;
+      if (depth < 0.0) return;  // apart
       const Eigen::Vector2d n = d / dist;
+      const Eigen::Vector2d u = v.segment<2>(2 * j) - v.segment<2>(2 * i);
+      const double un = u.dot(n);
+      if (depth == 0.0 && un >= 0.0) return;  // touching, not approaching
       note_depth(c, depth);
       x.segment<2>(2 * i) -= (0.5 * depth) * n;
       x.segment<2>(2 * j) += (0.5 * depth) * n;
-      c.changed = true;
-      const Eigen::Vector2d u = v.segment<2>(2 * j) - v.segment<2>(2 * i);
-      const double un = u.dot(n);
+      c.changed = c.changed || depth > 0.0;
       if (un < 0.0) {
         // u' = (1 - k_f) u_t - k_r u_n: the change du = -k_f u_t - (1 + k_r) u_n, half each.
         const Eigen::Vector2d du = -kf * (u - un * n) - ((1.0 + kr) * un) * n;

@@ -11,9 +11,12 @@
 // Closed form through Kepler's equation, solved to round-off (problems/exact/kepler.hpp).
 // Energy E = m |v|^2 / 2 - gm m / |r| and angular momentum L = m (x v_y - y v_x) are
 // conserved; both are recorded with their errors.
+#include <fmt/format.h>
+
 #include <Eigen/Core>
 #include <cmath>
 #include <numbers>
+#include <string>
 
 #include "core/concepts.hpp"
 #include "problems/exact/kepler.hpp"
@@ -75,6 +78,20 @@ struct kepler {
   }
   double energy(const vec& x, const vec& v) const { return mass_kg * (0.5 * v.squaredNorm() - gm / x.norm()); }
   double angular_momentum(const vec& x, const vec& v) const { return mass_kg * (x.x() * v.y() - x.y() * v.x()); }
+
+  // What happened in the scene where a run stopped (core/concepts.hpp, has_scene_report):
+  // an orbit whose radius fell well inside the periapsis a (1 - e) has collapsed into the
+  // centre, where the force is singular (implicit Euler's numerical damping drains an
+  // eccentric orbit's energy until it does).
+  std::string scene_report(double t, const vec& x, const vec& v) const {
+    const double r = x.norm(), periapsis = semi_major_axis * (1.0 - eccentricity);
+    const auto s0 = initial();
+    const std::string where = r < 0.5 * periapsis   ? "the orbit collapsed"
+                              : r < 1.5 * periapsis ? "at periapsis"
+                                                    : "on the orbit";
+    return fmt::format("{}: r = {:.3g} m at t = {:.4g} s (periapsis {:.3g} m), energy {:.3g} J against {:.3g} J", where,
+                       r, t, periapsis, energy(x, v), energy(s0.x, s0.v));
+  }
 };
 
 }  // namespace stepbench

@@ -149,6 +149,14 @@ struct incline_block {
     else
       f[0] = holds() ? 0.0 : -(along - kinetic);
   }
+  // The same friction as a set-valued force (core/concepts.hpp), for the implicit
+  // methods: gravity along the slope is the smooth force, and friction is up to
+  // mu_s |F_n| at rest, mu_k |F_n| sliding, |F_n| = m g cos theta.
+  void smooth_force(double, const vec&, const vec&, vec& f) const { f[0] = -mass_kg * gravity * std::sin(theta()); }
+  friction_limits friction(double, const vec&) const {
+    const double normal = mass_kg * gravity * std::cos(theta());
+    return {.static_max = static_coefficient() * normal, .kinetic = kinetic_coefficient() * normal};
+  }
   // The force is piecewise constant in v (its jump at v = 0 is the stop event's): both
   // derivatives are zero. Given, so that no implicit method differences across the jump.
   jacobian_matrix make_jacobian() const { return jacobian_matrix::Zero(); }

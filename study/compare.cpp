@@ -146,14 +146,29 @@ void match_ladder(method_pair& mp, comparison& out) {
                                      np.size(), param_list(mp.next, only_new), mp.rows.size())});
 }
 
-// The observed order of a fixed-step method (the fit of err_pos_max against dt).
+// The timesteps of a method's fitted levels.
+std::vector<double> fitted_params(const study_method& m) {
+  std::vector<double> out;
+  const auto& params = m.col("param");
+  for (long level : m.fit_levels)
+    if (level >= 0 && static_cast<std::size_t>(level) < params.size()) out.push_back(params[level]);
+  return out;
+}
+
+// The observed order of a fixed-step method (the fit of err_pos_max against dt), judged
+// only where both files fitted the same timesteps (a quick study's shorter ladder fits
+// other levels: its order is another measurement, not a change), and a change of fit
+// status only where both ladders are the same.
 void check_order(const method_pair& mp, comparison& out) {
   if (mp.base.kind != method_kind::fixed_step || mp.next.kind != method_kind::fixed_step) return;
+  const bool same_ladder =
+      mp.rows.size() == mp.base.col("param").size() && mp.rows.size() == mp.next.col("param").size();
   const bool was = mp.base.fit_status == "fitted", is = mp.next.fit_status == "fitted";
   change c;
   c.problem = mp.next_problem.name;
   c.method = mp.next.name;
   if (was && is) {
+    if (fitted_params(mp.base) != fitted_params(mp.next)) return;
     const auto k = judge_order(mp.base.fit_slope, mp.next.fit_slope, mp.opts.order_drop);
     if (!k) return;
     c.kind = *k;
@@ -161,7 +176,7 @@ void check_order(const method_pair& mp, comparison& out) {
     c.old_value = mp.base.fit_slope;
     c.new_value = mp.next.fit_slope;
     c.ratio = mp.next.fit_slope / mp.base.fit_slope;
-  } else if (was || (is && mp.base.fit_status == "insufficient")) {
+  } else if (same_ladder && (was || (is && mp.base.fit_status == "insufficient"))) {
     // Fitted and no longer is; or could not be fitted and now is. (From `exact` to fitted
     // is no improvement: the errors left round-off, which the row checks judge.)
     c.kind = was ? change_kind::regression : change_kind::improvement;
@@ -401,9 +416,9 @@ std::vector<std::string> describe_thresholds(const compare_options& o) {
                   "moves by more than {:g} %, or when a method becomes or stops being unstable for every dt or "
                   "unconditionally stable.",
                   100 * stability_tolerance),
-      fmt::format("What only BASE has (a problem, a method, a reference, rows of a ladder) {}; what only NEW has is "
-                  "listed as added.",
-                  o.allow_removed ? "is listed (--allow-removed)" : "regresses (unless --allow-removed)"),
+      fmt::format("Only what both files hold is compared: what only BASE has (a problem, a method, a reference, "
+                  "rows of a ladder) {}; what only NEW has is listed as added.",
+                  o.require_base ? "regresses (--require-base)" : "is listed as removed, not a regression"),
       fmt::format("Timing: a row timed in both is flagged when new/old exceeds 1+t (slower) or falls below "
                   "1/(1+t) (faster), t = max({:g} %, {:g} x the larger (max - min)/median of the two files' "
                   "repetitions); with a single repetition on a side there is no spread, and the floor is {:g} % "
@@ -428,19 +443,19 @@ std::size_t comparison::faster() const {
       std::count_if(timing.begin(), timing.end(), [](const timing_row& r) { return r.flag < 0; }));
 }
 std::size_t comparison::gating() const {
-  return count(change_kind::regression) + (options.allow_removed ? 0 : removed.size()) +
+  return count(change_kind::regression) + (options.require_base ? removed.size() : 0) +
          (options.gate_timing ? slower() : 0);
 }
 
 // The stability limits of our methods (/stability): a limit that moves by more than
 // stability_tolerance (relative), or a method that becomes (or stops being) stable for
 // every dt or unstable for every dt, is a regression.
-void check_stability(const study_data& base, const study_data& next, const compare_options& opts, comparison& out) {
+void check_stability(const study_data& base, const study_data& next, comparison& out) {
   for (const auto& b : base.stability) {
     const auto it = std::find_if(next.stability.begin(), next.stability.end(),
                                  [&](const auto& n) { return n.integrator == b.integrator && n.test == b.test; });
     if (it == next.stability.end()) {
-      if (!next.stability.empty() && !opts.allow_removed)
+      if (!next.stability.empty())
         out.removed.push_back({"stability", b.integrator, "limit " + b.test, "in BASE only"});
       continue;
     }
@@ -515,7 +530,7 @@ comparison compare_studies(const study_data& base, const study_data& next, const
   for (const auto& np : next.problems)
     if (!base.find(np.name))
       out.added.push_back({np.name, "", "problem", plural(np.methods.size(), "method", "methods")});
-  check_stability(base, next, opts, out);
+  check_stability(base, next, out);
   summarize_timing(out);
   return out;
 }

@@ -137,12 +137,12 @@ std::string findings(const comparison& c, table_format f) {
     out += md ? fmt::format("\n### {} ({}){}\n\n", title, n, note) : fmt::format("\n{} ({}){}:\n", title, n, note);
     out += render(t, f);
   };
-  const std::string flag = md ? "`--allow-removed`" : "--allow-removed";
+  const std::string flag = md ? "`--require-base`" : "--require-base";
   section("Regressions", c.count(change_kind::regression), changes_table(c, change_kind::regression));
   section("Improvements", c.count(change_kind::improvement), changes_table(c, change_kind::improvement));
   section("Added, only in NEW", c.added.size(), presence_table(c.added));
   section("Removed, only in BASE", c.removed.size(), presence_table(c.removed),
-          c.options.allow_removed ? ", allowed by " + flag : ", regressions: " + flag + " to accept");
+          c.options.require_base ? ", regressions (" + flag + ")" : ", listed, not compared");
   return out;
 }
 
@@ -152,9 +152,9 @@ std::string summary_line(const comparison& c) {
   std::string s = fmt::format(
       "{}, {}, {} added, {} removed{}", plural(c.count(change_kind::regression), "regression", "regressions"),
       plural(c.count(change_kind::improvement), "improvement", "improvements"), c.added.size(), c.removed.size(),
-      c.removed.empty()         ? ""
-      : c.options.allow_removed ? " (allowed)"
-                                : " (regressions)");
+      c.removed.empty()        ? ""
+      : c.options.require_base ? " (regressions)"
+                               : " (not compared)");
   if (c.timing_compared)
     s += fmt::format("; timing: {} of {} rows slower, {} faster{}", c.slower(), c.timing.size(), c.faster(),
                      c.options.gate_timing ? " (gating)" : " (informs)");

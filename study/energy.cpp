@@ -61,17 +61,24 @@ energy_run run_one(const problem_instance& p, const method_info& m, const energy
   out.completed = true;
   const double e_scale = std::abs(ep.e0), l_scale = std::abs(ep.l0);
   const bool has_l = p.has_angular_momentum();
-  std::vector<double> err(times.size()), period_end, l_period_end;
+  // Each period's peak error (signed): the sample of largest magnitude in the period.
+  std::vector<double> err(times.size()), period_peak, l_period_peak;
   double l_max = 0.0;
+  auto keep_peak = [](std::vector<double>& peaks, bool new_period, double e) {
+    if (new_period)
+      peaks.push_back(e);
+    else if (std::abs(e) > std::abs(peaks.back()))
+      peaks.back() = e;
+  };
   for (std::size_t j = 0; j < times.size(); ++j) {
+    const bool new_period = j % static_cast<std::size_t>(per) == 0;
     err[j] = (p.energy(r.sample_y[j]) - ep.e0) / e_scale;
     out.max_rel_err = std::max(out.max_rel_err, std::abs(err[j]));
-    const bool end_of_period = (j + 1) % static_cast<std::size_t>(per) == 0;
-    if (end_of_period) period_end.push_back(err[j]);
+    keep_peak(period_peak, new_period, err[j]);
     if (has_l) {
       const double dl = (p.angular_momentum(r.sample_y[j]) - ep.l0) / l_scale;
       l_max = std::max(l_max, std::abs(dl));
-      if (end_of_period) l_period_end.push_back(dl);
+      keep_peak(l_period_peak, new_period, dl);
     }
   }
   if (!std::isfinite(out.max_rel_err)) {
@@ -79,9 +86,9 @@ energy_run run_one(const problem_instance& p, const method_info& m, const energy
     out.note = "non-finite energy";
   }
   out.final_rel_err = err.back();
-  out.drift_per_period = slope(period_end);
+  out.drift_per_period = slope(period_peak);
   out.angmom_max_rel_err = has_l ? l_max : nan;
-  out.angmom_drift_per_period = has_l ? slope(l_period_end) : nan;
+  out.angmom_drift_per_period = has_l ? slope(l_period_peak) : nan;
   const std::size_t tenth = std::max<std::size_t>(1, err.size() / 10);
   for (std::size_t j = 0; j < tenth; ++j) out.first_tenth_max = std::max(out.first_tenth_max, std::abs(err[j]));
   double sum = 0.0;

@@ -26,8 +26,7 @@ namespace stepbench::registry_detail {
 template <class P>
 struct method_slot {
   const method_info* info = nullptr;
-  run_result (*run)(const P&, double param, double horizon, std::span<const double> times,
-                    const run_limits&) = nullptr;
+  run_result (*run)(const P&, double param, double horizon, std::span<const double> times, const run_limits&) = nullptr;
   std::function<double()> (*timed_run)(const P&, double param, double horizon, std::span<const double> times,
                                        const run_limits&) = nullptr;
   loop_result (*loop)(const P&, const loop_config&) = nullptr;  // ours at a fixed step only
@@ -105,8 +104,7 @@ void append_group(type_list<Ms...>, method_table<P>& table) {
   for_each_type(type_list<entry_t<Ms>...>{}, [&]<class M>() {
     if constexpr (runs_on<M, P>) {
       method_slot<P> slot{.info = &info_of<M>(), .run = &run_method<M, P>, .timed_run = &timed_method<M, P>};
-      if constexpr (requires { typename M::integrator_type; })
-        slot.loop = &loop_method<typename M::integrator_type, P>;
+      if constexpr (requires { typename M::integrator_type; }) slot.loop = &loop_method<typename M::integrator_type, P>;
       table.push_back(slot);
     }
   });

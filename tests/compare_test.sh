@@ -77,9 +77,12 @@ expect_exit 1 "$work/base.h5" "$work/worse.h5" --format md && {
 }
 expect_exit 0 "$work/base.h5" "$work/worse.h5" --error-factor 1000
 
-# A method only in BASE: a regression unless --allow-removed; only in NEW: added.
-expect_exit 1 "$work/base.h5" "$work/fewer.h5" && { grep -q "velocity_verlet" "$work/out" || bad "removed method not named"; }
+# A method only in BASE: listed as removed, not a regression (only what both hold is
+# compared), unless --require-base; only in NEW: added.
+expect_exit 0 "$work/base.h5" "$work/fewer.h5" && { grep -q "velocity_verlet" "$work/out" || bad "removed method not named"; }
 expect_exit 0 "$work/base.h5" "$work/fewer.h5" --allow-removed
+expect_exit 1 "$work/base.h5" "$work/fewer.h5" --require-base && { grep -q "velocity_verlet" "$work/out" || bad "removed method not named"; }
+expect_exit 2 "$work/base.h5" "$work/fewer.h5" --require-base --allow-removed
 expect_exit 0 "$work/fewer.h5" "$work/base.h5" && { grep -qE "Added, only in NEW \(1\)" "$work/out" || bad "added not listed"; }
 
 # Timing: made-up timings (3 repetitions, +-2 %); rk4 twice as slow in NEW.

@@ -276,7 +276,7 @@ TEST_F(compare_test, order_drop_and_lost_fit) {
   EXPECT_EQ(found(compare(base, next, lax), change_kind::regression, "observed order").size(), 0u);
 }
 
-TEST_F(compare_test, removed_method_regresses_unless_allowed_and_added_is_listed) {
+TEST_F(compare_test, removed_method_is_listed_and_regresses_only_with_require_base) {
   const study base = small_study({"damped_spring"}, {"rk4", "euler", "gsl_rk4"});
   const study next = small_study({"damped_spring"}, {"rk4", "euler", "midpoint"});
   const comparison c = compare(base, next);
@@ -286,10 +286,10 @@ TEST_F(compare_test, removed_method_regresses_unless_allowed_and_added_is_listed
   ASSERT_EQ(c.added.size(), 1u);
   EXPECT_EQ(c.added[0].method, "midpoint");
   EXPECT_EQ(c.count(change_kind::regression), 0u);
-  EXPECT_EQ(c.exit_status(), 1);  // the removal
-  compare_options allow;
-  allow.allow_removed = true;
-  EXPECT_EQ(compare(base, next, allow).exit_status(), 0);
+  EXPECT_EQ(c.exit_status(), 0);  // only what both hold is compared
+  compare_options require;
+  require.require_base = true;
+  EXPECT_EQ(compare(base, next, require).exit_status(), 1);  // the removal
   // Only added: never a regression.
   EXPECT_EQ(compare(small_study({"damped_spring"}, {"rk4"}), small_study({"damped_spring"}, {"rk4", "midpoint"}))
                 .exit_status(),
@@ -314,7 +314,10 @@ TEST_F(compare_test, changed_ladder_is_reported_and_common_rows_compared) {
   const comparison coarser = compare(six, five);
   ASSERT_EQ(coarser.removed.size(), 1u);
   EXPECT_EQ(coarser.removed[0].what, "ladder");
-  EXPECT_EQ(coarser.exit_status(), 1);
+  EXPECT_EQ(coarser.exit_status(), 0) << format_text(coarser);  // the rows both hold did not change
+  compare_options require;
+  require.require_base = true;
+  EXPECT_EQ(compare(six, five, require).exit_status(), 1);
 }
 
 TEST_F(compare_test, references_and_truth) {

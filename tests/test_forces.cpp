@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <numbers>
 
 #include "core/drive.hpp"
@@ -237,4 +238,29 @@ TEST(energy, symplectic_bounded_others_drift) {
     }
     EXPECT_LT(find("rk4").drift_per_period, 0.0) << ep.problem;
   }
+}
+
+// The verdict does not depend on the run's length: on the pendulum, at 10^2, 10^3 and
+// 10^4 periods, every method gets the same verdict, the symplectic ones (and implicit
+// midpoint) "bounded"; and the drift figure over the run, |drift a period| x periods,
+// never exceeds the largest error measured.
+TEST(energy, verdict_independent_of_run_length) {
+  std::map<std::string, std::string> first_verdict;
+  for (const double periods : {1e2, 1e3, 1e4}) {
+    energy_options opts;
+    opts.periods = periods;
+    opts.scenes.resize(1);
+    ASSERT_EQ(opts.scenes.front().problem, "pendulum");
+    const energy_study s = run_energy_study(opts);
+    ASSERT_EQ(s.problems.size(), 1u);
+    for (const auto& r : s.problems.front().runs) {
+      ASSERT_TRUE(r.completed) << r.info.name << ": " << r.note;
+      const auto it = first_verdict.emplace(r.info.name, r.verdict).first;
+      EXPECT_EQ(r.verdict, it->second) << r.info.name << " at " << periods << " periods";
+      EXPECT_LE(std::abs(r.drift_per_period) * periods, r.max_rel_err)
+          << r.info.name << " at " << periods << " periods: drift " << r.drift_per_period;
+    }
+  }
+  for (const char* name : {"semi_implicit_euler", "velocity_verlet", "forest_ruth", "implicit_midpoint"})
+    EXPECT_EQ(first_verdict.at(name), "bounded") << name;
 }

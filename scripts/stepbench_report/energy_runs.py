@@ -125,7 +125,7 @@ def section(doc, study, figs):
     doc.h(3, "Energy over 10^4 periods")
     doc.p(f"Every fixed-step integrator of ours for {float(a['periods']):g} periods at the stated dt, the energy "
           f"error sampled {int(a['samples_per_period'])} times a period; the drift per period is the least-squares "
-          f"slope of (E - E0) / |E0| at the period ends. Computed by stepbench in {float(a['wall_seconds']):.1f} s. "
+          f"slope of each period's peak (E - E0) / |E0| (signed) against the period count. Computed by stepbench in {float(a['wall_seconds']):.1f} s. "
           f"Rule: {a['rule']}.")
     if "energy_long_runs.png" in figs:
         doc.img("fig/energy_long_runs.png", "energy error against time")

@@ -7,10 +7,10 @@ import time
 
 import pytest
 
-# Exit codes of a study that was written whole: 0, or 3 when some cases failed, each
-# named on stderr and recorded with its reason (implicit Newton finds no root through
-# Coulomb friction's jump on sliding_block, for one). Anything else is an error.
-STUDY_WRITTEN = (0, 3)
+# The exit code of a study that was written whole: 0, also where a method failed on a
+# case (a finding, recorded with its reason and summed up on stderr; exit 3 only with
+# --strict). Anything else is an error.
+STUDY_WRITTEN = (0,)
 
 
 def run_study(args, **kwargs):

@@ -131,7 +131,7 @@ struct backward_euler_newton {
     if (const double moving = v0[0] - v_rest; moving != 0.0) {
       const double dir = moving > 0.0 ? 1.0 : -1.0;
       f_friction[0] = -dir * cone.kinetic;
-      if (solve(sys, t1, h, x0, v0, v0) && dir * (v1[0] - v_rest) >= 0.0) return with_friction();
+      if (solve(sys, t1, h, x0, v0, v0) && dir * (v1[0] - v_rest) >= 0.0) return true;  // f includes it
     }
     // At rest at the end of the step: the friction that holds it there, m (v1 - v0) / h
     // minus the smooth force, if the cone allows it.
@@ -140,7 +140,7 @@ struct backward_euler_newton {
     // kinetic friction against it.
     const double dir = f_friction[0] < 0.0 ? 1.0 : -1.0;  // hold_at_rest left the friction it needed
     f_friction[0] = -dir * cone.kinetic;
-    if (solve(sys, t1, h, x0, v0, v0) && dir * (v1[0] - v_rest) >= 0.0) return with_friction();
+    if (solve(sys, t1, h, x0, v0, v0) && dir * (v1[0] - v_rest) >= 0.0) return true;  // f includes it
     // Kinetic friction above the static limit (mu_k > mu_s) stops what static friction
     // could not hold: at rest, with the friction it needs (the exact motion's rest,
     // problems/exact/sliding_block.hpp).
@@ -159,10 +159,6 @@ struct backward_euler_newton {
       }
     }
     sys.force(t, x, v, out);
-  }
-  bool with_friction() {
-    f += f_friction;
-    return true;
   }
   // v1 at rest; true when the friction that needs is at most `limit`. Leaves the needed
   // friction in f_friction either way, and in f the smooth force plus it.
@@ -212,7 +208,7 @@ struct backward_euler_newton {
         return true;
       }
       // The update stopped decreasing once small: the rounding floor of the residual.
-      if (update >= last_update && last_update <= floor_update * scale) return true;
+      if (update >= last_update && update <= floor_update * scale) return true;
       // The full step first, halved while the residual does not fall; with a stale
       // Jacobian, refresh it before shortening the step.
       double lambda = 1.0, r_try_norm = std::numeric_limits<double>::infinity();

@@ -232,6 +232,7 @@ struct bouncing_balls {
         v.segment<2>(2 * i) -= 0.5 * du;
         v.segment<2>(2 * j) += 0.5 * du;
         ++c.resolved;
+        c.changed = true;
       }
     });
     const double w = width(), h = height();

@@ -233,13 +233,14 @@ class cvode_session {
         throw std::runtime_error(std::string(source_) + ": more than " + std::to_string(max_contacts) +
                                  " contacts before t=" + detail::num(tout) + " (a Zeno sequence?)");
       const auto y = st_.plain(N_VGetArrayPointer(h_.y));
+      const double gap = sys_.contact_gap(t, y);  // of the state CVODE would go on from
       y_resolved_.assign(y.begin(), y.end());
       if (const int resolved = sys_.resolve_contacts(t, y_resolved_); resolved > 0) {
         contacts_ += resolved;
         to_solver_layout(st_, y_resolved_, N_VGetArrayPointer(h_.y));
         add_counters(before_reinit_);
         check("CVodeReInit", CVodeReInit(h_.mem, t, h_.y));
-      } else if (sys_.contact_gap(t, y_resolved_) < 0.0) {
+      } else if (gap < 0.0) {
         // A root the problem did not resolve, with the bodies already overlapping: the
         // one gap function would stay negative and hide every later contact.
         throw std::runtime_error(std::string(source_) + ": a contact at t=" + detail::num(t) +

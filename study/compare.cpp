@@ -155,10 +155,11 @@ std::vector<double> fitted_params(const study_method& m) {
   return out;
 }
 
-// The observed order of a fixed-step method (the fit of err_pos_max against dt), judged
-// only where both files fitted the same timesteps (a quick study's shorter ladder fits
-// other levels: its order is another measurement, not a change), and a change of fit
-// status only where both ladders are the same.
+// The observed order of a fixed-step method (the fit of err_pos_max against dt). On the
+// same ladder it is always judged (the fit chooses its levels from the errors, so levels
+// that moved are part of what changed). On different ladders (a quick study's shorter
+// one) only where both fitted the same timesteps: otherwise its order is another
+// measurement, not a change; and a change of fit status only on the same ladder.
 void check_order(const method_pair& mp, comparison& out) {
   if (mp.base.kind != method_kind::fixed_step || mp.next.kind != method_kind::fixed_step) return;
   const bool same_ladder =
@@ -168,7 +169,7 @@ void check_order(const method_pair& mp, comparison& out) {
   c.problem = mp.next_problem.name;
   c.method = mp.next.name;
   if (was && is) {
-    if (fitted_params(mp.base) != fitted_params(mp.next)) return;
+    if (!same_ladder && fitted_params(mp.base) != fitted_params(mp.next)) return;
     const auto k = judge_order(mp.base.fit_slope, mp.next.fit_slope, mp.opts.order_drop);
     if (!k) return;
     c.kind = *k;

@@ -189,13 +189,13 @@ std::vector<std::string> failed_cases(const study& s) {
 namespace {
 
 // The parameters of the failed rows: up to four named, else their range.
-std::string failed_params(method_kind kind, const std::vector<double>& params) {
+std::string failed_params(std::string_view label, const std::vector<double>& params) {
   std::string out;
   if (params.size() <= 4)
     for (std::size_t i = 0; i < params.size(); ++i) out += fmt::format("{}{:.3g}", i ? ", " : "", params[i]);
   else
     out = fmt::format("{:.3g} to {:.3g}", params.front(), params.back());
-  return fmt::format("{} {}", param_name(kind), out);
+  return fmt::format("{} {}", label, out);
 }
 
 // What kind of failure a reason names: its opening words, up to the first ':' (the
@@ -212,7 +212,7 @@ std::string reason_kind(std::string_view method, std::string_view note) {
 // "implicit_euler: 8 of 12 failed on kepler at dt 0.0368 to 0.000288: the orbit collapsed
 // (5), at periapsis (3); at dt 0.000288: <its whole reason>": the kinds with their counts,
 // then the reason at the finest parameter in full.
-std::string failure_line(std::string_view method, std::string_view where, method_kind kind,
+std::string failure_line(std::string_view method, std::string_view where, std::string_view label,
                          const std::vector<const run_metrics*>& failed, const std::vector<double>& params,
                          std::size_t rows) {
   std::vector<std::pair<std::string, int>> kinds;
@@ -227,7 +227,7 @@ std::string failure_line(std::string_view method, std::string_view where, method
   std::string counted;
   for (const auto& [k, n] : kinds) counted += fmt::format("{}{} ({})", counted.empty() ? "" : ", ", k, n);
   return fmt::format("{}: {} of {} failed on {} at {}: {}; at {} {:.3g}: {}", method, failed.size(), rows, where,
-                     failed_params(kind, params), counted, param_name(kind), params.back(), failed.back()->note);
+                     failed_params(label, params), counted, label, params.back(), failed.back()->note);
 }
 
 }  // namespace
@@ -245,7 +245,8 @@ std::vector<std::string> failure_summary(const study& s) {
           params.push_back(r.param);
         }
       if (!failed.empty())
-        out.push_back(failure_line(ms.info.name, ps.problem->name(), ms.info.kind, failed, params, ms.rows.size()));
+        out.push_back(
+            failure_line(ms.info.name, ps.problem->name(), param_name(ms.info.kind), failed, params, ms.rows.size()));
     }
   }
   for (const auto& st : s.substeps)
@@ -258,8 +259,8 @@ std::vector<std::string> failure_summary(const study& s) {
           params.push_back(static_cast<double>(r.substeps));
         }
       if (!failed.empty())
-        out.push_back(failure_line(m.info.name, fmt::format("the substeps study of {}", st.problem), m.info.kind,
-                                   failed, params, m.rows.size()));
+        out.push_back(failure_line(m.info.name, fmt::format("the substeps study of {}", st.problem), "substeps", failed,
+                                   params, m.rows.size()));
     }
   return out;
 }

@@ -137,19 +137,17 @@ TEST_P(implicit_exact_map, agrees_with_the_method_solved_to_round_off) {
       err_map = std::max(err_map, static_cast<double>(std::fabs(map.x_at_samples[j] - truth[j][0])));
     }
     if (err_map > 1e-12 * x_scale) {  // above round-off
-      EXPECT_NEAR(err_run, err_map, 0.01 * err_map)
-          << problem << "/" << method << " at " << n << " steps: err_pos_max " << err_run << ", the exact map's "
-          << err_map;
+      EXPECT_NEAR(err_run, err_map, 0.01 * err_map) << problem << "/" << method << " at " << n << " steps: err_pos_max "
+                                                    << err_run << ", the exact map's " << err_map;
       ++compared;
     }
   }
   EXPECT_GE(compared, 6) << "levels with an error above round-off";
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    methods, implicit_exact_map,
-    ::testing::Combine(::testing::Values("falling_drag", "pendulum", "damped_spring"),
-                       ::testing::Values("implicit_euler", "implicit_midpoint")),
-    [](const auto& info) { return std::get<0>(info.param) + "_" + std::get<1>(info.param); });
+INSTANTIATE_TEST_SUITE_P(methods, implicit_exact_map,
+                         ::testing::Combine(::testing::Values("falling_drag", "pendulum", "damped_spring"),
+                                            ::testing::Values("implicit_euler", "implicit_midpoint")),
+                         [](const auto& info) { return std::get<0>(info.param) + "_" + std::get<1>(info.param); });
 
 }  // namespace

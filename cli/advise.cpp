@@ -17,28 +17,59 @@ using json = nlohmann::json;
 
 struct advise_args {
   std::string problem, tol_text, metric = "err_pos_max", study = "results/study.h5";
+  std::string hz_text;  // set: the frame-rate question instead
   bool json = false;
 };
 
 json pick_json(const advice& a, const wp_pick& p) {
   const auto& m = a.methods[p.method];
-  const auto& row = m.rows[p.row];
   return {{"method", m.name},
           {"origin", to_string(m.origin)},
           {"param_name", param_name(m.kind)},
-          {"param", row.param},
-          {"force_evals", row.force_evals},
-          {"time_ns", row.time_ns},  // NaN (not timed) is written as null by nlohmann::json
-          {"error", row.error},
+          {"param", p.param},
+          {"interpolated", p.interpolated},
+          {"force_evals", p.force_evals},
+          {"time_ns", p.time_ns},  // NaN (not timed) is written as null by nlohmann::json
+          {"error", p.error},
           {"cost", p.cost},
+          {"cost_lo", p.cost_lo},
+          {"cost_hi", p.cost_hi},
           {"diverged_rows", p.diverged_rows},
           {"smallest_diverged", p.smallest_diverged ? json(*p.smallest_diverged) : json(nullptr)},
           {"largest_diverged", p.largest_diverged ? json(*p.largest_diverged) : json(nullptr)}};
 }
 
+json frame_advice_json(const frame_advice& f) {
+  auto option = [](const frame_option& o) {
+    return json{{"method", o.method},     {"substeps", o.substeps},       {"completed", o.completed},
+                {"diverged", o.diverged}, {"err_pos_max", o.err_pos_max}, {"cost_per_frame", o.cost_per_frame},
+                {"note", o.note}};
+  };
+  json out = {{"problem", f.problem},     {"hz", f.hz},           {"tol", f.tol},  {"unit", f.unit},
+              {"cost_kind", f.cost_kind}, {"horizon", f.horizon}, {"met", f.met()}};
+  out["choice"] = f.met() ? option(f.ranked.front()) : json(nullptr);
+  out["ranked"] = json::array();
+  for (const auto& o : f.ranked) out["ranked"].push_back(option(o));
+  out["one_step"] = json::array();
+  for (const auto& o : f.one_step) out["one_step"].push_back(option(o));
+  out["not_meeting"] = f.not_meeting;
+  return out;
+}
+
 int run_advise(const advise_args& args) {
   const double tol = parse_number(args.tol_text, "--tol");
   if (!(tol > 0.0)) throw std::invalid_argument(fmt::format("--tol must be > 0, got {}", args.tol_text));
+  if (!args.hz_text.empty()) {
+    const double hz = parse_number(args.hz_text, "--hz");
+    if (args.metric != "err_pos_max")
+      throw std::invalid_argument("--hz answers for err_pos_max only (the frame-rate study measures that)");
+    const frame_advice f = advise_frame(args.study, args.problem, hz, tol);
+    if (args.json)
+      std::cout << frame_advice_json(f).dump(2) << "\n";
+    else
+      fmt::print("{}", format_frame_advice(f));
+    return f.met() ? 0 : advise_exit_no_method;
+  }
   const study_data study = read_study(args.study);
   const advice a = advise(study, args.problem, args.metric, tol);
   const int code = a.met() ? 0 : advise_exit_no_method;
@@ -71,6 +102,9 @@ command add_advise(CLI::App& app) {
   sub->add_option("--tol", a->tol_text, "largest acceptable error, in the problem's units (> 0)")->required();
   sub->add_option("--metric", a->metric, "err_pos_max, err_pos_final, err_pos_rms or err_vel_final")
       ->capture_default_str();
+  sub->add_option("--hz", a->hz_text,
+                  "frame rate: the methods stable at one step a frame, and the cheapest method and substeps a frame "
+                  "that meet --tol (from the study's frame-rate runs: 30, 60, 120 or 240)");
   sub->add_option("--study", a->study, "study file to read")->capture_default_str();
   sub->add_flag("--json", a->json, "print JSON");
   sub->footer("exit codes: 0 answer, 1 study file unreadable, 2 bad usage, 3 no method meets the tolerance\n");

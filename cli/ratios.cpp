@@ -21,6 +21,7 @@
 
 #include "cli/commands.hpp"
 #include "core/work_precision.hpp"
+#include "study/registry.hpp"
 #include "study/study_reader.hpp"
 #include "study/table_render.hpp"
 
@@ -100,20 +101,30 @@ json equal_error(const study_problem& p, double target, const std::string& metri
   const wp_pick *ours = nullptr, *peer = nullptr;
   for (const auto& pick : r.ranked) {
     const auto& m = methods[pick.method];
-    const auto& row = m.rows[pick.row];
     out["ranked"].push_back({{"method", m.name},
                              {"origin", to_string(m.origin)},
-                             {"param", row.param},
-                             {"time_ns", row.time_ns},
-                             {"error", row.error}});
+                             {"param", pick.param},
+                             {"interpolated", pick.interpolated},
+                             {"time_ns", pick.time_ns},
+                             {"time_ns_lo", pick.cost_lo},
+                             {"time_ns_hi", pick.cost_hi},
+                             {"error", pick.error}});
     if (m.origin == method_origin::ours && !ours) ours = &pick;
     if (m.origin == method_origin::peer && !peer) peer = &pick;
   }
   auto named = [&](const wp_pick* pick) {
-    return pick ? json{{"method", methods[pick->method].name}, {"time_ns", pick->cost}} : json(nullptr);
+    if (!pick) return json(nullptr);
+    const auto& m = methods[pick->method];
+    return json{{"method", m.name},           {"param_name", param_name(m.kind)},
+                {"param", pick->param},       {"interpolated", pick->interpolated},
+                {"time_ns", pick->cost},      {"time_ns_lo", pick->cost_lo},
+                {"time_ns_hi", pick->cost_hi}};
   };
   out["ours"] = named(ours);
   out["peer"] = named(peer);
+  // Ahead or behind only when the spreads do not overlap (the repetitions' fastest and
+  // slowest, interpolated like the median).
+  out["spread_verdict"] = ours && peer ? json(compare_at_equal_error(*ours, *peer)) : json(nullptr);
   out["peer_over_ours"] = ours && peer && r.cost == "time_ns" ? json(peer->cost / ours->cost) : json(nullptr);
   out["ours_over_peer"] = ours && peer && r.cost == "time_ns" ? json(ours->cost / peer->cost) : json(nullptr);
   out["target_0_5"] = verdict(out["ours_over_peer"].is_null() ? NAN : out["ours_over_peer"].get<double>());
@@ -205,24 +216,29 @@ void print_ns_per_call(const json& per_problem) {
 }
 
 std::string who(const json& j) {
-  return j.is_null() ? std::string("none reaches it")
-                     : fmt::format("{} {}", j["method"].get<std::string>(), format_time_ns(j["time_ns"].get<double>()));
+  if (j.is_null()) return "none reaches it";
+  return fmt::format("{} {} at {} {:.3g}", j["method"].get<std::string>(), format_time_ns(j["time_ns"].get<double>()),
+                     j["param_name"].get<std::string>() == "dt" ? "dt" : "tol", j["param"].get<double>());
 }
 
 void print_equal_error(const json& out) {
-  fmt::print("\nEqual error: time to reach err_pos_max (cheapest measured row that reaches it; the study's rule)\n");
+  fmt::print(
+      "\nEqual error: time to reach err_pos_max, interpolated on each method's measured curve (log-log between the two "
+      "rows that bracket the target; dt in s, tol relative; the study's rule)\n");
   table t{{{"problem"},
-           right_column("target"),
-           {"cheapest of ours"},
-           {"cheapest peer"},
+           right_column("target", "m or rad"),
+           {"fastest of ours"},
+           {"fastest peer"},
            right_column("peer / ours"),
            right_column("ours / peer"),
+           {"beyond the spread"},
            {"target <= 0.5"}},
           {}};
   std::string open;
   for (const auto& e : out["equal_error"]) {
     t.add({e["problem"].get<std::string>(), fmt::format("{:.0e}", e["target"].get<double>()), who(e["ours"]),
            who(e["peer"]), fixed(e["peer_over_ours"], 2), fixed(e["ours_over_peer"], 2),
+           e["spread_verdict"].is_null() ? "-" : e["spread_verdict"].get<std::string>(),
            e["target_0_5"].get<std::string>()});
     if (e["target_0_5"] == "OPEN")
       open += fmt::format("{}{} at {:.0e}", open.empty() ? "" : ", ", e["problem"].get<std::string>(),
@@ -233,12 +249,12 @@ void print_equal_error(const json& out) {
   for (const auto& e : out["equal_error"]) {
     if (e["problem"] != "pendulum" || e["target"].get<double>() != 1e-6) continue;
     fmt::print("\n  pendulum, every method to err_pos_max = 1e-6:\n");
-    table ranked{{{"method"}, right_column("time"), {"origin"}, right_column("dt or tolerance")}, {}};
+    table ranked{{{"method"}, right_column("time"), {"origin"}, right_column("at")}, {}};
     for (const auto& r : e["ranked"]) {
       const std::string origin = r["origin"].get<std::string>();
       ranked.add({r["method"].get<std::string>(), format_time_ns(r["time_ns"].get<double>()),
                   origin == "baseline" ? "baseline, for scale" : origin,
-                  fmt::format("{:g}", r["param"].get<double>())});
+                  fmt::format("{:.3g}{}", r["param"].get<double>(), r["interpolated"].get<bool>() ? "" : " (row)")});
     }
     fmt::print("{}", render_text(ranked, "    "));
   }
@@ -275,6 +291,7 @@ void print_ratios(const json& out, const std::string& study) {
 }
 
 int run_ratios(const ratios_args& a) {
+  for (const auto& name : a.problems) make_problem(name);  // an unknown name: exit 2, naming the known ones
   const study_data s = read_study(a.study);
   if (!s.timed) throw std::runtime_error(fmt::format("{} has no timings: run stepbench_bench --study_out", a.study));
   const json out = ratios_json(s, a);

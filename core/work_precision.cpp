@@ -39,6 +39,86 @@ std::optional<wp_pick> cheapest_result::answer(const std::vector<wp_method>& met
   return std::nullopt;
 }
 
+std::optional<wp_pick> at_equal_error(const wp_method& m, double target, bool by_time, bool timed) {
+  const auto cost_of = [&](const wp_row& r) { return by_time ? r.time_ns : r.force_evals; };
+  // The curve: the usable rows in ladder order (coarse to fine, as the study stores them).
+  std::vector<std::size_t> curve;
+  for (std::size_t i = 0; i < m.rows.size(); ++i) {
+    const auto& r = m.rows[i];
+    const double c = cost_of(r);
+    if (r.completed && std::isfinite(r.error) && r.error > 0.0 && std::isfinite(c) && c > 0.0 && !(timed && r.cut))
+      curve.push_back(i);
+  }
+  // The spread of a row's cost: its fastest and slowest repetition when timed and
+  // recorded, else the cost itself.
+  const auto lo_of = [&](const wp_row& r) {
+    return by_time && std::isfinite(r.time_lo) && r.time_lo > 0.0 ? r.time_lo : cost_of(r);
+  };
+  const auto hi_of = [&](const wp_row& r) {
+    return by_time && std::isfinite(r.time_hi) && r.time_hi > 0.0 ? r.time_hi : cost_of(r);
+  };
+  const auto at_row = [&](std::size_t i) {
+    const auto& r = m.rows[i];
+    wp_pick p;
+    p.row = i;
+    p.cost = cost_of(r);
+    p.cost_lo = lo_of(r);
+    p.cost_hi = hi_of(r);
+    p.param = r.param;
+    p.error = r.error;
+    p.time_ns = r.time_ns;
+    p.force_evals = r.force_evals;
+    return p;
+  };
+  std::optional<wp_pick> best;
+  const auto consider = [&](const wp_pick& p) {
+    if (!best || p.cost < best->cost) best = p;
+  };
+  // An upper bound: the coarsest row of the curve already at or under the target (no
+  // cheaper row was measured, and the curve is not extrapolated beyond it).
+  if (!curve.empty() && m.rows[curve.front()].error <= target) consider(at_row(curve.front()));
+  // Log-log interpolation between neighbours that bracket the target.
+  const double lt = std::log(target);
+  for (std::size_t k = 0; k + 1 < curve.size(); ++k) {
+    const auto &a = m.rows[curve[k]], &b = m.rows[curve[k + 1]];
+    const bool brackets = (a.error >= target && b.error <= target) || (a.error <= target && b.error >= target);
+    if (!brackets) continue;
+    if (a.error == b.error) {  // flat at exactly the target: the cheaper row
+      consider(at_row(cost_of(a) <= cost_of(b) ? curve[k] : curve[k + 1]));
+      continue;
+    }
+    const double s = (lt - std::log(a.error)) / (std::log(b.error) - std::log(a.error));
+    const auto lerp = [&](double va, double vb) {
+      if (!(std::isfinite(va) && std::isfinite(vb) && va > 0.0 && vb > 0.0))
+        return std::numeric_limits<double>::quiet_NaN();
+      return std::exp(std::log(va) + s * (std::log(vb) - std::log(va)));
+    };
+    wp_pick p;
+    p.row = a.error <= b.error ? curve[k] : curve[k + 1];  // the more accurate of the two
+    p.cost = lerp(cost_of(a), cost_of(b));
+    p.cost_lo = lerp(lo_of(a), lo_of(b));
+    p.cost_hi = lerp(hi_of(a), hi_of(b));
+    p.param = lerp(a.param, b.param);
+    p.error = target;
+    p.time_ns = lerp(a.time_ns, b.time_ns);
+    p.force_evals = lerp(a.force_evals, b.force_evals);
+    p.interpolated = true;
+    consider(p);
+  }
+  return best;
+}
+
+const char* compare_at_equal_error(double a_lo, double a_hi, double b_lo, double b_hi) {
+  constexpr double rounding = 1e-9;
+  if (a_hi < b_lo * (1.0 - rounding)) return "ahead";
+  if (a_lo > b_hi * (1.0 + rounding)) return "behind";
+  return "within spread";
+}
+
+const char* compare_at_equal_error(const wp_pick& a, const wp_pick& b) {
+  return compare_at_equal_error(a.cost_lo, a.cost_hi, b.cost_lo, b.cost_hi);
+}
+
 cheapest_result cheapest(const std::vector<wp_method>& methods, double target, bool timed, const std::string& metric,
                          const std::string& unit, wp_candidates candidates) {
   if (!(target > 0.0) || !std::isfinite(target))
@@ -49,25 +129,23 @@ cheapest_result cheapest(const std::vector<wp_method>& methods, double target, b
     return candidates == wp_candidates::every_method ||
            std::any_of(m.rows.begin(), m.rows.end(), [](const wp_row& row) { return std::isfinite(row.time_ns); });
   };
-  // Time is the cost only if it can rank every qualifying row; otherwise the counted
-  // force evaluations, which every row has.
+  // Time is the cost only if it can rank every method that reaches the target: every
+  // completed row of a competing method that meets the target has a time (a coarser
+  // neighbour without one leaves the crossing off the curve, and the method is charged
+  // its coarsest timed row that meets the target: an upper bound, never a guess).
   bool all_timed = timed;
   for (const auto& m : methods)
     if (competes(m))
       for (const auto& row : m.rows)
         if (qualifies(row, target, timed) && !(std::isfinite(row.time_ns) && row.time_ns > 0.0)) all_timed = false;
   r.cost = all_timed ? "time_ns" : "force_evals";
-  auto cost_of = [&](const wp_row& row) { return all_timed ? row.time_ns : row.force_evals; };
 
   std::optional<wp_pick> best_achieved;
   for (std::size_t mi = 0; mi < methods.size(); ++mi) {
     const auto& m = methods[mi];
     if (!competes(m)) continue;
-    auto make_pick = [&](std::size_t ri) {
-      wp_pick p;
+    auto with_margin = [&](wp_pick p) {
       p.method = mi;
-      p.row = ri;
-      p.cost = cost_of(m.rows[ri]);
       for (const auto& d : m.rows) {
         if (!d.diverged) continue;
         ++p.diverged_rows;
@@ -76,21 +154,25 @@ cheapest_result cheapest(const std::vector<wp_method>& methods, double target, b
       }
       return p;
     };
-    std::optional<std::size_t> best, lowest;
+    std::optional<std::size_t> lowest;
     for (std::size_t ri = 0; ri < m.rows.size(); ++ri) {
       const auto& row = m.rows[ri];
       if (row.completed && std::isfinite(row.error) && (!lowest || row.error < m.rows[*lowest].error)) lowest = ri;
-      if (!qualifies(row, target, timed)) continue;
-      // Cheapest; on a tie the more accurate row.
-      if (!best || cost_of(row) < cost_of(m.rows[*best]) ||
-          (cost_of(row) == cost_of(m.rows[*best]) && row.error < m.rows[*best].error))
-        best = ri;
     }
     if (lowest && m.origin != method_origin::baseline &&
-        (!best_achieved || m.rows[*lowest].error < methods[best_achieved->method].rows[best_achieved->row].error))
-      best_achieved = make_pick(*lowest);
-    if (best) {
-      r.ranked.push_back(make_pick(*best));
+        (!best_achieved || m.rows[*lowest].error < methods[best_achieved->method].rows[best_achieved->row].error)) {
+      wp_pick p;
+      p.row = *lowest;
+      p.cost = all_timed ? m.rows[*lowest].time_ns : m.rows[*lowest].force_evals;
+      p.cost_lo = p.cost_hi = p.cost;
+      p.param = m.rows[*lowest].param;
+      p.error = m.rows[*lowest].error;
+      p.time_ns = m.rows[*lowest].time_ns;
+      p.force_evals = m.rows[*lowest].force_evals;
+      best_achieved = with_margin(p);
+    }
+    if (const auto p = at_equal_error(m, target, all_timed, timed)) {
+      r.ranked.push_back(with_margin(*p));
       continue;
     }
     std::string reason;
@@ -111,8 +193,7 @@ cheapest_result cheapest(const std::vector<wp_method>& methods, double target, b
   }
   std::stable_sort(r.ranked.begin(), r.ranked.end(), [&](const wp_pick& a, const wp_pick& b) {
     if (a.cost != b.cost) return a.cost < b.cost;
-    const double ea = methods[a.method].rows[a.row].error, eb = methods[b.method].rows[b.row].error;
-    if (ea != eb) return ea < eb;
+    if (a.error != b.error) return a.error < b.error;
     return methods[a.method].name < methods[b.method].name;
   });
   if (!r.answer(methods)) r.best_achieved = best_achieved;

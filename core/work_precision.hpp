@@ -4,14 +4,25 @@
 // shows them: `stepbench advise`, the study file's equal-error and front tables (which
 // the report draws and the README's tables come from) and `stepbench ratios`.
 //
-// The cheapest-method rule. A row qualifies for a target error when the run completed
-// (did not diverge or fail), its error is at or below the target, and, in a timed study,
-// its timing was not cut by the time budget. Each method is represented by its cheapest
-// qualifying row (on a tie, the more accurate one). The cost is the measured time (the
-// median wall time of one whole run) when every qualifying row of every method has one,
-// else the counted force evaluations. Methods are ranked by that cost, then by error,
-// then by name. Only measured rows count: no interpolation between ladder rows, so
-// every answer is a dt (or tolerance) that was run and a cost that was measured. The
+// The cheapest-method rule: the cost of each method at equal error, read off its
+// measured work-precision curve. A row is on the curve when the run completed (did not
+// diverge or fail), its error is finite and positive, its cost is measured and, in a
+// timed study, its timing was not cut by the time budget. The cost at a target error is
+// interpolated log-log between two rows next to each other on the ladder whose errors
+// bracket the target (log cost and log param linear in log error), never extrapolated:
+// a method whose coarsest row already meets the target is charged that row's cost (an
+// upper bound, flagged `interpolated = false`), and one whose finest row misses it does
+// not reach it. Where the curve crosses the target more than once (a pre-asymptotic
+// bump, a round-off plateau) the cheapest crossing counts. The repetition spread
+// (fastest and slowest repetition) is interpolated the same way, so a comparison can
+// say whether two methods differ by more than the noise. Interpolating the curve, as
+// work-precision comparisons in the field do (DiffEqDevTools, SciMLBenchmarks), removes
+// the factor-2 quantisation of "the cheapest rung that reaches the target" on a halving
+// ladder, which flipped verdicts between two runs of the same code.
+//
+// The cost is the measured time (the median wall time of one whole run) when every
+// competing method's curve is timed, else the counted force evaluations. Methods are
+// ranked by that cost, then by the error of the row used, then by name. The
 // hand-written baseline is ranked for scale but is never the answer.
 #include <cstddef>
 #include <limits>
@@ -34,7 +45,9 @@ struct wp_row {
   double force_evals = 0.0;
   bool completed = true;  // did not diverge or fail
   bool diverged = false;
-  bool cut = false;  // timing skipped by the time budget
+  bool cut = false;                                           // timing skipped by the time budget
+  double time_lo = std::numeric_limits<double>::quiet_NaN();  // fastest repetition (NaN: not recorded)
+  double time_hi = std::numeric_limits<double>::quiet_NaN();  // slowest repetition
 };
 
 struct wp_method {
@@ -45,9 +58,14 @@ struct wp_method {
 };
 
 struct wp_pick {
-  std::size_t method = 0;  // index into the input
-  std::size_t row = 0;     // index into that method's rows
-  double cost = 0.0;
+  std::size_t method = 0;                   // index into the input
+  std::size_t row = 0;                      // the row used: the finer of the two bracketing rows, or the bounding row
+  double cost = 0.0;                        // at equal error: interpolated (or the bounding row's)
+  double cost_lo = 0.0, cost_hi = 0.0;      // the repetition spread at equal error (= cost for force evaluations)
+  double param = 0.0;                       // the dt or tolerance at equal error, interpolated the same way
+  double error = 0.0;                       // the target, or the bounding row's error
+  double time_ns = 0.0, force_evals = 0.0;  // both costs at equal error (time NaN when untimed)
+  bool interpolated = false;  // between two bracketing rows; false: the coarsest row already met the target
   // The params at which this method diverged: the largest and smallest (the edge of
   // stability seen in the study) and how many rows; nullopt if never.
   std::optional<double> largest_diverged, smallest_diverged;
@@ -68,6 +86,18 @@ struct cheapest_result {
   // The answer: the first ranked method that is not a baseline; nullopt when none.
   std::optional<wp_pick> answer(const std::vector<wp_method>& methods) const;
 };
+
+// One method's cost at equal error by the rule above; nullopt when no row of its curve
+// reaches the target. `by_time`: the cost is time_ns (else force_evals); `timed`: cut
+// rows are off the curve. `pick.method` is left 0 for the caller to set.
+std::optional<wp_pick> at_equal_error(const wp_method& m, double target, bool by_time, bool timed);
+
+// Two costs at equal error compared with their spreads: "ahead" when a's slowest is
+// below b's fastest, "behind" when a's fastest is above b's slowest, else "within
+// spread". Counted costs (force evaluations) have no spread; they are equal, not ahead,
+// when they agree to 1e-9 relative (the interpolation's rounding).
+const char* compare_at_equal_error(const wp_pick& a, const wp_pick& b);
+const char* compare_at_equal_error(double a_lo, double a_hi, double b_lo, double b_hi);
 
 // Which methods compete. The two callers genuinely differ:
 //  - every_method: advise and the study file's equal-error table rank every method; one

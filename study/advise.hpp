@@ -36,4 +36,29 @@ advice advise(const study_data& study, const std::string& problem, const std::st
 // The human-readable answer (several lines, ends with a newline).
 std::string format_advice(const advice& a, std::size_t runners_up = 5);
 
+// `stepbench advise --hz`: the game programmer's question, from the study's frame-rate
+// runs (/frame_rates/<problem>, study/verdict.hpp): at a frame rate, which of our
+// fixed-step methods are stable at one step a frame and their error, and the cheapest
+// method and substep count a frame whose err_pos_max is at or under `tol`.
+struct frame_option {
+  std::string method, note;
+  int substeps = 1;
+  bool completed = false, diverged = false;
+  double err_pos_max = 0.0, cost_per_frame = 0.0;
+};
+
+struct frame_advice {
+  std::string problem, unit, cost_kind;  // cost_kind: time_ns or force_evals (per frame)
+  double hz = 0.0, tol = 0.0, horizon = 0.0;
+  std::vector<frame_option> one_step;    // every method at one step a frame
+  std::vector<frame_option> ranked;      // each method's cheapest substep count meeting tol, cheapest first
+  std::vector<std::string> not_meeting;  // "rk4: best 3e-5 m at x64"
+  bool met() const { return !ranked.empty(); }
+};
+
+// Throws std::invalid_argument for a problem or rate the file lacks (naming what it has)
+// and std::runtime_error when the file cannot be read.
+frame_advice advise_frame(const std::string& path, const std::string& problem, double hz, double tol);
+std::string format_frame_advice(const frame_advice& f);
+
 }  // namespace stepbench

@@ -41,10 +41,10 @@ constexpr field run_timing_fields[] = {
 constexpr field substep_fields[] = {{"substeps", i64}, {"extra_damping", f64}};
 constexpr field parameter_fields[] = {{"name", str},       {"value", f64},   {"unit", str},    {"kind", str},
                                       {"value_name", str}, {"default", f64}, {"allowed", str}, {"description", str}};
-constexpr field equal_error_fields[] = {{"metric", str},    {"target", f64}, {"rank", i64},    {"method", str},
-                                        {"origin", str},    {"kind", str},   {"param", f64},   {"error", f64},
-                                        {"cost_kind", str}, {"cost", f64},   {"time_ns", f64}, {"force_evals", f64},
-                                        {"is_answer", i8}};
+constexpr field equal_error_fields[] = {
+    {"metric", str},  {"target", f64},      {"rank", i64},        {"method", str},  {"origin", str},  {"kind", str},
+    {"param", f64},   {"error", f64},       {"cost_kind", str},   {"cost", f64},    {"cost_lo", f64}, {"cost_hi", f64},
+    {"time_ns", f64}, {"force_evals", f64}, {"interpolated", i8}, {"is_answer", i8}};
 constexpr field front_fields[] = {{"method", str}, {"param", f64}, {"cost", f64}, {"err_pos_max", f64}};
 constexpr field limit_fields[] = {{"integrator", str},
                                   {"test", str},
@@ -128,6 +128,21 @@ constexpr field substeps_verdict_fields[] = {{"implicit_method", str},
                                              {"cost_to_match", f64},
                                              {"summary", str}};
 
+constexpr field verdict_equal_error_fields[] = {
+    {"problem", str},    {"unit", str},       {"target", f64},       {"ours_method", str},  {"ours_kind", str},
+    {"ours_param", f64}, {"ours_cost", f64},  {"ours_cost_lo", f64}, {"ours_cost_hi", f64}, {"peer_method", str},
+    {"peer_kind", str},  {"peer_param", f64}, {"peer_cost", f64},    {"peer_cost_lo", f64}, {"peer_cost_hi", f64},
+    {"ratio", f64},      {"verdict", str},    {"best_error", f64}};
+constexpr field frame_rate_fields[] = {{"problem", str}, {"unit", str},        {"hz", f64},  {"method", str},
+                                       {"stable", i8},   {"err_pos_max", f64}, {"note", str}};
+constexpr field frame_answer_fields[] = {{"problem", str},     {"unit", str},           {"hz", f64},
+                                         {"target", f64},      {"method", str},         {"substeps", i64},
+                                         {"err_pos_max", f64}, {"cost_per_frame", f64}, {"frame_share", f64}};
+constexpr field frame_rate_run_fields[] = {
+    {"hz", f64},          {"method", str},         {"substeps", i64},    {"dt", f64},
+    {"completed", i8},    {"diverged", i8},        {"err_pos_max", f64}, {"steps", i64},
+    {"force_evals", f64}, {"cost_per_frame", f64}, {"note", str}};
+
 constexpr field_group runs_groups[] = {{run_fields}, {run_timing_fields, true}};
 constexpr field_group substep_runs_groups[] = {{run_fields}, {run_timing_fields, true}, {substep_fields}};
 constexpr field_group parameters_groups[] = {{parameter_fields}};
@@ -138,6 +153,10 @@ constexpr field_group energy_groups[] = {{energy_fields}};
 constexpr field_group loop_groups[] = {{loop_fields}};
 constexpr field_group loop_cheapest_groups[] = {{loop_cheapest_fields}};
 constexpr field_group substeps_verdict_groups[] = {{substeps_verdict_fields}};
+constexpr field_group verdict_equal_error_groups[] = {{verdict_equal_error_fields}};
+constexpr field_group frame_rate_groups[] = {{frame_rate_fields}};
+constexpr field_group frame_answer_groups[] = {{frame_answer_fields}};
+constexpr field_group frame_rate_run_groups[] = {{frame_rate_run_fields}};
 
 constexpr table all_tables[] = {
     {"runs", "/problems/<p>/methods/<m>/runs", runs_groups},
@@ -150,6 +169,10 @@ constexpr table all_tables[] = {
     {"loop_cheapest", "/loop/<p>/<m>/cheapest", loop_cheapest_groups},
     {"substeps_runs", "/substeps/<p>/<m>/runs", substep_runs_groups},
     {"substeps_verdict", "/substeps/<p>/verdict", substeps_verdict_groups},
+    {"verdict_equal_error", "/verdict/equal_error", verdict_equal_error_groups},
+    {"verdict_frame_rate", "/verdict/frame_rate", frame_rate_groups},
+    {"verdict_frame_answer", "/verdict/frame_answer", frame_answer_groups},
+    {"frame_rate_runs", "/frame_rates/<p>/runs", frame_rate_run_groups},
 };
 
 }  // namespace

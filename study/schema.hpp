@@ -13,7 +13,7 @@
 namespace stepbench::schema {
 
 // Bump when the layout changes incompatibly; readers refuse other versions.
-inline constexpr int format_version = 3;
+inline constexpr int format_version = 4;
 
 enum class field_type { f64, i64, i8, str };
 std::string_view to_string(field_type t);

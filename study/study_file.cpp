@@ -18,6 +18,7 @@
 #include "study/stability.hpp"
 #include "study/substeps.hpp"
 #include "study/temp_file_guard.hpp"
+#include "study/verdict.hpp"
 
 namespace stepbench {
 namespace {
@@ -96,12 +97,12 @@ void write_method(H5::Group& parent, const method_study& ms, bool timed) {
 }
 
 // The equal-error table: for each metric and target, every method that reaches it with
-// its cheapest qualifying row, ranked (core/work_precision.hpp).
+// its cost at equal error interpolated on its measured curve, ranked (core/work_precision.hpp).
 void write_equal_error(H5::Group& g, const problem_study& ps, bool timed) {
   std::vector<std::string> metric, method, origin, cost_kind, kind;
-  std::vector<double> target, param, error, cost, time_ns, force_evals;
+  std::vector<double> target, param, error, cost, cost_lo, cost_hi, time_ns, force_evals;
   std::vector<std::int64_t> rank;
-  std::vector<std::int8_t> is_answer;
+  std::vector<std::int8_t> interpolated, is_answer;
   for (const char* m : {"err_pos_max", "err_pos_final"}) {
     const auto methods = work_precision_input(ps, m);
     for (double tgt : equal_error_targets()) {
@@ -110,19 +111,21 @@ void write_equal_error(H5::Group& g, const problem_study& ps, bool timed) {
       for (std::size_t k = 0; k < r.ranked.size(); ++k) {
         const auto& p = r.ranked[k];
         const auto& wm = methods[p.method];
-        const auto& row = wm.rows[p.row];
         metric.emplace_back(m);
         target.push_back(tgt);
         rank.push_back(static_cast<std::int64_t>(k + 1));
         method.push_back(wm.name);
         origin.emplace_back(to_string(wm.origin));
         kind.emplace_back(to_string(wm.kind));
-        param.push_back(row.param);
-        error.push_back(row.error);
+        param.push_back(p.param);
+        error.push_back(p.error);
         cost_kind.push_back(r.cost);
         cost.push_back(p.cost);
-        time_ns.push_back(row.time_ns);
-        force_evals.push_back(row.force_evals);
+        cost_lo.push_back(p.cost_lo);
+        cost_hi.push_back(p.cost_hi);
+        time_ns.push_back(p.time_ns);
+        force_evals.push_back(p.force_evals);
+        interpolated.push_back(static_cast<std::int8_t>(p.interpolated));
         is_answer.push_back(static_cast<std::int8_t>(answer && answer->method == p.method));
       }
     }
@@ -138,8 +141,11 @@ void write_equal_error(H5::Group& g, const problem_study& ps, bool timed) {
   t.add("error", error);
   t.add("cost_kind", cost_kind);
   t.add("cost", cost);
+  t.add("cost_lo", cost_lo);
+  t.add("cost_hi", cost_hi);
   t.add("time_ns", time_ns);
   t.add("force_evals", force_evals);
+  t.add("interpolated", interpolated);
   t.add("is_answer", is_answer);
   t.write(g, "equal_error", schema::find("equal_error"));
 }
@@ -255,6 +261,7 @@ std::vector<unsigned char> study_image(const study& s, const std::string& name) 
   write_substeps(file, s.substeps, s.timed.has_value());
   write_loop(file, s);           // /loop: the game-loop study (study/loop.hpp), when the study holds one
   write_energy(file, s.energy);  // /energy: the long-run energy study (study/energy.hpp)
+  write_verdict(file, s);        // /verdict and /frame_rates: the answer (study/verdict.hpp)
   file.flush(H5F_SCOPE_GLOBAL);
   const ssize_t size = H5Fget_file_image(file.getId(), nullptr, 0);
   std::vector<unsigned char> image(size > 0 ? static_cast<std::size_t>(size) : 0);
@@ -363,8 +370,8 @@ std::vector<wp_method> work_precision_input(const problem_study& ps, const std::
     wp_method m{ms.info.name, ms.info.origin, ms.info.kind, {}};
     for (const auto& r : ms.rows)
       m.rows.push_back({r.param, metric_value(r.metrics, metric), r.time.time_ns,
-                        static_cast<double>(r.work.force_evals), r.metrics.completed(), r.metrics.diverged,
-                        r.time.cut});
+                        static_cast<double>(r.work.force_evals), r.metrics.completed(), r.metrics.diverged, r.time.cut,
+                        r.time.time_ns_min, r.time.time_ns_max});
     out.push_back(std::move(m));
   }
   return out;

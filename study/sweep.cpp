@@ -10,6 +10,7 @@
 
 #include "core/drive.hpp"
 #include "study/substeps.hpp"
+#include "study/verdict.hpp"
 
 namespace stepbench {
 namespace {
@@ -27,7 +28,7 @@ std::vector<double> decades(int first, int last, int stride) {
   return out;
 }
 
-std::vector<double> tolerance_ladder(bool thinned) { return decades(2, 12, thinned ? 2 : 1); }
+std::vector<double> tolerance_ladder(bool thinned) { return decades(2, 14, thinned ? 2 : 1); }
 
 std::unique_ptr<problem_instance> configured_problem(const std::string& name, const sweep_options& opts) {
   auto p = make_problem(name);
@@ -151,6 +152,7 @@ study run_sweep(const sweep_options& opts) {
     out.problems.push_back(std::move(ps));
   }
   out.substeps = run_substeps(out, opts.substeps);
+  out.frame_rates = run_frame_rates(out, opts.frame_rates);
   loop_options loop = opts.loop;
   loop.progress = opts.progress;
   out.loop = run_loop_study(out, loop);

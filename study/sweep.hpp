@@ -23,7 +23,8 @@ namespace stepbench {
 // 10^-first, 10^-(first + stride), ... down to 10^-last: the tolerance ladder and the
 // equal-error targets (study_file.hpp) are both decades, built here.
 std::vector<double> decades(int first, int last, int stride);
-// Relative tolerances of the adaptive methods: 1e-2 .. 1e-12 (every other one when
+// Relative tolerances of the adaptive methods: 1e-2 .. 1e-14, down to round-off, so that
+// every equal-error target (1e-2 .. 1e-12) is reachable (every other one when
 // `thinned`).
 std::vector<double> tolerance_ladder(bool thinned = false);
 
@@ -36,6 +37,14 @@ struct substep_options {
   int frames = 32;  // the frame is horizon / frames; the truth's sample times are its ends
 };
 
+// The frame-rate study (study/verdict.hpp): our fixed-step methods at whole frames of
+// each rate, with n substeps a frame.
+struct frame_rate_options {
+  bool enabled = true;
+  std::vector<double> hz{30, 60, 120, 240};  // each divides the largest, so one truth serves all
+  std::vector<int> substeps{1, 2, 4, 8, 16, 32, 64};
+};
+
 struct sweep_options {
   std::vector<std::string> problems;  // empty: all
   std::vector<std::string> methods;   // empty: all that run on each problem
@@ -46,11 +55,12 @@ struct sweep_options {
   int sample_count = 32;  // fixed sample times j T / sample_count; must divide base_steps
   std::vector<double> tolerances = tolerance_ladder();
   reference_tolerances tol{};
-  run_limits limits{};         // the work budget of one run (core/method.hpp)
-  substep_options substeps{};  // the small-steps comparison (study/substeps.hpp)
-  loop_options loop{};         // the game-loop study (study/loop.hpp)
-  energy_options energy{};     // the long-run energy study (study/energy.hpp)
-  bool progress = false;       // one line per problem on stderr
+  run_limits limits{};               // the work budget of one run (core/method.hpp)
+  substep_options substeps{};        // the small-steps comparison (study/substeps.hpp)
+  loop_options loop{};               // the game-loop study (study/loop.hpp)
+  energy_options energy{};           // the long-run energy study (study/energy.hpp)
+  frame_rate_options frame_rates{};  // the game programmer's frame-rate table (study/verdict.hpp)
+  bool progress = false;             // one line per problem on stderr
 };
 
 // Wall time of one whole run, from the benchmark (absent unless timed).
@@ -115,10 +125,24 @@ struct substep_study {
   std::vector<substep_method> methods;
 };
 
+struct frame_rate_run {
+  double hz = 0.0;
+  std::string method;
+  int substeps = 1;
+  method_row row;  // param = dt = 1 / (hz substeps); errors at the frame ends
+};
+
+struct frame_rate_study {
+  std::string problem, unit;
+  double horizon = 0.0;  // whole frames of the slowest rate within the problem's horizon
+  std::vector<frame_rate_run> runs;
+};
+
 struct study {
   sweep_options options;
   std::vector<problem_study> problems;
   std::vector<substep_study> substeps;
+  std::vector<frame_rate_study> frame_rates;
   loop_study loop;      // empty when the options disable it or name none of the problems
   energy_study energy;  // empty when the options disable it
   // The stability limits and regions of our integrators (study/stability.hpp): not of the

@@ -51,22 +51,77 @@ TEST(work_precision, cheapest_qualifying_row_per_method_ranked_by_force_evals) {
   const auto r = cheapest(ms, 1e-2, false, "err_pos_max", "m");
   EXPECT_EQ(r.cost, "force_evals");
   ASSERT_EQ(r.ranked.size(), 2u);
-  // fourth reaches 1e-3 at dt 0.2 with 80 evals; second reaches 6e-3 at dt 0.1, also 80
-  // evals: the tie goes to the lower error.
-  EXPECT_EQ(ms[r.ranked[0].method].name, "fourth");
-  EXPECT_DOUBLE_EQ(ms[r.ranked[0].method].rows[r.ranked[0].row].param, 0.2);
-  EXPECT_EQ(ms[r.ranked[1].method].name, "second");
+  // second crosses 1e-2 between dt 0.2 (2.5e-2, 40 evals) and dt 0.1 (6e-3, 80 evals):
+  // log-log, s = ln(1e-2 / 2.5e-2) / ln(6e-3 / 2.5e-2), cost 40 * 2^s = 62.4 evals at
+  // dt 0.2 * 2^-s. fourth already meets it at its coarsest completed row (dt 0.2, 1e-3,
+  // 80 evals): charged that row, an upper bound, not extrapolated to a cheaper dt.
+  const double s = std::log(1e-2 / 2.5e-2) / std::log(6e-3 / 2.5e-2);
+  EXPECT_EQ(ms[r.ranked[0].method].name, "second");
+  EXPECT_TRUE(r.ranked[0].interpolated);
+  EXPECT_NEAR(r.ranked[0].cost, 40.0 * std::exp2(s), 1e-12);
+  EXPECT_NEAR(r.ranked[0].force_evals, 40.0 * std::exp2(s), 1e-12);
+  EXPECT_NEAR(r.ranked[0].param, 0.2 * std::exp2(-s), 1e-15);
+  EXPECT_DOUBLE_EQ(r.ranked[0].error, 1e-2);
+  EXPECT_EQ(r.ranked[0].cost_lo, r.ranked[0].cost);  // counted costs have no spread
+  EXPECT_EQ(ms[r.ranked[1].method].name, "fourth");
+  EXPECT_FALSE(r.ranked[1].interpolated);
+  EXPECT_DOUBLE_EQ(r.ranked[1].cost, 80.0);
+  EXPECT_DOUBLE_EQ(r.ranked[1].param, 0.2);
+  EXPECT_DOUBLE_EQ(r.ranked[1].error, 1e-3);
   // Stable at the chosen dt even though it diverged at a coarser one; the margin is kept.
-  ASSERT_TRUE(r.ranked[0].largest_diverged.has_value());
-  EXPECT_DOUBLE_EQ(*r.ranked[0].largest_diverged, 0.4);
-  EXPECT_EQ(r.ranked[0].diverged_rows, 1);
-  EXPECT_FALSE(r.ranked[1].largest_diverged.has_value());
+  ASSERT_TRUE(r.ranked[1].largest_diverged.has_value());
+  EXPECT_DOUBLE_EQ(*r.ranked[1].largest_diverged, 0.4);
+  EXPECT_EQ(r.ranked[1].diverged_rows, 1);
+  EXPECT_FALSE(r.ranked[0].largest_diverged.has_value());
   const auto* e = excluded(r, ms, "first");
   ASSERT_NE(e, nullptr);
   EXPECT_EQ(e->reason, "too inaccurate: best err_pos_max 0.05 m at dt 0.05 s");
   EXPECT_FALSE(r.best_achieved.has_value());
   EXPECT_THROW(cheapest(ms, 0.0, false, "err_pos_max", "m"), std::invalid_argument);
   EXPECT_THROW(cheapest(ms, NAN, false, "err_pos_max", "m"), std::invalid_argument);
+}
+
+// The interpolation itself: never beyond the measured curve, the cheapest of several
+// crossings, the repetition spread carried along, and the verdict beyond the spread.
+TEST(work_precision, cost_at_equal_error_is_interpolated_never_extrapolated) {
+  auto timed_row = [](double dt, double evals, double err, double t, double lo, double hi) {
+    wp_row r{dt, err, t, evals, true, false, false};
+    r.time_lo = lo;
+    r.time_hi = hi;
+    return r;
+  };
+  // A curve with a bump: 1e-3, 1e-5, 2e-5 (pre-asymptotic), 1e-7.
+  const wp_method m =
+      method("bumpy", {timed_row(0.4, 10, 1e-3, 100, 90, 120), timed_row(0.2, 20, 1e-5, 200, 180, 240),
+                       timed_row(0.1, 40, 2e-5, 400, 360, 480), timed_row(0.05, 80, 1e-7, 800, 720, 960)});
+  // Beyond the finest row: not reached.
+  EXPECT_FALSE(at_equal_error(m, 1e-8, true, true).has_value());
+  // Crosses 1.5e-5 twice (0.2..0.1 rises through it, 0.1..0.05 falls through it) and once
+  // before (0.4..0.2 falls through it): the cheapest crossing is between 0.4 and 0.2.
+  const auto p = at_equal_error(m, 1.5e-5, true, true);
+  ASSERT_TRUE(p.has_value());
+  const double s = std::log(1.5e-5 / 1e-3) / std::log(1e-5 / 1e-3);
+  EXPECT_NEAR(p->cost, 100.0 * std::exp2(s), 1e-9);
+  EXPECT_NEAR(p->cost_lo, 90.0 * std::exp2(s), 1e-9);
+  EXPECT_NEAR(p->cost_hi, 120.0 * std::exp2(s), 1e-9);
+  EXPECT_NEAR(p->param, 0.4 * std::exp2(-s), 1e-15);
+  EXPECT_EQ(p->row, 1u);  // the more accurate of the bracketing rows
+  // Exactly at a row: that row's cost.
+  EXPECT_NEAR(at_equal_error(m, 1e-5, true, true)->cost, 200.0, 1e-9);
+  // Above the coarsest row's error: that row, an upper bound.
+  const auto coarse = at_equal_error(m, 1e-2, true, true);
+  ASSERT_TRUE(coarse.has_value());
+  EXPECT_FALSE(coarse->interpolated);
+  EXPECT_DOUBLE_EQ(coarse->cost, 100.0);
+  // Ahead or behind only beyond the spread.
+  wp_pick a, b;
+  a.cost_lo = 90, a.cost_hi = 110, b.cost_lo = 105, b.cost_hi = 130;
+  EXPECT_STREQ(compare_at_equal_error(a, b), "within spread");
+  b.cost_lo = 111;
+  EXPECT_STREQ(compare_at_equal_error(a, b), "ahead");
+  EXPECT_STREQ(compare_at_equal_error(b, a), "behind");
+  // Counted costs equal up to the interpolation's rounding are equal.
+  EXPECT_STREQ(compare_at_equal_error(100.0, 100.0, 100.0 * (1 + 1e-12), 100.0 * (1 + 1e-12)), "within spread");
 }
 
 TEST(work_precision, diverged_everywhere_is_a_reason) {
@@ -86,7 +141,8 @@ TEST(work_precision, time_is_the_cost_when_every_qualifying_row_is_timed) {
   EXPECT_EQ(r.cost, "time_ns");
   ASSERT_EQ(r.ranked.size(), 2u);
   EXPECT_EQ(ms[r.ranked[0].method].name, "second");
-  EXPECT_DOUBLE_EQ(r.ranked[0].cost, 500.0);
+  const double s = std::log(1e-2 / 2.5e-2) / std::log(6e-3 / 2.5e-2);
+  EXPECT_NEAR(r.ranked[0].cost, 6.25 * 40.0 * std::exp2(s), 1e-9);
   // One qualifying row without a time: the ranking falls back to force evaluations.
   ms[2].rows[2].time_ns = NAN;
   EXPECT_EQ(cheapest(ms, 1e-2, true, "err_pos_max", "m").cost, "force_evals");
@@ -143,7 +199,7 @@ TEST(work_precision, the_baseline_is_never_the_answer) {
   ASSERT_EQ(ms[r.ranked.front().method].name, "baseline_rk4");
   const auto answer = r.answer(ms);
   ASSERT_TRUE(answer.has_value());
-  EXPECT_EQ(ms[answer->method].name, "fourth");
+  EXPECT_EQ(ms[answer->method].name, "second");
   // Only the baseline meets the target: no answer, and the best achieved is not the baseline.
   const auto only = cheapest({ms[0], ms[3]}, 1e-2, false, "err_pos_max", "m");
   EXPECT_FALSE(only.answer({ms[0], ms[3]}).has_value());
@@ -174,7 +230,8 @@ TEST(work_precision, pareto_front) {
 }
 
 // advise on a file the sweep wrote: every method is a candidate with its rows as the
-// sweep computed them, and the answer is the cheapest row meeting the tolerance.
+// sweep computed them, and the answer costs no more than the cheapest row meeting the
+// tolerance (the cost at equal error lies on or below the measured rows).
 TEST(advise, reads_a_study_file) {
   sweep_options opts;
   opts.problems = {"damped_spring"};
@@ -209,8 +266,13 @@ TEST(advise, reads_a_study_file) {
   }
   const auto answer = a.result.answer(a.methods);
   ASSERT_TRUE(answer.has_value());
-  EXPECT_EQ(a.methods[answer->method].name, best_name);
-  EXPECT_DOUBLE_EQ(answer->cost, best_evals);
+  EXPECT_LE(answer->cost, best_evals);
+  double best_at_equal_error = INFINITY;
+  for (const auto& m : a.methods)
+    if (m.origin != method_origin::baseline)
+      if (const auto p = at_equal_error(m, 1e-4, false, false))
+        best_at_equal_error = std::min(best_at_equal_error, p->cost);
+  EXPECT_DOUBLE_EQ(answer->cost, best_at_equal_error);
 
   try {
     advise(file, "nope", "err_pos_max", 1e-4);
@@ -225,5 +287,60 @@ TEST(advise, reads_a_study_file) {
   // Not an HDF5 file at all.
   std::ofstream(path) << "not hdf5\n";
   EXPECT_THROW(read_study(path), std::runtime_error);
+  std::filesystem::remove(path);
+}
+
+// The frame-rate study on stiff_spring (w0 = 1000 rad/s, so w0 dt = 16.7 at one 60 Hz
+// step): each method turns stable at the substep count its stability limit predicts
+// (rk4: w0 dt <= 2.83, 6 substeps, so 8 of 1, 2, 4, 8; semi-implicit Euler: w0 dt < 2,
+// 8.3 substeps, so 16), implicit Euler at one step; and every run equals the substeps
+// study's run of the same method and count, whose frame is also 1/60 s, so `advise --hz
+// 60` and the substeps study agree (issue 18).
+TEST(advise, frame_rates_follow_the_stability_limits_and_agree_with_the_substeps_study) {
+  sweep_options opts;
+  opts.problems = {"stiff_spring"};
+  opts.methods = {"rk4", "semi_implicit_euler", "implicit_euler"};
+  opts.levels = 8;
+  opts.loop.enabled = false;
+  opts.energy.enabled = false;
+  const study s = run_sweep(opts);
+  ASSERT_EQ(s.frame_rates.size(), 1u);
+  ASSERT_EQ(s.substeps.size(), 1u);
+  ASSERT_NEAR(s.substeps.front().frame_dt, 1.0 / 60.0, 1e-15);
+  const auto path = (std::filesystem::temp_directory_path() / fmt::format("test_frames_{}.h5", ::getpid())).string();
+  write_study(s, path);
+  const frame_advice f = advise_frame(path, "stiff_spring", 60.0, 1e-3);
+  auto completed_at = [&](const std::string& m, int n) {
+    for (const auto& r : s.frame_rates.front().runs)
+      if (r.hz == 60.0 && r.method == m && r.substeps == n) return r.row.metrics.completed();
+    ADD_FAILURE() << m << " x" << n << " not run";
+    return false;
+  };
+  EXPECT_FALSE(completed_at("rk4", 4));
+  EXPECT_TRUE(completed_at("rk4", 8));
+  EXPECT_FALSE(completed_at("semi_implicit_euler", 8));
+  EXPECT_TRUE(completed_at("semi_implicit_euler", 16));
+  EXPECT_TRUE(completed_at("implicit_euler", 1));
+  for (const auto& o : f.one_step) EXPECT_EQ(o.completed, o.method == "implicit_euler") << o.method;
+  // The same runs as the substeps study's.
+  int compared = 0;
+  for (const auto& sm : s.substeps.front().methods)
+    for (const auto& sr : sm.rows)
+      for (const auto& r : s.frame_rates.front().runs)
+        if (r.hz == 60.0 && r.method == sm.info.name && r.substeps == sr.substeps && r.row.metrics.completed()) {
+          EXPECT_EQ(r.row.metrics.err_pos_max, sr.row.metrics.err_pos_max) << r.method << " x" << r.substeps;
+          ++compared;
+        }
+  EXPECT_EQ(compared, 4);  // semi_implicit_euler x16, x32, x64 and implicit_euler x1 (rk4 is not in the substeps study)
+  // The answer is the cheapest run meeting the tolerance, by force evaluations a frame.
+  ASSERT_TRUE(f.met());
+  double cheapest = INFINITY;
+  for (const auto& r : s.frame_rates.front().runs)
+    if (r.hz == 60.0 && r.row.metrics.completed() && r.row.metrics.err_pos_max <= 1e-3)
+      cheapest = std::min(cheapest, static_cast<double>(r.row.work.force_evals) / 32.0);
+  EXPECT_DOUBLE_EQ(f.ranked.front().cost_per_frame, cheapest);
+  EXPECT_LE(f.ranked.front().err_pos_max, 1e-3);
+  EXPECT_THROW(advise_frame(path, "stiff_spring", 50.0, 1e-3), std::invalid_argument);
+  EXPECT_THROW(advise_frame(path, "nosuch", 60.0, 1e-3), std::invalid_argument);
   std::filesystem::remove(path);
 }

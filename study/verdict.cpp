@@ -1,0 +1,578 @@
+#include "study/verdict.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <set>
+
+#include "core/work_precision.hpp"
+#include "study/h5.hpp"
+#include "study/loop.hpp"
+#include "study/study_file.hpp"
+#include "study/substeps.hpp"
+#include "study/table_render.hpp"
+
+namespace stepbench {
+namespace {
+
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+constexpr const char* metric = "err_pos_max";
+
+// The truth at every stride-th sample of `t` (the frame ends of a slower rate).
+truth_table every_nth(const truth_table& t, std::size_t stride) {
+  truth_table out = t;
+  out.times.clear();
+  out.y.clear();
+  for (std::size_t j = stride - 1; j < t.times.size(); j += stride) {
+    out.times.push_back(t.times[j]);
+    out.y.push_back(t.y[j]);
+  }
+  return out;
+}
+
+bool contains(const std::vector<std::string>& v, std::string_view s) {
+  return std::find(v.begin(), v.end(), s) != v.end();
+}
+
+std::string hz_text(double hz) { return fmt::format("{:g} Hz", hz); }
+
+// "rk4 x4" for four substeps, "rk4" for one.
+std::string with_substeps(const std::string& method, int n) {
+  return n == 1 ? method : fmt::format("{} x{}", method, n);
+}
+
+}  // namespace
+
+std::vector<double> verdict_targets() { return equal_error_targets(); }
+
+std::vector<frame_rate_study> run_frame_rates(const study& s, const frame_rate_options& opts) {
+  std::vector<frame_rate_study> out;
+  if (!opts.enabled || opts.hz.empty()) return out;
+  const double slowest = *std::min_element(opts.hz.begin(), opts.hz.end());
+  const double fastest = *std::max_element(opts.hz.begin(), opts.hz.end());
+  const double finest_target = verdict_targets().back();
+  for (const auto& ps : s.problems) {
+    if (!ps.truth.trusted) continue;
+    // Whole frames of the slowest rate; every rate divides the fastest, so the truth at
+    // the fastest rate's frame ends holds every rate's.
+    const long slow_frames = static_cast<long>(std::floor(ps.horizon * slowest * (1.0 + 1e-12)));
+    if (slow_frames < 1) continue;
+    frame_rate_study fs;
+    fs.problem = std::string(ps.problem->name());
+    fs.unit = std::string(ps.problem->position_unit());
+    fs.horizon = static_cast<double>(slow_frames) / slowest;
+    const long fast_frames = std::lround(fs.horizon * fastest);
+    std::vector<double> times;
+    for (long j = 1; j <= fast_frames; ++j) times.push_back(static_cast<double>(j) / fastest);
+    const truth_table fine = build_truth(*ps.problem, times, {.tol = s.options.tol});
+    if (!fine.trusted) continue;
+    for (double hz : opts.hz) {
+      const auto stride = static_cast<std::size_t>(std::lround(fastest / hz));
+      const truth_table truth = every_nth(fine, stride);
+      for (const auto& info : ps.problem->methods()) {
+        if (info.origin != method_origin::ours || info.kind != method_kind::fixed_step) continue;
+        if (!s.options.methods.empty() && !contains(s.options.methods, info.name)) continue;
+        for (int n : opts.substeps) {
+          const double dt = 1.0 / (hz * n);
+          const run_result run = ps.problem->run(info.name, dt, fs.horizon, truth.times, s.options.limits);
+          frame_rate_run r{
+              hz, info.name, n, {dt, run.steps, run.rejected_steps, run.work, measure(*ps.problem, run, truth), {}}};
+          const bool done =
+              r.row.metrics.skipped || (r.row.metrics.completed() && r.row.metrics.err_pos_max <= finest_target);
+          fs.runs.push_back(std::move(r));
+          if (done) break;  // over the work budget, or already at the finest target
+        }
+      }
+    }
+    if (s.options.progress) std::fprintf(stderr, "frame rates %-20s %zu runs\n", fs.problem.c_str(), fs.runs.size());
+    out.push_back(std::move(fs));
+  }
+  return out;
+}
+
+namespace {
+
+// The cost of a frame of a run: the measured ns per step times the steps of a frame
+// (timed), else the force evaluations of a frame.
+double cost_per_frame(const problem_study* ps, const frame_rate_study& fs, const frame_rate_run& r, bool timed) {
+  const double frames = fs.horizon * r.hz;
+  if (!timed) return static_cast<double>(r.row.work.force_evals) / frames;
+  const double ns = ps ? measured_step_cost_ns(*ps, r.method) : nan;
+  return std::isfinite(ns) && ns > 0.0 ? ns * r.substeps : nan;
+}
+
+const problem_study* find_problem(const study& s, std::string_view name) {
+  for (const auto& ps : s.problems)
+    if (ps.problem->name() == name) return &ps;
+  return nullptr;
+}
+
+cost_at_error cost_of(const std::vector<wp_method>& methods, const wp_pick* p) {
+  if (!p) return {};
+  const auto& m = methods[p->method];
+  return {m.name, std::string(to_string(m.kind)), p->param, p->cost, p->cost_lo, p->cost_hi};
+}
+
+std::string verdict_of(const cost_at_error& ours, const cost_at_error& peer) {
+  if (!ours.found() && !peer.found()) return "not reached";
+  if (!peer.found()) return "ours only";
+  if (!ours.found()) return "peers only";
+  return compare_at_equal_error(ours.cost_lo, ours.cost_hi, peer.cost_lo, peer.cost_hi);
+}
+
+std::string cost_text(const std::string& kind, double c) {
+  if (!std::isfinite(c)) return "-";
+  return kind == "time_ns" ? format_time_ns(c) : fmt::format("{:.3g} evals", c);
+}
+
+// The findings: one sentence each, from the verdicts just computed and the studies'.
+std::vector<std::string> findings_of(const study& s, const verdict_tables& v) {
+  std::vector<std::string> out;
+  const bool timed = v.cost_kind == "time_ns";
+  // Equal error.
+  {
+    int ahead = 0, behind = 0, within = 0, ours_only = 0, peers_only = 0;
+    const equal_error_verdict* best_win = nullptr;
+    const equal_error_verdict* worst_loss = nullptr;
+    for (const auto& e : v.equal_error) {
+      if (e.verdict == "ahead") ++ahead;
+      if (e.verdict == "behind") ++behind;
+      if (e.verdict == "within spread") ++within;
+      if (e.verdict == "ours only") ++ours_only;
+      if (e.verdict == "peers only") ++peers_only;
+      if (e.verdict == "ahead" && (!best_win || e.ratio < best_win->ratio)) best_win = &e;
+      if (e.verdict == "behind" && (!worst_loss || e.ratio > worst_loss->ratio)) worst_loss = &e;
+    }
+    std::string line = fmt::format(
+        "At equal error ({}, interpolated on each method's measured curve), the fastest of ours against the "
+        "fastest library peer: ahead on {}, behind on {}, within the repetition spread on {} of the {} "
+        "problem-and-target pairs both reach; only ours reach {}, only a peer {}.",
+        timed ? "measured time" : "force evaluations", ahead, behind, within, ahead + behind + within, ours_only,
+        peers_only);
+    if (best_win)
+      line += fmt::format(" Largest lead: {} on {} at {:g} {} ({:.2g}x the time of {}).", best_win->ours.method,
+                          best_win->problem, best_win->target, best_win->unit, best_win->ratio, best_win->peer.method);
+    if (worst_loss)
+      line += fmt::format(" Largest deficit: {} on {} at {:g} {} ({:.2g}x {}).", worst_loss->ours.method,
+                          worst_loss->problem, worst_loss->target, worst_loss->unit, worst_loss->ratio,
+                          worst_loss->peer.method);
+    out.push_back(line);
+  }
+  // Implicit step against substeps.
+  for (const auto& st : s.substeps)
+    for (const auto& sv : substep_verdicts(st, s.timed.has_value()))
+      if (sv.implicit_method == "implicit_euler" && sv.explicit_method == "semi_implicit_euler") {
+        const int n = sv.substeps_at_equal_cost;
+        std::string line = fmt::format("{} (frame {:.3g} s): ", st.problem, st.frame_dt);
+        if (n == 0)
+          line += "even one semi_implicit_euler substep costs more than one implicit_euler step";
+        else if (!std::isfinite(sv.explicit_error))
+          line +=
+              fmt::format("one implicit_euler step costs as much as {} semi_implicit_euler substep{}, which diverge{}",
+                          n, n == 1 ? "" : "s", n == 1 ? "s" : "");
+        else if (sv.explicit_error <= sv.implicit_error)
+          line += fmt::format(
+              "{} semi_implicit_euler substep{} cost as much as one implicit_euler step and are {:.2g}x "
+              "more accurate",
+              n, n == 1 ? "" : "s", sv.implicit_error / sv.explicit_error);
+        else
+          line += fmt::format(
+              "{} semi_implicit_euler substep{} cost as much as one implicit_euler step and are {:.2g}x "
+              "less accurate",
+              n, n == 1 ? "" : "s", sv.explicit_error / sv.implicit_error);
+        if (sv.substeps_to_match > 0) line += fmt::format("; {} substeps match its error", sv.substeps_to_match);
+        out.push_back(line + ".");
+      }
+  // Declared orders that do not hold.
+  {
+    std::map<std::string, std::set<std::string>> broken;  // method -> problems
+    for (const auto& ps : s.problems)
+      for (const auto& ms : ps.methods)
+        if (ms.info.origin == method_origin::peer && ms.declared_order_holds == 0)
+          broken[ms.info.name].insert(std::string(ps.problem->name()));
+    if (!broken.empty()) {
+      std::string names;
+      for (const auto& [m, ps] : broken)
+        names +=
+            fmt::format("{}{} on {} problem{}", names.empty() ? "" : ", ", m, ps.size(), ps.size() == 1 ? "" : "s");
+      out.push_back(
+          fmt::format("Library methods whose observed order differs from the order they declare: {}.", names));
+    } else {
+      out.push_back("Every library method's observed order matches its declared order where it can be fitted.");
+    }
+  }
+  // Stability at 60 Hz, one step a frame.
+  {
+    std::map<std::string, std::vector<std::string>> unstable;  // problem -> methods
+    for (const auto& f : v.frame_rate)
+      if (f.hz == 60.0 && !f.stable) unstable[f.problem].push_back(f.method);
+    if (unstable.empty()) {
+      out.push_back("At 60 Hz, one step a frame, every fixed-step method of ours stays stable on every problem.");
+    } else {
+      std::string parts;
+      for (const auto& [p, ms] : unstable)
+        parts += fmt::format("{}{}: {}", parts.empty() ? "" : "; ", p, fmt::join(ms, ", "));
+      out.push_back(fmt::format("At 60 Hz, one step a frame, these diverge or fail: {}.", parts));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+verdict_tables compute_verdict(const study& s) {
+  verdict_tables v;
+  const bool timed = s.timed.has_value();
+  v.cost_kind = timed ? "time_ns" : "force_evals";
+  for (const auto& ps : s.problems) {
+    const auto methods = work_precision_input(ps, metric);
+    const std::string unit(ps.problem->position_unit());
+    double best_error = std::numeric_limits<double>::infinity();
+    for (const auto& m : methods)
+      if (m.origin != method_origin::baseline)
+        for (const auto& r : m.rows)
+          if (r.completed && std::isfinite(r.error)) best_error = std::min(best_error, r.error);
+    for (double target : verdict_targets()) {
+      const auto r = cheapest(methods, target, timed, metric, unit,
+                              timed ? wp_candidates::timed_methods : wp_candidates::every_method);
+      const wp_pick *ours = nullptr, *peer = nullptr;
+      for (const auto& p : r.ranked) {
+        if (methods[p.method].origin == method_origin::ours && !ours) ours = &p;
+        if (methods[p.method].origin == method_origin::peer && !peer) peer = &p;
+      }
+      equal_error_verdict e;
+      e.problem = std::string(ps.problem->name());
+      e.unit = unit;
+      e.target = target;
+      e.ours = cost_of(methods, ours);
+      e.peer = cost_of(methods, peer);
+      e.ratio = ours && peer ? ours->cost / peer->cost : nan;
+      e.verdict = verdict_of(e.ours, e.peer);
+      e.best_error = std::isfinite(best_error) ? best_error : nan;
+      v.equal_error.push_back(std::move(e));
+    }
+  }
+  for (const auto& fs : s.frame_rates) {
+    const problem_study* ps = find_problem(s, fs.problem);
+    std::vector<double> rates;
+    for (const auto& r : fs.runs)
+      if (std::find(rates.begin(), rates.end(), r.hz) == rates.end()) rates.push_back(r.hz);
+    for (double hz : rates) {
+      for (const auto& r : fs.runs) {
+        if (r.hz != hz || r.substeps != 1) continue;
+        const auto& m = r.row.metrics;
+        v.frame_rate.push_back({fs.problem, fs.unit, r.method, m.completed() ? "" : (m.diverged ? "diverged" : m.note),
+                                hz, m.completed(), m.completed() ? m.err_pos_max : nan});
+      }
+      for (double target : verdict_targets()) {
+        frame_answer a{fs.problem, fs.unit, "", hz, target, 0, nan, nan, nan};
+        for (const auto& r : fs.runs) {
+          if (r.hz != hz || !r.row.metrics.completed() || !(r.row.metrics.err_pos_max <= target)) continue;
+          const double c = cost_per_frame(ps, fs, r, timed);
+          if (!std::isfinite(c)) continue;
+          if (a.method.empty() || c < a.cost_per_frame ||
+              (c == a.cost_per_frame && r.row.metrics.err_pos_max < a.err_pos_max)) {
+            a.method = r.method;
+            a.substeps = r.substeps;
+            a.err_pos_max = r.row.metrics.err_pos_max;
+            a.cost_per_frame = c;
+            a.frame_share = timed ? c / (1e9 / hz) : nan;
+          }
+        }
+        v.frame_answers.push_back(std::move(a));
+      }
+    }
+  }
+  v.findings = findings_of(s, v);
+  return v;
+}
+
+void write_verdict(H5::Group& root, const study& s) {
+  using h5::attr;
+  const verdict_tables v = compute_verdict(s);
+  H5::Group g = root.createGroup("verdict");
+  attr(g, "metric", metric);
+  attr(g, "targets", verdict_targets());
+  attr(g, "frame_hz", frame_rate_options{}.hz);
+  attr(g, "cost_kind", v.cost_kind);
+  std::string findings;
+  for (const auto& f : v.findings) findings += (findings.empty() ? "" : "\n") + f;
+  attr(g, "findings", findings);
+  attr(g, "rule",
+       "time (or force evaluations) at equal error, interpolated log-log between the two measured rows that bracket "
+       "the target on each method's work-precision curve, never extrapolated; ahead or behind only when the ratio "
+       "lies outside the repetition spread");
+  {
+    std::vector<std::string> problem, unit, om, ok, pm, pk, verdict;
+    std::vector<double> target, op, oc, ol, oh, pp, pc, pl, ph, ratio, best;
+    for (const auto& e : v.equal_error) {
+      problem.push_back(e.problem);
+      unit.push_back(e.unit);
+      target.push_back(e.target);
+      om.push_back(e.ours.method);
+      ok.push_back(e.ours.kind);
+      op.push_back(e.ours.found() ? e.ours.param : nan);
+      oc.push_back(e.ours.found() ? e.ours.cost : nan);
+      ol.push_back(e.ours.found() ? e.ours.cost_lo : nan);
+      oh.push_back(e.ours.found() ? e.ours.cost_hi : nan);
+      pm.push_back(e.peer.method);
+      pk.push_back(e.peer.kind);
+      pp.push_back(e.peer.found() ? e.peer.param : nan);
+      pc.push_back(e.peer.found() ? e.peer.cost : nan);
+      pl.push_back(e.peer.found() ? e.peer.cost_lo : nan);
+      ph.push_back(e.peer.found() ? e.peer.cost_hi : nan);
+      ratio.push_back(e.ratio);
+      verdict.push_back(e.verdict);
+      best.push_back(e.best_error);
+    }
+    h5::table t;
+    t.add("problem", problem);
+    t.add("unit", unit);
+    t.add("target", target);
+    t.add("ours_method", om);
+    t.add("ours_kind", ok);
+    t.add("ours_param", op);
+    t.add("ours_cost", oc);
+    t.add("ours_cost_lo", ol);
+    t.add("ours_cost_hi", oh);
+    t.add("peer_method", pm);
+    t.add("peer_kind", pk);
+    t.add("peer_param", pp);
+    t.add("peer_cost", pc);
+    t.add("peer_cost_lo", pl);
+    t.add("peer_cost_hi", ph);
+    t.add("ratio", ratio);
+    t.add("verdict", verdict);
+    t.add("best_error", best);
+    t.write(g, "equal_error", schema::find("verdict_equal_error"));
+  }
+  {
+    std::vector<std::string> problem, unit, method, note;
+    std::vector<double> hz, err;
+    std::vector<std::int8_t> stable;
+    for (const auto& f : v.frame_rate) {
+      problem.push_back(f.problem);
+      unit.push_back(f.unit);
+      hz.push_back(f.hz);
+      method.push_back(f.method);
+      stable.push_back(static_cast<std::int8_t>(f.stable));
+      err.push_back(f.err_pos_max);
+      note.push_back(f.note);
+    }
+    h5::table t;
+    t.add("problem", problem);
+    t.add("unit", unit);
+    t.add("hz", hz);
+    t.add("method", method);
+    t.add("stable", stable);
+    t.add("err_pos_max", err);
+    t.add("note", note);
+    t.write(g, "frame_rate", schema::find("verdict_frame_rate"));
+  }
+  {
+    std::vector<std::string> problem, unit, method;
+    std::vector<double> hz, target, err, cost, share;
+    std::vector<std::int64_t> substeps;
+    for (const auto& a : v.frame_answers) {
+      problem.push_back(a.problem);
+      unit.push_back(a.unit);
+      hz.push_back(a.hz);
+      target.push_back(a.target);
+      method.push_back(a.method);
+      substeps.push_back(a.substeps);
+      err.push_back(a.err_pos_max);
+      cost.push_back(a.cost_per_frame);
+      share.push_back(a.frame_share);
+    }
+    h5::table t;
+    t.add("problem", problem);
+    t.add("unit", unit);
+    t.add("hz", hz);
+    t.add("target", target);
+    t.add("method", method);
+    t.add("substeps", substeps);
+    t.add("err_pos_max", err);
+    t.add("cost_per_frame", cost);
+    t.add("frame_share", share);
+    t.write(g, "frame_answer", schema::find("verdict_frame_answer"));
+  }
+  H5::Group fr = root.createGroup("frame_rates");
+  const bool timed = s.timed.has_value();
+  for (const auto& fs : s.frame_rates) {
+    H5::Group pg = fr.createGroup(fs.problem);
+    attr(pg, "horizon", fs.horizon);
+    attr(pg, "position_unit", fs.unit);
+    std::vector<std::string> method, note;
+    std::vector<double> hz, dt, err, evals, cost;
+    std::vector<std::int64_t> substeps, steps;
+    std::vector<std::int8_t> completed, diverged;
+    const problem_study* ps = find_problem(s, fs.problem);
+    for (const auto& r : fs.runs) {
+      hz.push_back(r.hz);
+      method.push_back(r.method);
+      substeps.push_back(r.substeps);
+      dt.push_back(r.row.param);
+      completed.push_back(static_cast<std::int8_t>(r.row.metrics.completed()));
+      diverged.push_back(static_cast<std::int8_t>(r.row.metrics.diverged));
+      err.push_back(r.row.metrics.completed() ? r.row.metrics.err_pos_max : nan);
+      steps.push_back(r.row.steps);
+      evals.push_back(static_cast<double>(r.row.work.force_evals));
+      cost.push_back(cost_per_frame(ps, fs, r, timed));
+      note.push_back(r.row.metrics.note);
+    }
+    h5::table t;
+    t.add("hz", hz);
+    t.add("method", method);
+    t.add("substeps", substeps);
+    t.add("dt", dt);
+    t.add("completed", completed);
+    t.add("diverged", diverged);
+    t.add("err_pos_max", err);
+    t.add("steps", steps);
+    t.add("force_evals", evals);
+    t.add("cost_per_frame", cost);
+    t.add("note", note);
+    t.write(pg, "runs", schema::find("frame_rate_runs"));
+  }
+}
+
+std::string format_verdict_text(const study& s) { return format_verdict_text(compute_verdict(s)); }
+
+std::string format_verdict_text(const verdict_tables& v) {
+  std::string out;
+  const bool timed = v.cost_kind == "time_ns";
+  // The equal-error table: problems down, every other target across.
+  const std::vector<double> shown{1e-2, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12};
+  std::vector<std::string> problems;
+  for (const auto& e : v.equal_error)
+    if (!contains(problems, e.problem)) problems.push_back(e.problem);
+  {
+    std::vector<column> cols{{"problem"}};
+    for (double t : shown) cols.push_back({fmt::format("err <= {:g}", t)});
+    table tb{cols, {}};
+    for (const auto& p : problems) {
+      std::vector<std::string> row{p};
+      for (double t : shown) {
+        std::string cell = "-";
+        for (const auto& e : v.equal_error) {
+          if (e.problem != p || e.target != t) continue;
+          if (e.ours.found()) {
+            cell = e.ours.method;
+            if (std::isfinite(e.ratio))
+              cell += fmt::format(" {:.2g}x{}", e.ratio,
+                                  e.verdict == "ahead"    ? "+"
+                                  : e.verdict == "behind" ? "-"
+                                                          : "~");
+          } else if (e.peer.found()) {
+            cell = "(" + e.peer.method + ")";
+          }
+        }
+        row.push_back(cell);
+      }
+      tb.add(row);
+    }
+    out += fmt::format(
+        "Fastest of ours at equal error (err_pos_max in the problem's unit, m or rad), and its {} over the fastest "
+        "library peer's: + ahead, - behind, ~ within the repetition spread; (peer) when none of ours reaches it.\n",
+        timed ? "time" : "force evaluations");
+    out += render_text(tb);
+  }
+  // The frame-rate table at 60 Hz.
+  {
+    const std::vector<double> targets{1e-2, 1e-4, 1e-6};
+    std::vector<column> cols{{"problem"}, {"stable at 1 step"}};
+    for (double t : targets) cols.push_back({fmt::format("cheapest for {:g}", t)});
+    table tb{cols, {}};
+    for (const auto& p : problems) {
+      int stable = 0, total = 0;
+      for (const auto& f : v.frame_rate)
+        if (f.problem == p && f.hz == 60.0) {
+          ++total;
+          stable += f.stable;
+        }
+      if (total == 0) continue;
+      std::vector<std::string> row{p, fmt::format("{} of {}", stable, total)};
+      for (double t : targets) {
+        std::string cell = "none <= x64";
+        for (const auto& a : v.frame_answers)
+          if (a.problem == p && a.hz == 60.0 && a.target == t && !a.method.empty())
+            cell = with_substeps(a.method, a.substeps) + " " + cost_text(v.cost_kind, a.cost_per_frame);
+        row.push_back(cell);
+      }
+      tb.add(row);
+    }
+    out += fmt::format(
+        "\nAt {} (a frame of 16.7 ms): our fixed-step methods stable at one step a frame, and the cheapest method "
+        "x substeps a frame whose err_pos_max meets each target, with its {} per frame "
+        "(stepbench advise --problem P --hz HZ --tol X for other rates and targets).\n",
+        hz_text(60), timed ? "measured time" : "force evaluations");
+    out += render_text(tb);
+  }
+  out += "\nFindings:\n";
+  for (const auto& f : v.findings) out += "  - " + f + "\n";
+  return out;
+}
+
+verdict_tables read_verdict(const std::string& path) {
+  verdict_tables v;
+  try {
+    if (!H5::H5File::isHdf5(path)) throw std::runtime_error("not an HDF5 file");
+    const H5::H5File file(path, H5F_ACC_RDONLY);
+    if (!h5::is_group(file, "verdict"))
+      throw std::runtime_error("it has no /verdict (written before format_version 4: run the study again)");
+    const H5::Group g = file.openGroup("verdict");
+    v.cost_kind = h5::string_attr(g, "cost_kind");
+    const std::string findings = h5::string_attr(g, "findings");
+    for (std::size_t a = 0; a < findings.size();) {
+      const auto b = std::min(findings.find('\n', a), findings.size());
+      v.findings.push_back(findings.substr(a, b - a));
+      a = b + 1;
+    }
+    {
+      const auto t = h5::read_table(g.openDataSet("equal_error"));
+      const auto &problem = t.strings("problem"), &unit = t.strings("unit"), &om = t.strings("ours_method"),
+                 &ok = t.strings("ours_kind"), &pm = t.strings("peer_method"), &pk = t.strings("peer_kind"),
+                 &verdict = t.strings("verdict");
+      const auto target = t.doubles("target"), op = t.doubles("ours_param"), oc = t.doubles("ours_cost"),
+                 ol = t.doubles("ours_cost_lo"), oh = t.doubles("ours_cost_hi"), pp = t.doubles("peer_param"),
+                 pc = t.doubles("peer_cost"), pl = t.doubles("peer_cost_lo"), ph = t.doubles("peer_cost_hi"),
+                 ratio = t.doubles("ratio"), best = t.doubles("best_error");
+      for (std::size_t i = 0; i < t.rows(); ++i)
+        v.equal_error.push_back({problem[i],
+                                 unit[i],
+                                 target[i],
+                                 {om[i], ok[i], op[i], oc[i], ol[i], oh[i]},
+                                 {pm[i], pk[i], pp[i], pc[i], pl[i], ph[i]},
+                                 ratio[i],
+                                 verdict[i],
+                                 best[i]});
+    }
+    {
+      const auto t = h5::read_table(g.openDataSet("frame_rate"));
+      const auto &problem = t.strings("problem"), &unit = t.strings("unit"), &method = t.strings("method"),
+                 &note = t.strings("note");
+      const auto hz = t.doubles("hz"), stable = t.doubles("stable"), err = t.doubles("err_pos_max");
+      for (std::size_t i = 0; i < t.rows(); ++i)
+        v.frame_rate.push_back({problem[i], unit[i], method[i], note[i], hz[i], stable[i] != 0, err[i]});
+    }
+    {
+      const auto t = h5::read_table(g.openDataSet("frame_answer"));
+      const auto &problem = t.strings("problem"), &unit = t.strings("unit"), &method = t.strings("method");
+      const auto hz = t.doubles("hz"), target = t.doubles("target"), substeps = t.doubles("substeps"),
+                 err = t.doubles("err_pos_max"), cost = t.doubles("cost_per_frame"), share = t.doubles("frame_share");
+      for (std::size_t i = 0; i < t.rows(); ++i)
+        v.frame_answers.push_back({problem[i], unit[i], method[i], hz[i], target[i], static_cast<int>(substeps[i]),
+                                   err[i], cost[i], share[i]});
+    }
+  } catch (const H5::Exception& e) {
+    throw std::runtime_error(fmt::format("cannot read the verdict of study file '{}': {}", path, e.getDetailMsg()));
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(fmt::format("cannot read the verdict of study file '{}': {}", path, e.what()));
+  }
+  return v;
+}
+
+}  // namespace stepbench

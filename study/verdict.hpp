@@ -1,0 +1,87 @@
+#pragma once
+// The answer a user comes for, computed once when the study is written and stored in it
+// (/verdict, docs/study-format.md); the report's first screen, `stepbench advise --hz`,
+// `stepbench ratios` and the end of a study run all show these tables, never a second
+// computation.
+//
+//  - Equal error: for each problem and error target (err_pos_max, 1e-2 .. 1e-12 in the
+//    problem's unit), the fastest of our methods and the fastest library peer by the cost
+//    at equal error interpolated on each method's measured work-precision curve
+//    (core/work_precision.hpp), their ratio, and whether the ratio lies outside the
+//    repetition spread ("ahead" / "behind") or within it.
+//  - Frame rates, the game programmer's question: at 30, 60, 120 and 240 Hz, every fixed-step
+//    method of ours is run at n = 1, 2, 4, ..., 64 substeps a frame over the whole frames of
+//    the problem's horizon and measured against the truth at the frame ends. Which methods
+//    are stable at one step a frame and their error; for each target the cheapest method
+//    and substep count that meets it. The cost of a frame is the benchmark's median ns per
+//    step of the method on the problem times the steps of a frame (timed study), else the
+//    force evaluations of a frame.
+//  - Findings: a few sentences generated from these and the other studies' verdicts.
+#include <H5Cpp.h>
+
+#include <string>
+#include <vector>
+
+#include "study/sweep.hpp"
+
+namespace stepbench {
+
+// Runs the frame-rate study on every problem of `s` (their truths are rebuilt at the frame
+// ends of the fastest rate). A problem whose horizon holds no whole frame is left out.
+std::vector<frame_rate_study> run_frame_rates(const study& s, const frame_rate_options& opts);
+
+// The error targets of the verdict: 1e-2 .. 1e-12.
+std::vector<double> verdict_targets();
+
+struct cost_at_error {
+  std::string method, kind;  // empty method: none reaches the target
+  double param = 0.0, cost = 0.0, cost_lo = 0.0, cost_hi = 0.0;
+  bool found() const { return !method.empty(); }
+};
+
+struct equal_error_verdict {
+  std::string problem, unit;
+  double target = 0.0;
+  cost_at_error ours, peer;
+  double ratio = 0.0;   // ours / peer; NaN unless both
+  std::string verdict;  // "ahead", "behind", "within spread", "ours only", "peers only", "not reached"
+  double best_error = 0.0;
+};
+
+struct frame_stability {
+  std::string problem, unit, method, note;
+  double hz = 0.0;
+  bool stable = false;
+  double err_pos_max = 0.0;
+};
+
+struct frame_answer {
+  std::string problem, unit, method;  // empty: none within the largest substep count
+  double hz = 0.0, target = 0.0;
+  int substeps = 0;
+  double err_pos_max = 0.0, cost_per_frame = 0.0, frame_share = 0.0;
+};
+
+struct verdict_tables {
+  std::string cost_kind;  // "time_ns" or "force_evals"
+  std::vector<equal_error_verdict> equal_error;
+  std::vector<frame_stability> frame_rate;
+  std::vector<frame_answer> frame_answers;
+  std::vector<std::string> findings;
+};
+
+verdict_tables compute_verdict(const study& s);
+
+// /verdict and /frame_rates/<problem> (docs/study-format.md).
+void write_verdict(H5::Group& root, const study& s);
+
+// The verdict tables as text: the equal-error table across problems and targets, the
+// frame-rate table and the findings (what a study run prints at its end).
+std::string format_verdict_text(const study& s);
+std::string format_verdict_text(const verdict_tables& v);
+
+// Reads /verdict back from a study file (`stepbench advise --hz`); throws
+// std::runtime_error naming what is missing.
+verdict_tables read_verdict(const std::string& path);
+
+}  // namespace stepbench

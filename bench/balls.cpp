@@ -8,9 +8,8 @@
 // target: the cost per ball-step at 1e6 within 2x of that at 1000, where everything fits
 // in the caches.
 //
-// The family registers itself into Google Benchmark's registry at start-up (a
-// function-local static in the library: no initialisation-order trap), so stepbench_bench
-// runs it with the others; --benchmark_filter=bouncing_balls selects it alone.
+// Registered by main when bouncing_balls is selected (every problem, or --problem=
+// bouncing_balls); --benchmark_filter=bouncing_balls/ then selects it alone.
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
 
@@ -18,6 +17,7 @@
 #include <functional>
 #include <string>
 
+#include "bench/scaling.hpp"
 #include "study/registry.hpp"
 
 namespace stepbench::bench {
@@ -45,7 +45,10 @@ void balls_case(benchmark::State& state, const std::string& method) {
   state.SetComplexityN(n);
 }
 
-[[maybe_unused]] const bool registered = [] {
+}  // namespace
+
+void register_balls(const std::vector<std::string>& problems) {
+  if (!selected(problems, "bouncing_balls")) return;
   for (const auto& m : integrators()) {
     // Explicit fixed-step methods: what a game steps a ball pit with. An implicit step
     // would difference the 2N-coordinate force for its Jacobian (no analytic one here).
@@ -56,8 +59,6 @@ void balls_case(benchmark::State& state, const std::string& method) {
     for (long n : ball_counts) b->Arg(n);
     b->Complexity(benchmark::oN)->UseRealTime()->Unit(benchmark::kMillisecond);
   }
-  return true;
-}();
+}
 
-}  // namespace
 }  // namespace stepbench::bench

@@ -9,6 +9,31 @@
 
 namespace stepbench::bench {
 
+const char* own_flags_help() {
+  return "stepbench_bench: Google Benchmark timing of the accuracy study: one case per completed row of the sweep,\n"
+         "the scaling families spring_chain/<method>/masses:N and bouncing_balls/<method>/balls:N, and the\n"
+         "memory-bandwidth triad stream/triad.\n"
+         "\n"
+         "Our flags:\n"
+         "  --quick              CI mode: 8-level ladder, thinned tolerances, min time 0.002 s, 1 repetition\n"
+         "  --study_out=PATH     write the study file (timings beside accuracy); results to bench.json beside it\n"
+         "  --problem=NAME       sweep and time this problem only, and its scaling family (repeatable)\n"
+         "  --set=P.NAME=VALUE   a problem parameter, as stepbench's --set; NAME=VALUE with one --problem\n"
+         "  --case_budget=S      cut a family's finer cases once one run would exceed S s (0.5; quick 0.05)\n"
+         "  --strict             exit 3 when some case failed (recorded in the study; else exit 0)\n"
+         "  --verbose            with --study_out: Google Benchmark's table and context on the terminal too\n"
+         "\n"
+         "With --study_out, stderr shows one progress line and stdout the verdict at the end; Google Benchmark's\n"
+         "table goes to the terminal only with --verbose or --benchmark_format (the verdict then goes to stderr\n"
+         "if stdout carries json or csv), and to --benchmark_out instead of bench.json when that is given.\n"
+         "The scaling families and the triad ignore --set; the triad runs with either scaling family.\n"
+         "Google Benchmark's context line \"***WARNING*** Library was built as DEBUG\" is left out (Debian\n"
+         "builds libbenchmark without NDEBUG; bench.json records library_build_type); its other warnings stay.\n"
+         "Exit: 0 done, 1 an error, 2 bad usage, 3 with --strict some case failed.\n"
+         "\n"
+         "Google Benchmark's flags:\n";
+}
+
 options take_own_flags(int& argc, char** argv, std::vector<std::string>& extra) {
   options o;
   bool min_time_given = false, reps_given = false, budget_given = false;
@@ -20,6 +45,8 @@ options take_own_flags(int& argc, char** argv, std::vector<std::string>& extra) 
       o.quick = true;
     } else if (a == "--strict") {
       o.strict = true;
+    } else if (a == "--verbose") {
+      o.verbose = true;
     } else if (a.rfind("--set=", 0) == 0) {
       sets.push_back(a.substr(6));  // resolved below, once every --problem is known
     } else if (a.rfind("--problem=", 0) == 0) {
@@ -47,6 +74,14 @@ options take_own_flags(int& argc, char** argv, std::vector<std::string>& extra) 
         o.repetitions = static_cast<int>(reps);
       }
       if (a == "--benchmark_list_tests" || a == "--benchmark_list_tests=true") o.list_only = true;
+      if (a.rfind("--benchmark_format=", 0) == 0) {
+        // Checked here: Google Benchmark answers a bad value with its help and exit 0.
+        o.benchmark_format = a.substr(19);
+        if (o.benchmark_format != "console" && o.benchmark_format != "json" && o.benchmark_format != "csv")
+          throw std::invalid_argument("--benchmark_format must be console, json or csv, got '" + o.benchmark_format +
+                                      "'");
+      }
+      if (a.rfind("--benchmark_out=", 0) == 0) o.benchmark_out = a.substr(16);
       argv[out++] = argv[i];
     }
   }

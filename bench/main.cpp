@@ -2,24 +2,101 @@
 // (every method, ours and the peers, over its ladder, measured by the same code as
 // `stepbench sweep`), registers one timed case per completed row from the same entries,
 // runs them, and writes the study file with each timing next to its accuracy row
-// (--study_out). stdout carries exactly the output format chosen with
-// --benchmark_format; progress and the summary go to stderr. The performance ratios
-// and equal-error tables come from the study file: `stepbench ratios`.
+// (--study_out). A study run shows one progress line on stderr (bench/progress.hpp),
+// writes Google Benchmark's results to bench.json beside the study (its JSON format, read
+// by compare.py), and ends with the verdict on stdout. Otherwise, or with --verbose or
+// --benchmark_format, stdout carries exactly the output format chosen with
+// --benchmark_format; progress and the summary go to stderr. The performance ratios and
+// equal-error tables come from the study file: `stepbench ratios`.
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
+#include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 #include "bench/cases.hpp"
 #include "bench/flags.hpp"
+#include "bench/progress.hpp"
 #include "bench/scaling.hpp"
 #include "bench/timings.hpp"
+#include "study/registry.hpp"
 #include "study/study_file.hpp"
 #include "study/sweep.hpp"
+#include "study/temp_file_guard.hpp"
+#include "study/verdict.hpp"
 
 using namespace stepbench;
+
+namespace {
+
+void print_help() {
+  std::fputs(bench::own_flags_help(), stdout);
+  benchmark::PrintDefaultHelp();
+}
+
+// A reporter that reports nothing: the listing below writes to its output stream.
+class listing_reporter : public benchmark::BenchmarkReporter {
+ public:
+  bool ReportContext(const Context&) override { return true; }
+  void ReportRuns(const std::vector<Run>&) override {}
+};
+
+// The number of cases the run will time: Google Benchmark's own listing of what its
+// filter selects, counted (--benchmark_list_tests on for the listing, off again after;
+// every other flag stays as the first Initialize parsed it). The same selection as the
+// run, without a second implementation of the filter.
+std::size_t count_selected(char* program) {
+  std::string on = "--benchmark_list_tests=true", off = "--benchmark_list_tests=false";
+  char* list_args[] = {program, on.data(), nullptr};
+  int list_argc = 2;
+  benchmark::Initialize(&list_argc, list_args);
+  std::ostringstream names, errors;
+  listing_reporter listing;
+  listing.SetOutputStream(&names);
+  listing.SetErrorStream(&errors);  // "Failed to match any benchmarks": the run says it
+  const std::size_t n = benchmark::RunSpecifiedBenchmarks(&listing);
+  char* run_args[] = {program, off.data(), nullptr};
+  int run_argc = 2;
+  benchmark::Initialize(&run_argc, run_args);
+  return n;
+}
+
+// Writes `text` to a temporary file beside `path` and renames it into place, as the
+// study file is written: an interrupted run leaves the previous file and nothing else.
+void write_whole_file(const std::string& path, const std::string& text) {
+  const std::string tmp = fmt::format("{}.tmp.{}", path, ::getpid());
+  const temp_file_guard guard(tmp);
+  std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+  out << text;
+  out.close();
+  if (!out) {
+    const int error = errno;
+    std::remove(tmp.c_str());
+    throw std::runtime_error(fmt::format("cannot write results file '{}': {}", path, std::strerror(error)));
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error(fmt::format("cannot write results file '{}': {}", path, ec.message()));
+  }
+}
+
+std::size_t run_count(const study& s) {
+  std::size_t n = 0;
+  for (const auto& ps : s.problems)
+    for (const auto& ms : ps.methods) n += ms.rows.size();
+  return n;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   try {
@@ -29,9 +106,19 @@ int main(int argc, char** argv) {
     for (auto& e : extra) args.push_back(e.data());
     int n = static_cast<int>(args.size());
     args.push_back(nullptr);
-    benchmark::Initialize(&n, args.data());
+    benchmark::Initialize(&n, args.data(), print_help);
     if (benchmark::ReportUnrecognizedArguments(n, args.data())) return 2;
-    if (!opts.study_out.empty() && !opts.list_only) check_writable(opts.study_out);
+
+    // A study run keeps the terminal for progress and the verdict: Google Benchmark's
+    // table goes to bench.json beside the study (or where --benchmark_out says), and to
+    // the terminal only when asked for.
+    const bool study_run = !opts.study_out.empty() && !opts.list_only;
+    const bool show_table = !study_run || opts.verbose || !opts.benchmark_format.empty();
+    const std::string bench_json = study_run && opts.benchmark_out.empty()
+                                       ? (std::filesystem::path(opts.study_out).parent_path() / "bench.json").string()
+                                       : std::string();
+    if (study_run) check_writable(opts.study_out);
+    if (!bench_json.empty()) check_writable(bench_json);
 
     // The accuracy sweep first: it gives each case its counters and the study its rows.
     sweep_options sopts;
@@ -39,19 +126,40 @@ int main(int argc, char** argv) {
       sopts.levels = 8;
       sopts.tolerances = tolerance_ladder(true);
     }
-    sopts.overrides = opts.overrides;  // checked by run_sweep's validate()
+    sopts.overrides = opts.overrides;
     sopts.problems = opts.problems;
-    sopts.progress = !opts.list_only;
+    validate(sopts);  // before any output: one line and exit 2 on a bad name or value
+    bench::progress_line progress("stepbench_bench", !opts.list_only);
     const auto start = std::chrono::steady_clock::now();
+    const std::size_t problem_count = opts.problems.empty() ? problem_names().size() : opts.problems.size();
+    progress.begin(fmt::format("sweeping {} for accuracy", count_of(problem_count, "problem")));
     study s = run_sweep(sopts);
+    progress.end(fmt::format("swept {} ({}) in {}", count_of(s.problems.size(), "problem"),
+                             count_of(run_count(s), "run"), bench::format_duration(s.wall_seconds)));
+
     bench::case_book book(opts.case_budget_s);
     book.register_all(s);
-    bench::register_scaling();
+    bench::register_scaling(opts.problems);
+    bench::register_balls(opts.problems);
+    const std::size_t total = opts.list_only ? 0 : count_selected(argv[0]);
 
     // The display reporter is made after Initialize, from the flags it parsed.
-    bench::collecting_reporter reporter(benchmark::CreateDefaultDisplayReporter(), book);
+    benchmark::JSONReporter json;
+    std::ostringstream json_text;
+    json.SetOutputStream(&json_text);
+    json.SetErrorStream(&json_text);
+    bench::collecting_reporter reporter(show_table ? benchmark::CreateDefaultDisplayReporter() : nullptr,
+                                        bench_json.empty() ? nullptr : &json, book, progress, opts.verbose);
+    const char* mode = opts.quick ? "quick" : "full";
+    const auto timing_start = std::chrono::steady_clock::now();
+    if (total > 0) progress.begin("timing", total, "cases");
     benchmark::RunSpecifiedBenchmarks(&reporter);
     benchmark::Shutdown();
+    if (total > 0)
+      progress.end(
+          fmt::format("timed {} ({} mode) in {}", count_of(total, "case"), mode,
+                      bench::format_duration(
+                          std::chrono::duration<double>(std::chrono::steady_clock::now() - timing_start).count())));
     if (opts.list_only) return 0;
 
     if (!opts.study_out.empty() && !book.any_timed())
@@ -59,7 +167,7 @@ int main(int argc, char** argv) {
                                " was not written");
     book.merge_into_rows();
     timing_settings ts;
-    ts.mode = opts.quick ? "quick" : "full";
+    ts.mode = mode;
     ts.min_time_s = opts.min_time_s;
     ts.repetitions = opts.repetitions;
     ts.case_budget_s = opts.case_budget_s;
@@ -68,17 +176,25 @@ int main(int argc, char** argv) {
     ts.cpu_scaling_enabled = reporter.cpu_scaling;
     ts.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     s.timed = ts;
-    if (!opts.study_out.empty()) {
-      write_study(s, opts.study_out);
-      fmt::print(stderr,
-                 "stepbench_bench: wrote {} ({} mode, {} cases timed) in {:.1f} s; `stepbench ratios --study {}` "
-                 "prints the performance ratios\n",
-                 opts.study_out, ts.mode, book.timed_count(), ts.wall_seconds, opts.study_out);
-    } else {
-      fmt::print(stderr, "stepbench_bench: timed {} cases in {:.1f} s ({} mode)\n", book.timed_count(), ts.wall_seconds,
-                 ts.mode);
-    }
-    return report_study_outcome(s, "stepbench_bench", opts.strict);
+    const std::string timed = count_of(book.timed_count(), "case");
+    if (opts.study_out.empty()) return report_study_outcome(s, "stepbench_bench", opts.strict);
+    // The study first, then bench.json: a signal between the two leaves the new study
+    // whole and the previous bench.json (the study is what the other commands read).
+    write_study(s, opts.study_out);
+    if (!bench_json.empty()) write_whole_file(bench_json, json_text.str());
+    std::fflush(stdout);
+    fmt::print(stderr,
+               "stepbench_bench: wrote {}{} ({} mode, {} timed) in {}; `stepbench ratios --study {}` prints the "
+               "performance ratios\n",
+               opts.study_out, bench_json.empty() ? "" : " and " + bench_json, ts.mode, timed,
+               bench::format_duration(ts.wall_seconds), opts.study_out);
+    const int status = report_study_outcome(s, "stepbench_bench", opts.strict);
+    // The answer last: the verdict tables (on stderr when stdout carries Google
+    // Benchmark's JSON or CSV).
+    std::FILE* verdict_to =
+        show_table && !opts.benchmark_format.empty() && opts.benchmark_format != "console" ? stderr : stdout;
+    fmt::print(verdict_to, "\n{}", format_verdict_text(s));
+    return status;
   } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "stepbench_bench: error: %s\n", e.what());
     return 2;

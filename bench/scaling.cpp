@@ -3,6 +3,7 @@
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <memory>
 #include <string>
@@ -58,9 +59,15 @@ void triad(benchmark::State& state) {
 
 }  // namespace
 
-void register_scaling() {
+bool selected(const std::vector<std::string>& problems, const std::string& problem) {
+  return problems.empty() || std::find(problems.begin(), problems.end(), problem) != problems.end();
+}
+
+void register_scaling(const std::vector<std::string>& problems) {
+  const bool chain = selected(problems, "spring_chain");
+  if (!chain && !selected(problems, "bouncing_balls")) return;
   for (const auto& m : integrators()) {
-    if (m.kind != method_kind::fixed_step) continue;
+    if (!chain || m.kind != method_kind::fixed_step) continue;
     auto* b = benchmark::RegisterBenchmark(fmt::format("spring_chain/{}", m.name).c_str(),
                                            [name = m.name](benchmark::State& state) { chain_case(state, name); });
     b->ArgName("masses");

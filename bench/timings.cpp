@@ -2,7 +2,21 @@
 
 #include <fmt/format.h>
 
+#include <sstream>
+
 namespace stepbench::bench {
+
+std::string shown_context(const std::string& header, bool warnings_only, bool verbose) {
+  std::istringstream in(header);
+  std::string out, line;
+  while (std::getline(in, line)) {
+    const bool warning = line.rfind("***WARNING***", 0) == 0;
+    if (warnings_only && !warning) continue;
+    if (!verbose && line.rfind("***WARNING*** Library was built as DEBUG", 0) == 0) continue;
+    out += line + "\n";
+  }
+  return out;
+}
 
 bool collecting_reporter::ReportContext(const Context& context) {
   cpu_scaling = context.cpu_info.scaling == benchmark::CPUInfo::ENABLED    ? 1
@@ -10,10 +24,22 @@ bool collecting_reporter::ReportContext(const Context& context) {
                                                                            : -1;
   num_cpus = context.cpu_info.num_cpus;
   mhz = context.cpu_info.cycles_per_second / 1e6;
-  // The display reporter writes to the streams Google Benchmark gave this reporter.
-  display_->SetOutputStream(&GetOutputStream());
-  display_->SetErrorStream(&GetErrorStream());
-  return display_->ReportContext(context);
+  bool ok = !file_ || file_->ReportContext(context);
+  progress_.around([&] {
+    // The console and CSV reporters print the header to their error stream (the JSON one
+    // puts it in the document): caught here, and passed on filtered.
+    std::ostringstream header;
+    if (display_) {
+      display_->SetOutputStream(&GetOutputStream());
+      display_->SetErrorStream(&header);
+      ok = display_->ReportContext(context) && ok;
+      display_->SetErrorStream(&GetErrorStream());
+    } else {
+      PrintBasicContext(&header, context);
+    }
+    GetErrorStream() << shown_context(header.str(), display_ == nullptr, verbose_) << std::flush;
+  });
+  return ok;
 }
 
 void collecting_reporter::ReportRuns(const std::vector<Run>& runs) {
@@ -26,15 +52,16 @@ void collecting_reporter::ReportRuns(const std::vector<Run>& runs) {
     else if (r.iterations > 0)
       c->ns_per_run.push_back(r.real_accumulated_time * 1e9 / static_cast<double>(r.iterations));
   }
-  display_->ReportRuns(runs);
-  if (!runs.empty() && runs.front().run_type == Run::RT_Iteration && book_.find(runs.front().run_name.function_name))
-    ++reported_;
-  const auto now = std::chrono::steady_clock::now();
-  if (now - last_progress_ > std::chrono::seconds(10)) {
-    last_progress_ = now;
-    fmt::print(stderr, "stepbench_bench: {} of {} cases timed ({:.0f} s)\n", reported_, book_.size(),
-               std::chrono::duration<double>(now - start_).count());
-  }
+  if (file_) file_->ReportRuns(runs);
+  if (display_) progress_.around([&] { display_->ReportRuns(runs); });
+  // Google Benchmark reports a case once all its repetitions ran (then its aggregates, in a
+  // second call): a case is done when its iteration runs come.
+  if (!runs.empty() && runs.front().run_type == Run::RT_Iteration) progress_.advance();
+}
+
+void collecting_reporter::Finalize() {
+  if (file_) file_->Finalize();
+  if (display_) progress_.around([&] { display_->Finalize(); });
 }
 
 }  // namespace stepbench::bench

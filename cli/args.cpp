@@ -17,6 +17,11 @@ double parse_number(std::string_view text, std::string_view what) {
   throw std::invalid_argument(fmt::format("{} must be a finite number, got '{}'", what, text));
 }
 
+std::string count_of(long long n, std::string_view singular, std::string_view plural) {
+  if (n == 1) return fmt::format("1 {}", singular);
+  return plural.empty() ? fmt::format("{} {}s", n, singular) : fmt::format("{} {}", n, plural);
+}
+
 void add_override(parameter_overrides& out, std::string_view text, std::span<const std::string> selected) {
   const auto eq = text.find('=');
   if (eq == std::string_view::npos || eq == 0 || eq + 1 == text.size())

@@ -23,4 +23,8 @@ using parameter_overrides = std::map<std::string, std::map<std::string, double>>
 // parameter's declared constraint.
 void add_override(parameter_overrides& out, std::string_view text, std::span<const std::string> selected);
 
+// A count and its noun, the plural when the count is not one: "1 step", "2 steps",
+// "1 repetition"; `plural` for the irregular ones.
+std::string count_of(long long n, std::string_view singular, std::string_view plural = {});
+
 }  // namespace stepbench

@@ -12,6 +12,7 @@
 
 #include "cli/args.hpp"
 #include "cli/commands.hpp"
+#include "core/work_precision.hpp"
 #include "study/table_render.hpp"
 
 namespace stepbench::cli {
@@ -76,32 +77,37 @@ int run_energy(const energy_args& a) {
     return 0;
   }
   for (const auto& p : s.problems) {
-    fmt::print("{}: {:g} periods of {:.6g} s, dt = {:.6g} s ({} steps a period); E0 = {:.6g}{}\n", p.problem,
-               opts.periods, p.period, p.dt, p.steps_per_period, p.e0,
-               std::isfinite(p.l0) ? fmt::format(", L0 = {:.6g}", p.l0) : "");
+    fmt::print("{}: {:g} periods of {:.6g} s, dt = {:.6g} s ({} a period); E0 = {:.6g} J{}\n", p.problem, opts.periods,
+               p.period, p.dt, count_of(p.steps_per_period, "step"), p.e0,
+               std::isfinite(p.l0) ? fmt::format(", L0 = {:.6g} kg m^2/s", p.l0) : "");
+    // Relative errors (dE/E, dL/L: no unit); the drifts per period of the problem.
     table t{{{"method"},
              right_column("max |dE|/E"),
              right_column("final dE/E"),
-             right_column("drift/period"),
+             right_column("dE/E drift", "1/period"),
              {"verdict"},
              right_column("max |dL|/L"),
-             right_column("dL drift/period")},
+             right_column("dL/L drift", "1/period")},
             {}};
+    std::vector<std::string> failures;  // below the table: a long reason would stretch its column
     for (const auto& r : p.runs) {
-      const std::string verdict = !r.completed       ? "failed: " + r.note
+      const std::string verdict = !r.completed       ? "failed (below)"
                                   : r.drift_sign > 0 ? "drifting, gains"
                                   : r.drift_sign < 0 ? "drifting, loses"
                                                      : r.verdict;
+      if (!r.completed) failures.push_back(fmt::format("  {} failed: {}\n", r.info.name, r.note));
       t.add({r.info.name, sci(r.max_rel_err), signed_sci(r.final_rel_err), signed_sci(r.drift_per_period), verdict,
              sci(r.angmom_max_rel_err), signed_sci(r.angmom_drift_per_period)});
     }
     fmt::print("{}", render_text(t));
+    for (const auto& f : failures) fmt::print("{}", f);
   }
   fmt::print(
       "bounded: the largest |dE|/E over the last tenth of the run is at most {:g} x that over the first tenth, "
       "and below {:g}; drifting otherwise.\n",
       opts.bounded_growth, opts.lost);
-  fmt::print(stderr, "energy study in {:.2f} s\n", s.wall_seconds);
+  std::fflush(stdout);
+  fmt::print(stderr, "energy study in {}\n", format_time_ns(s.wall_seconds * 1e9));
   return 0;
 }
 

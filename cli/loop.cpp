@@ -18,6 +18,7 @@
 
 #include "cli/args.hpp"
 #include "cli/commands.hpp"
+#include "core/work_precision.hpp"
 #include "study/study_file.hpp"
 #include "study/sweep.hpp"
 #include "study/table_render.hpp"
@@ -63,6 +64,9 @@ const method_info& loop_method_info(const std::string& name) {
 
 std::string g3(double v) { return std::isfinite(v) ? fmt::format("{:.3g}", v) : "n/a"; }
 
+// A time [s] in the unit that fits it (ns, us, ms or s; core/work_precision.hpp), signed.
+std::string time_text(double s) { return s < 0.0 ? "-" + format_time_ns(-s * 1e9) : format_time_ns(s * 1e9); }
+
 // The loop a --design run asks for: the study's defaults, then the command's options.
 loop_config one_loop_config(const loop_args& a, const problem_instance& problem, const loop_options& opts) {
   loop_config c;
@@ -97,9 +101,11 @@ double stated_step_cost_ns(const loop_args& a, const loop_options& opts) {
   return cost_ns;
 }
 
-// The position (offset 0) or velocity (offset dim) part of a state.
+// The position (offset 0) or velocity (offset dim) part of a state (-0 as 0: printed "0").
 std::vector<double> state_part(const std::vector<double>& y, int offset, int dim) {
-  return std::vector<double>(y.begin() + offset, y.begin() + offset + dim);
+  std::vector<double> out(y.begin() + offset, y.begin() + offset + dim);
+  for (double& x : out) x = x == 0.0 ? 0.0 : x;
+  return out;
 }
 
 json one_loop_json(const loop_args& a, const problem_instance& problem, const loop_config& c, const loop_options& opts,
@@ -182,17 +188,18 @@ void print_one_loop(const loop_args& a, const problem_instance& problem, const l
   fmt::print("  clock dependence   {} {} shown, {} {} physics, against the {:g} Hz display at the horizon\n",
              g3(r.clock_dependence), unit, g3(r.physics_clock_dependence), unit, opts.reference_display_hz);
   fmt::print("  judder             {} {}/s (std of shown - exact velocity)\n", g3(r.judder), unit);
-  fmt::print("  lag                {} s measured ({} s from the loop's clocks)\n", g3(r.lag_s), g3(r.lag_clock_s));
+  fmt::print("  lag                {} measured ({} from the loop's clocks)\n", time_text(r.lag_s),
+             time_text(r.lag_clock_s));
   if (uses_accumulator(c.design)) fmt::print("  alpha              [{:.4g}, {:.4g}]\n", r.alpha_min, r.alpha_max);
   if (c.stalls())
-    fmt::print("  stall              {} steps in the stall frame, {} frame{} clamped\n", r.stall_burst_steps,
-               r.clamp_hits, r.clamp_hits == 1 ? "" : "s");
+    fmt::print("  stall              {} in the stall frame, {} clamped\n", count_of(r.stall_burst_steps, "step"),
+               count_of(r.clamp_hits, "frame"));
   fmt::print(
-      "  cost model         {:g} ns a step{}: worst frame {:.3g} ns of a {:.3g} ns budget, load {:.3g}, {} "
-      "late frame{}: {} (without the clamp: {})\n",
-      cost.step_cost_ns, a.step_cost.empty() ? " (stated default)" : "", cost.schedule.worst_work_s * 1e9,
-      cost.schedule.frame_budget_s * 1e9, cost.schedule.load, cost.schedule.late_frames,
-      cost.schedule.late_frames == 1 ? "" : "s", to_string(cost.schedule.outcome), to_string(cost.without_clamp));
+      "  cost model         {} a step{}: worst frame {} of a {} budget, load {:.3g}, {}: {} (without the clamp: {})\n",
+      format_time_ns(cost.step_cost_ns), a.step_cost.empty() ? " (stated default)" : "",
+      time_text(cost.schedule.worst_work_s), time_text(cost.schedule.frame_budget_s), cost.schedule.load,
+      count_of(cost.schedule.late_frames, "late frame"), to_string(cost.schedule.outcome),
+      to_string(cost.without_clamp));
   fmt::print("  final physics      t = {:.10g} s, position {::.12g}\n", r.physics_t, part(r.final_physics, 0));
   if (!r.note.empty()) fmt::print("  {}: {}\n", r.diverged ? "DIVERGED" : "NOTE", r.note);
 }

@@ -1,16 +1,26 @@
 // stepbench: the command line. Every error is one line on stderr and a non-zero exit
 // (2 bad usage, 1 a file or solver failure; a command may add its own, see its help),
 // and a results file is written whole or not at all.
+#include <fmt/format.h>
+
 #include <cstdio>
 #include <exception>
 #include <vector>
 
+#include "build_info.hpp"
 #include "cli/commands.hpp"
 
 int main(int argc, char** argv) {
   using namespace stepbench::cli;
   CLI::App app{"stepbench: accuracy, stability and speed of time integrators on game-physics problems"};
   app.require_subcommand(1);
+  // The build facts every study file records (study/build_info.cmake).
+  namespace info = stepbench::build_info;
+  app.set_version_flag("--version",
+                       fmt::format("stepbench {} (commit {}, {} build)\ncompiler: {}; flags: {}\ndependencies: {}",
+                                   info::version, info::git_commit, info::build_type, info::compiler,
+                                   *info::build_flags ? info::build_flags : "(none)", info::dependencies),
+                       "print the version, commit, build type and flags, and exit");
   const std::vector<command> commands{add_list(app),   add_run(app),     add_sweep(app),     add_advise(app),
                                       add_ratios(app), add_compare(app), add_stability(app), add_loop(app),
                                       add_energy(app), add_schema(app)};
@@ -19,6 +29,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "stepbench: error: %s\n", e.what());

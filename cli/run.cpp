@@ -1,8 +1,9 @@
 // `stepbench run`: one problem, one method, one dt (or tolerance); prints the final state,
 // the true state, the errors and the work.
 #include <fmt/format.h>
-#include <fmt/ranges.h>
 
+#include <algorithm>
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -61,9 +62,42 @@ run_request checked_request(const run_args& a) {
     r.horizon = parse_number(a.horizon_text, "--horizon");
     if (!(r.horizon > 0.0)) throw std::invalid_argument(fmt::format("--horizon must be > 0, got {}", a.horizon_text));
   }
+  if (fixed && param > r.horizon)
+    throw std::invalid_argument(
+        fmt::format("--dt {} s is longer than the horizon of {} ({:g} s): give a smaller --dt or a longer --horizon",
+                    a.dt_text, a.problem, r.horizon));
   if (fixed && r.horizon / param > 1e9)
     throw std::invalid_argument(fmt::format("--dt {} needs more than 1e9 steps to reach {}", param, r.horizon));
   return r;
+}
+
+// One entry of a printed state: 12 significant digits, and never "-0".
+std::string entry(double x, int digits = 12) { return fmt::format("{:.{}g}", x == 0.0 ? 0.0 : x, digits); }
+
+// A state vector, printed once and compactly: every entry up to six, else the first and
+// last three (6 digits) with the count and the Euclidean norm.
+std::string compact(const std::vector<double>& v) {
+  constexpr std::size_t whole = 6, ends = 3;
+  std::string out = "[";
+  if (v.size() <= whole) {
+    for (std::size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + entry(v[i]);
+    return out + "]";
+  }
+  for (std::size_t i = 0; i < ends; ++i) out += entry(v[i], 6) + ", ";
+  out += "...";
+  for (std::size_t i = v.size() - ends; i < v.size(); ++i) out += ", " + entry(v[i], 6);
+  double sum = 0.0;
+  for (double x : v) sum += x * x;
+  return out + fmt::format("] ({} entries, norm {})", v.size(), entry(std::sqrt(sum), 6));
+}
+
+// The computed vector and the true one: both in full when short; when long, the computed
+// one and the true one's norm (their difference is the error below).
+std::string with_truth(const std::vector<double>& y, const std::vector<double>& truth, const std::string& source) {
+  if (y.size() <= 6) return fmt::format("{}   (true {}{})", compact(y), compact(truth), source);
+  double sum = 0.0;
+  for (double x : truth) sum += x * x;
+  return fmt::format("{}   (true: norm {}{})", compact(y), entry(std::sqrt(sum), 6), source);
 }
 
 int run_run(const run_args& a) {
@@ -116,17 +150,26 @@ int run_run(const run_args& a) {
     std::cout << out.dump(2) << "\n";
     return metrics.failed ? 1 : 0;
   }
-  fmt::print("{} with {}: {} {:g} to t = {:g} s, {} steps ({} rejected), {} force evaluations\n", a.problem, m.name,
-             fixed ? "dt" : "tol", param, horizon, run.steps, run.rejected_steps, run.work.force_evals);
+  const std::string unit(problem.position_unit());
+  fmt::print("{} with {}: {} to t = {:g} s, {}{}, {}\n", a.problem, m.name,
+             fixed ? fmt::format("dt {:g} s", param) : fmt::format("tol {:g}", param), horizon,
+             count_of(run.steps, "step"), fixed ? "" : fmt::format(" ({} rejected)", run.rejected_steps),
+             count_of(run.work.force_evals, "force evaluation"));
   if (run.work.jacobian_evals || run.work.newton_iterations)
-    fmt::print("  {} Jacobian evaluations, {} Newton iterations, {} linear solves\n", run.work.jacobian_evals,
-               run.work.newton_iterations, run.work.linear_solves);
-  fmt::print("  position       {::.12g}   (true {::.12g}, from {})\n", part(run.final_y, 0), part(truth.y.back(), 0),
-             truth.source);
-  fmt::print("  velocity       {::.12g}   (true {::.12g})\n", part(run.final_y, dim), part(truth.y.back(), dim));
-  fmt::print("  err_pos_final  {:.6e}\n  err_vel_final  {:.6e}\n  err_pos_max    {:.6e}\n  err_pos_rms    {:.6e}\n",
-             metrics.err_pos_final, metrics.err_vel_final, metrics.err_pos_max, metrics.err_pos_rms);
-  if (problem.has_energy()) fmt::print("  energy_drift   {:+.6e} (relative, at the horizon)\n", metrics.energy_drift);
+    fmt::print("  {}, {}, {}\n", count_of(run.work.jacobian_evals, "Jacobian evaluation"),
+               count_of(run.work.newton_iterations, "Newton iteration"),
+               count_of(run.work.linear_solves, "linear solve"));
+  const std::string pos_label = fmt::format("position [{}]", unit), vel_label = fmt::format("velocity [{}/s]", unit);
+  const std::size_t w = std::max<std::size_t>(14, vel_label.size());
+  fmt::print("  {:<{}} {}\n", pos_label, w,
+             with_truth(part(run.final_y, 0), part(truth.y.back(), 0), fmt::format(", from {}", truth.source)));
+  fmt::print("  {:<{}} {}\n", vel_label, w, with_truth(part(run.final_y, dim), part(truth.y.back(), dim), ""));
+  fmt::print("  {:<{}} {:.6e} {}\n", "err_pos_final", w, metrics.err_pos_final, unit);
+  fmt::print("  {:<{}} {:.6e} {}/s\n", "err_vel_final", w, metrics.err_vel_final, unit);
+  fmt::print("  {:<{}} {:.6e} {}\n", "err_pos_max", w, metrics.err_pos_max, unit);
+  fmt::print("  {:<{}} {:.6e} {}\n", "err_pos_rms", w, metrics.err_pos_rms, unit);
+  if (problem.has_energy())
+    fmt::print("  {:<{}} {:+.6e} (relative, at the horizon)\n", "energy_drift", w, metrics.energy_drift);
   if (metrics.diverged) fmt::print("  DIVERGED: {}\n", metrics.note);
   if (metrics.failed) fmt::print("  FAILED: {}\n", metrics.note);
   return metrics.failed ? 1 : 0;

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
+#include "core/work_precision.hpp"
 #include "study/table_render.hpp"
 
 namespace stepbench::cli {
@@ -51,8 +52,8 @@ int run_stability(bool as_json) {
              always_accept_tolerance);
   table t{{{"integrator"},
            {"test"},
-           right_column("theory (a)"),
-           right_column("measured (b)"),
+           right_column("y_max theory (a)"),
+           right_column("y_max measured (b)"),
            right_column("(b)/(a)-1"),
            {"long runs"}},
           {}};
@@ -77,8 +78,9 @@ int run_stability(bool as_json) {
   fmt::print("{}", render_text(t, ""));
   fmt::print("\n\"unstable\": unstable for every dt; \"uncond.\": stable for every dt (up to y = {:g}).\n",
              s.y_unconditional);
-  fmt::print("Computed in {:.3f} s (limits {:.3f} s, stability regions on a {} x {} grid {:.3f} s).\n",
-             d.limits_seconds + d.regions_seconds, d.limits_seconds, s.re_count, s.im_count, d.regions_seconds);
+  fmt::print("Computed in {} (limits {}, stability regions on a {} x {} grid {}).\n",
+             format_time_ns((d.limits_seconds + d.regions_seconds) * 1e9), format_time_ns(d.limits_seconds * 1e9),
+             s.re_count, s.im_count, format_time_ns(d.regions_seconds * 1e9));
   return 0;
 }
 

@@ -3,7 +3,10 @@
 # missing, builds in Release, runs the full study: the accuracy sweep (every problem x
 # every integrator over the timestep ladder, references included) and the Google
 # Benchmark timing of every case and peer, each timing written next to its accuracy row.
-# Extra arguments go to stepbench_bench (e.g. --quick, --benchmark_filter=pendulum).
+# The run shows one progress line on stderr and ends with the verdict on stdout; Google
+# Benchmark's own results go to results/bench.json (its JSON format: compare.py reads it).
+# Extra arguments go to stepbench_bench (e.g. --quick, --problem=pendulum, --verbose for
+# Google Benchmark's table on the terminal too; stepbench_bench --help lists them).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 "$root/scripts/install-deps.sh"

@@ -108,5 +108,68 @@ grep -q "the orbit collapsed: r = " "$work/err" && grep -q "Newton found no root
 rc=$?
 [ "$rc" -eq 3 ] && ok || bad "--strict with failed cases exited $rc, want 3"
 
+# --version: the version, commit and build type on the first line, then the compiler,
+# flags and dependencies the study file records.
+"$bin" --version >"$work/out" 2>&1 && ok || bad "--version exited non-zero"
+head -1 "$work/out" | grep -Eq '^stepbench [0-9][^ ]* \(commit [0-9a-f]+(-dirty)?|unknown, [A-Za-z]* ?build\)$' && ok ||
+  bad "--version line: $(head -1 "$work/out")"
+grep -q '^compiler: .*; flags: ' "$work/out" && grep -q '^dependencies: .*Google Benchmark' "$work/out" && ok ||
+  bad "--version lacks the compiler, flags or dependencies: $(cat "$work/out")"
+
+# Usage errors exit 2 with one line naming what is wrong.
+expect_usage() {
+  expect_error "$@"
+  shift
+  "$bin" "$@" >/dev/null 2>&1
+  local rc=$?
+  [ "$rc" -eq 2 ] && ok || bad "exit $rc, want 2, for: $*"
+}
+expect_usage "--dt 20 s is longer than the horizon of constant_acceleration (10 s)" \
+  run --problem constant_acceleration --integrator euler --dt 20
+expect_usage "--dt 3 s is longer than the horizon of pendulum (2 s)" run --problem pendulum --integrator rk4 --dt 3 --horizon 2
+expect_usage "unknown problem 'nosuch' (known: constant_acceleration, " ratios --problem nosuch
+expect_usage "unknown problem 'nosuch'" ratios --study "$work/none.h5" --problem damped_spring --problem nosuch
+
+# run's text: every vector once, compact beyond six entries, never "-0"; counts with the
+# right plural; units on every quantity.
+"$bin" run --problem spring_chain --integrator rk4 --dt 0.0001 >"$work/out" || bad "run spring_chain failed"
+[ "$(grep -c '96 entries' "$work/out")" -eq 2 ] && ok || bad "spring_chain vectors not compact: $(cat "$work/out")"
+[ "$(awk '{ if (length($0) > 160) n++ } END { print n + 0 }' "$work/out")" -eq 0 ] && ok ||
+  bad "run prints lines over 160 characters: $(cat "$work/out")"
+grep -q '^  position \[m\] ' "$work/out" && grep -q '^  velocity \[m/s\]' "$work/out" && grep -q 'err_pos_max .* m$' "$work/out" &&
+  ok || bad "run lacks units: $(cat "$work/out")"
+for args in "--problem spring_chain --integrator rk4 --dt 0.0001" "--problem kepler --integrator rk4 --dt 0.01" \
+  "--problem pendulum --integrator velocity_verlet --dt 0.01"; do
+  # shellcheck disable=SC2086
+  "$bin" run $args >"$work/out" || bad "run $args failed"
+  grep -Eq '(^|[^0-9.e])-0([^.0-9e]|$)' "$work/out" && bad "run $args prints -0: $(grep -E -- '-0([^.0-9e]|$)' "$work/out")" || ok
+done
+"$bin" run --problem constant_acceleration --integrator euler --dt 10 >"$work/out" || bad "one-step run failed"
+grep -q 'dt 10 s to t = 10 s, 1 step, 1 force evaluation$' "$work/out" && ok || bad "plural of one: $(head -1 "$work/out")"
+
+# loop: times in the unit that fits them.
+"$bin" loop --problem pendulum --integrator rk4 --design fixed >"$work/out" || bad "loop --design failed"
+grep -q 'cost model  *1 us a step (stated default): worst frame 1 us of a 16.7 ms budget' "$work/out" && ok ||
+  bad "loop's cost model units: $(grep 'cost model' "$work/out")"
+grep -q 'e+0[0-9] ns' "$work/out" && bad "loop prints powers of ten of ns: $(cat "$work/out")" || ok
+
+# list: the friction table once; stability: labelled columns.
+[ "$("$bin" list | grep -c 'aluminum_on_aluminum')" -eq 1 ] && ok || bad "list prints the friction table more than once"
+"$bin" stability | grep -q 'y_max theory (a)  y_max measured (b)' && ok || bad "stability's columns are not labelled"
+
+# stepbench_bench, beside stepbench: --help lists our flags, one line each, above Google
+# Benchmark's.
+bench=$(dirname "$bin")/stepbench_bench
+if [ -x "$bench" ]; then
+  "$bench" --help >"$work/out" 2>&1 && ok || bad "stepbench_bench --help exited non-zero"
+  for flag in --quick --study_out= --problem= --set= --case_budget= --strict --verbose --benchmark_filter; do
+    [ "$(grep -c -- "^ *\[\?$flag" "$work/out")" -eq 1 ] && ok || bad "stepbench_bench --help does not list $flag once"
+  done
+  "$bench" --benchmark_format=xml >/dev/null 2>"$work/err"
+  rc=$?
+  [ "$rc" -eq 2 ] && grep -q "benchmark_format must be console, json or csv, got 'xml'" "$work/err" && ok ||
+    bad "stepbench_bench --benchmark_format=xml exited $rc: $(cat "$work/err")"
+fi
+
 echo "cli: $passes passed, $fails failed"
 [ "$fails" -eq 0 ]

@@ -7,6 +7,7 @@ import io
 import json
 import math
 import os
+import shutil
 import subprocess
 
 import h5py
@@ -63,6 +64,20 @@ def test_lists_a_case_for_every_completed_row(bench, plain_study):
     assert names == expected, (sorted(expected - names)[:5], sorted(names - expected)[:5])
 
 
+def test_problem_restricts_every_family(bench):
+    """--problem selects the study's cases of that problem and only its own scaling family
+    (the triad, for scale, with either scaling family)."""
+    names = listed(bench, "--problem=damped_spring")
+    assert names and all(n.startswith("damped_spring/") for n in names), sorted({n.split("/")[0] for n in names})
+    names = listed(bench, "--problem=spring_chain")
+    families = {n.split("/")[0] for n in names}
+    assert families == {"spring_chain", "substeps", "stream"}, families
+    assert "spring_chain/rk4/masses:65536/real_time" in names
+    assert all(n.startswith("substeps/spring_chain/") for n in names if n.startswith("substeps/"))
+    families = {n.split("/")[0] for n in listed(bench, "--problem=bouncing_balls")}
+    assert families == {"bouncing_balls", "stream"}, families
+
+
 def test_filter_selects_one_family(bench):
     names = listed(bench, "--problem=pendulum", "--benchmark_filter=^pendulum/rk4/")
     assert len(names) == 8 and all(n.startswith("pendulum/rk4/dt:") for n in names)
@@ -74,7 +89,7 @@ def test_json_format_is_clean_json_on_stdout(bench):
     done = run_bench(bench, "--problem=pendulum", f"--benchmark_filter={ONE_CASE}", "--benchmark_format=json", check=True)
     doc = json.loads(done.stdout)
     assert [b["name"] for b in doc["benchmarks"]] == ["pendulum/rk4/dt:0.0430546/real_time"]
-    assert "swept pendulum" in done.stderr and "stepbench_bench:" in done.stderr
+    assert "swept 1 problem (" in done.stderr and "stepbench_bench: timed 1 case" in done.stderr
 
 
 def test_csv_format_is_clean_csv_on_stdout(bench):
@@ -82,7 +97,7 @@ def test_csv_format_is_clean_csv_on_stdout(bench):
     rows = list(csv.DictReader(io.StringIO(done.stdout)))
     assert [r["name"] for r in rows] == ["pendulum/rk4/dt:0.0430546/real_time"]
     assert float(rows[0]["err_pos_max"]) > 0 and int(float(rows[0]["force_evals"])) == 512
-    assert "swept pendulum" in done.stderr
+    assert "swept 1 problem (" in done.stderr
 
 
 def test_counters_tabular_prints_a_header(bench):
@@ -117,6 +132,17 @@ def test_one_case_agrees_with_stepbench_run(bench, stepbench, tmp_path):
 def test_quick_timed_study(timed_study, stepbench):
     path, done = timed_study
     assert f"wrote {path}" in done.stderr and "stepbench ratios" in done.stderr
+    # The terminal gets the progress and the verdict; Google Benchmark's results go to
+    # bench.json beside the study, its JSON format (compare.py reads it).
+    assert "Benchmark " not in done.stdout and "real_time" not in done.stdout
+    assert done.stdout.strip(), "the run ends without the verdict on stdout"
+    assert "Library was built as DEBUG" not in done.stderr
+    assert "stepbench_bench: swept 13 problems (" in done.stderr and "stepbench_bench: timed " in done.stderr
+    assert "\r" not in done.stderr and "\x1b[" not in done.stderr  # not a terminal: plain lines
+    doc = json.loads((path.parent / "bench.json").read_text())
+    assert "library_build_type" in doc["context"]
+    names = {b["name"] for b in doc["benchmarks"] if b["run_type"] == "iteration"}
+    assert "damped_spring/rk4/dt:0.0390625/real_time" in names and "stream/triad/doubles:196608/real_time" in names
     with h5py.File(path, "r") as f:
         assert f.attrs["timing"] == 1 and f.attrs["benchmark_mode"] == "quick"
         for key in ["benchmark_min_time_s", "benchmark_repetitions", "benchmark_case_budget_s",
@@ -222,3 +248,35 @@ def test_set_reaches_the_timed_cases_and_the_study(bench, stepbench, tmp_path):
                                          text=True).stdout)
     assert case["err_pos_max"] == pytest.approx(run("--set", "k_d=3")["err_pos_max"], rel=1e-12)
     assert case["err_pos_max"] != pytest.approx(run()["err_pos_max"], rel=1e-3)
+
+
+def test_display_only_when_asked_and_never_the_debug_line(bench, tmp_path):
+    """A study run keeps Google Benchmark's table off the terminal unless --verbose (which
+    shows the whole context); a plain run shows it, without the DEBUG-build line; a
+    --benchmark_out given replaces bench.json."""
+    one = ["--problem=pendulum", f"--benchmark_filter={ONE_CASE}"]
+    done = run_bench(bench, *one, f"--study_out={tmp_path / 'a.h5'}", check=True)
+    assert "real_time" not in done.stdout and (tmp_path / "bench.json").exists()
+    assert not [p for p in tmp_path.iterdir() if ".tmp." in p.name]
+    done = run_bench(bench, *one, f"--study_out={tmp_path / 'b.h5'}", "--verbose", check=True)
+    assert "pendulum/rk4/dt:0.0430546/real_time" in done.stdout and "Run on (" in done.stderr
+    done = run_bench(bench, *one, "--benchmark_format=console", check=True)
+    assert "pendulum/rk4/dt:0.0430546/real_time" in done.stdout and "Run on (" in done.stderr
+    assert "Library was built as DEBUG" not in done.stderr
+    (tmp_path / "bench.json").unlink()
+    out = tmp_path / "mine.json"
+    run_bench(bench, *one, f"--study_out={tmp_path / 'c.h5'}", f"--benchmark_out={out}", "--benchmark_out_format=json",
+              check=True)
+    assert out.exists() and not (tmp_path / "bench.json").exists()
+
+
+def test_progress_is_one_redrawn_line_on_a_terminal(bench, tmp_path):
+    """On a terminal the progress is a bar redrawn with \\r; in a log, plain lines."""
+    if not shutil.which("script"):
+        pytest.skip("script (bsdutils) is not installed")
+    log = tmp_path / "tty.log"
+    command = f"{bench} --quick --problem=pendulum --benchmark_filter=^pendulum/rk4/ --study_out={tmp_path / 's.h5'}"
+    subprocess.run(["script", "-qec", command, str(log)], check=True, capture_output=True, timeout=120)
+    text = log.read_bytes().decode()  # read_text would turn each \r into a newline
+    assert "\r\x1b[Ktiming [" in text and " of 8 cases" in text
+    assert "stepbench_bench: swept 1 problem (" in text

@@ -132,7 +132,12 @@ int main(int argc, char** argv) {
     bench::progress_line progress("stepbench_bench", !opts.list_only);
     const auto start = std::chrono::steady_clock::now();
     const std::size_t problem_count = opts.problems.empty() ? problem_names().size() : opts.problems.size();
-    progress.begin(fmt::format("sweeping {} for accuracy", count_of(problem_count, "problem")));
+    progress.begin(fmt::format("sweeping {} for accuracy", count_of(problem_count, "problem")), sweep_parts(sopts),
+                   "parts");
+    sopts.on_progress = [&](std::size_t, std::size_t) { progress.advance(); };
+    sopts.on_warning = [&](const std::string& line) {
+      progress.around([&] { std::fprintf(stderr, "%s\n", line.c_str()); });
+    };
     study s = run_sweep(sopts);
     progress.end(fmt::format("swept {} ({}) in {}", count_of(s.problems.size(), "problem"),
                              count_of(run_count(s), "run"), bench::format_duration(s.wall_seconds)));

@@ -57,7 +57,8 @@ int run_sweep_command(sweep_args a) {
                    r.vs.pos_rel, r.vs.vel_rel, r.solution.stats.steps, r.solution.stats.rhs_evals_counted);
   }
   std::fflush(stdout);
-  fmt::print(stderr, "wrote {} ({} problems, {} levels) in {:.2f} s\n", a.out, s.problems.size(), a.opts.levels,
+  fmt::print(stderr, "wrote {} ({}, {}) in {:.2f} s\n", a.out,
+             count_of(static_cast<long long>(s.problems.size()), "problem"), count_of(a.opts.levels, "level"),
              s.wall_seconds);
   return report_study_outcome(s, "stepbench", a.strict);
 }

@@ -12,11 +12,12 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 build=${STEPBENCH_BUILD_DIR:-$root/build}
 [ -x "$build/stepbench_bench" ] && [ -x "$build/stepbench" ] || "$root/scripts/build.sh" >/dev/null
 study=${STUDY_OUT:-$(mktemp --suffix=.h5)}
-[ -n "${STUDY_OUT:-}" ] || trap 'rm -f "$study"' EXIT
+# Google Benchmark's own results go beside the study (bench.json's place); kept with it.
+[ -n "${STUDY_OUT:-}" ] || trap 'rm -f "$study" "$study.json"' EXIT
 # A method's failure on a case is recorded in the file with its reason (exit 0); only a
 # missing file stops here.
 "$build/stepbench_bench" --problem=damped_spring --problem=pendulum --problem=kepler \
-  --benchmark_filter='^(damped_spring|pendulum|kepler)/' --study_out="$study" "$@" \
+  --benchmark_filter='^(damped_spring|pendulum|kepler)/' --study_out="$study" --benchmark_out="$study.json" "$@" \
   >/dev/null 2>"$study.log" || status=$?
 if [ ! -s "$study" ]; then
   cat "$study.log" >&2

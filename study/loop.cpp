@@ -282,8 +282,8 @@ loop_study run_loop_study(const study& s, const loop_options& opts) {
   }
   out.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (opts.progress && configs)
-    std::fprintf(stderr, "loop study: %zu problems, %zu configurations in %.2f s\n", out.problems.size(), configs,
-                 out.wall_seconds);
+    std::fprintf(stderr, "loop study: %zu problem%s, %zu configurations in %.2f s\n", out.problems.size(),
+                 out.problems.size() == 1 ? "" : "s", configs, out.wall_seconds);
   return out;
 }
 

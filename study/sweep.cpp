@@ -126,11 +126,26 @@ method_study run_method(const problem_study& ps, const method_info& m, const swe
   return ms;
 }
 
+std::size_t sweep_parts(const sweep_options& opts) {
+  return (opts.problems.empty() ? problem_names().size() : opts.problems.size()) + 3;
+}
+
 study run_sweep(const sweep_options& opts) {
   validate(opts);
   const auto start = std::chrono::steady_clock::now();
   study out;
   out.options = opts;
+  const std::size_t parts = sweep_parts(opts);
+  std::size_t done = 0;
+  const auto part_done = [&] {
+    if (opts.on_progress) opts.on_progress(++done, parts);
+  };
+  const auto warn = [&](const std::string& line) {
+    if (opts.on_warning)
+      opts.on_warning(line);
+    else
+      std::fprintf(stderr, "%s\n", line.c_str());
+  };
   for (const auto& name : opts.problems.empty() ? problem_names() : opts.problems) {
     const auto t0 = std::chrono::steady_clock::now();
     problem_study ps;
@@ -139,23 +154,24 @@ study run_sweep(const sweep_options& opts) {
     ps.truth = build_truth(*ps.problem, sample_times(ps.horizon, opts.sample_count), {.tol = opts.tol});
     for (const auto& r : ps.truth.references)
       if (r.status != "ok" && r.status != "unsupported")
-        std::fprintf(stderr, "warning: %s: reference %s %s: %s\n", name.c_str(), r.source.c_str(), r.status.c_str(),
-                     r.reason.c_str());
+        warn(fmt::format("warning: {}: reference {} {}: {}", name, r.source, r.status, r.reason));
     if (!ps.truth.trusted)
-      std::fprintf(stderr, "warning: %s: no trusted truth (%s); its errors are recorded as NaN\n", name.c_str(),
-                   ps.truth.note.c_str());
+      warn(fmt::format("warning: {}: no trusted truth ({}); its errors are recorded as NaN", name, ps.truth.note));
     for (const auto& m : ps.problem->methods())
       if (opts.methods.empty() || contains(opts.methods, m.name)) ps.methods.push_back(run_method(ps, m, opts));
     if (opts.progress)
       std::fprintf(stderr, "swept %-22s %3zu methods in %.2f s\n", name.c_str(), ps.methods.size(),
                    std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     out.problems.push_back(std::move(ps));
+    part_done();
   }
   out.substeps = run_substeps(out, opts.substeps);
   out.frame_rates = run_frame_rates(out, opts.frame_rates);
+  part_done();
   loop_options loop = opts.loop;
   loop.progress = opts.progress;
   out.loop = run_loop_study(out, loop);
+  part_done();
   // The energy study on the selected problems and methods only.
   energy_options energy = opts.energy;
   energy.progress = opts.progress;
@@ -164,6 +180,7 @@ study run_sweep(const sweep_options& opts) {
   if (energy.methods.empty()) energy.methods = opts.methods;
   if (energy.scenes.empty()) energy.enabled = false;
   out.energy = run_energy_study(energy, opts.overrides);
+  part_done();
   out.stability = compute_stability();
   out.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;

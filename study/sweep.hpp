@@ -3,6 +3,7 @@
 // problem, over a halving ladder of timesteps (fixed-step methods) or a ladder of
 // tolerances (adaptive ones), each run measured against the truth by the same code,
 // with the observed order fitted. The benchmark adds timings to these rows.
+#include <functional>
 #include <limits>
 #include <map>
 #include <memory>
@@ -61,7 +62,16 @@ struct sweep_options {
   energy_options energy{};           // the long-run energy study (study/energy.hpp)
   frame_rate_options frame_rates{};  // the game programmer's frame-rate table (study/verdict.hpp)
   bool progress = false;             // one line per problem on stderr
+  // A caller's live progress: called after each problem and each later study (frame
+  // rates, loop, energy) with the parts done and the total (sweep_parts); and where the
+  // sweep's warnings go (a reference that disagrees), so that they do not land on a
+  // progress line drawn in place. Unset: warnings to stderr, no progress calls.
+  std::function<void(std::size_t done, std::size_t total)> on_progress;
+  std::function<void(const std::string&)> on_warning;
 };
+
+// The parts on_progress counts: the problems, then the frame-rate, loop and energy studies.
+std::size_t sweep_parts(const sweep_options& opts);
 
 // Wall time of one whole run, from the benchmark (absent unless timed).
 struct timing {

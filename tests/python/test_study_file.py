@@ -50,7 +50,7 @@ def text(v):
 def test_root_attributes(plain):
     for key in ROOT_ATTRS:
         assert key in plain.attrs, key
-    assert plain.attrs["format_version"] == 3 and plain.attrs["timing"] == 0
+    assert plain.attrs["format_version"] == 4 and plain.attrs["timing"] == 0
     assert plain.attrs["levels"] == 8  # --quick
     assert "GSL" in plain.attrs["dependencies"] and "SUNDIALS" in plain.attrs["dependencies"]
     for target in (1e-2, 1e-4, 1e-6):
@@ -156,22 +156,54 @@ def methods_of(g):
     return {name: (text(m.attrs["origin"]), m["runs"][()]) for name, m in g["methods"].items()}
 
 
+def completed(runs):
+    return (runs["diverged"] == 0) & (runs["failed"] == 0) & (runs["skipped"] == 0)
+
+
+def at_equal_error(runs, target, metric, cost, timed):
+    """docs/study-format.md, `equal_error`: the cost at the target interpolated log-log
+    between neighbouring rows of the curve that bracket it, never extrapolated; the
+    coarsest row when it already meets the target; the cheapest crossing. (cost, error,
+    param) or None."""
+    err, c = runs[metric], runs[cost].astype(float)
+    on = completed(runs) & np.isfinite(err) & (err > 0) & np.isfinite(c) & (c > 0)
+    if timed:
+        on &= runs["cut"] == 0
+    curve = runs[on]
+    if len(curve) == 0:
+        return None
+    found = []
+    if curve[metric][0] <= target:
+        found.append((float(curve[cost][0]), float(curve[metric][0]), float(curve["param"][0])))
+    for a, b in zip(curve[:-1], curve[1:]):
+        ea, eb = float(a[metric]), float(b[metric])
+        if not (min(ea, eb) <= target <= max(ea, eb)):
+            continue
+        if ea == eb:
+            r = a if a[cost] <= b[cost] else b
+            found.append((float(r[cost]), float(r[metric]), float(r["param"])))
+            continue
+        s = math.log(target / ea) / math.log(eb / ea)
+        lerp = lambda u, v: math.exp(math.log(u) + s * (math.log(v) - math.log(u)))  # noqa: E731
+        found.append((lerp(float(a[cost]), float(b[cost])), target, lerp(float(a["param"]), float(b["param"]))))
+    return min(found, key=lambda x: x[0]) if found else None
+
+
 def cheapest_by_the_rule(methods, target, metric, timed):
     """docs/study-format.md, `equal_error`: (cost kind, [(cost, error, method, param)] ranked)."""
-    qualifying = {}
-    for name, (_, runs) in methods.items():
-        err = runs[metric]
-        ok = (runs["diverged"] == 0) & (runs["failed"] == 0) & np.isfinite(err) & (err <= target)
-        if timed:
-            ok &= runs["cut"] == 0
-        if ok.any():
-            qualifying[name] = runs[ok]
-    by_time = timed and all((np.isfinite(r["time_ns"]) & (r["time_ns"] > 0)).all() for r in qualifying.values())
+    by_time = timed
+    for _, runs in methods.values():
+        if not timed:
+            break
+        ok = completed(runs) & np.isfinite(runs[metric]) & (runs[metric] <= target) & (runs["cut"] == 0)
+        if not (np.isfinite(runs["time_ns"][ok]) & (runs["time_ns"][ok] > 0)).all():
+            by_time = False
     cost = "time_ns" if by_time else "force_evals"
     picks = []
-    for name, rows in qualifying.items():
-        i = min(range(len(rows)), key=lambda i: (rows[cost][i], rows[metric][i]))
-        picks.append((float(rows[cost][i]), float(rows[metric][i]), name, float(rows["param"][i])))
+    for name, (_, runs) in methods.items():
+        p = at_equal_error(runs, target, metric, cost, timed)
+        if p is not None:
+            picks.append((p[0], p[1], name, p[2]))
     return cost, sorted(picks)
 
 
@@ -190,12 +222,38 @@ def test_equal_error_follows_the_rule(plain, timed, shape):
                 assert [text(m) for m in rows["method"]] == [p[2] for p in picks], where
                 assert list(rows["rank"]) == list(range(1, len(picks) + 1)), where
                 assert all(text(c) == cost for c in rows["cost_kind"]), where
-                np.testing.assert_array_equal(rows["param"], [p[3] for p in picks])
-                np.testing.assert_array_equal(rows["cost"], [p[0] for p in picks])
+                np.testing.assert_allclose(rows["param"], [p[3] for p in picks], rtol=1e-12)
+                np.testing.assert_allclose(rows["cost"], [p[0] for p in picks], rtol=1e-12)
                 # The answer: the first ranked method that is not the baseline.
                 answers = [text(m) for m, a in zip(rows["method"], rows["is_answer"]) if a]
                 first = [p[2] for p in picks if methods[p[2]][0] != "baseline"][:1]
                 assert answers == first, where
+
+
+@pytest.mark.parametrize("shape", ["plain", "timed"])
+def test_verdict_is_the_fastest_of_ours_against_the_fastest_peer(plain, timed, shape):
+    """/verdict/equal_error: per problem and target, the first of ours and the first peer
+    in the problem's equal_error ranking (err_pos_max), their ratio, and ahead/behind only
+    beyond the spread."""
+    f = plain if shape == "plain" else timed
+    v = f["verdict/equal_error"][()]
+    assert len(v) == len(f["problems"]) * len(f["verdict"].attrs["targets"])
+    for row in v:
+        ranked = f[f"problems/{text(row['problem'])}/equal_error"][()]
+        ranked = ranked[(ranked["metric"].astype(str) == "err_pos_max") & (ranked["target"] == row["target"])]
+        ours = [r for r in ranked if text(r["origin"]) == "ours"][:1]
+        peer = [r for r in ranked if text(r["origin"]) == "peer"][:1]
+        assert text(row["ours_method"]) == (text(ours[0]["method"]) if ours else "")
+        assert text(row["peer_method"]) == (text(peer[0]["method"]) if peer else "")
+        if ours and peer:
+            assert row["ratio"] == pytest.approx(ours[0]["cost"] / peer[0]["cost"], rel=1e-12)
+            lo, hi = ours[0]["cost_lo"], ours[0]["cost_hi"]
+            plo, phi = peer[0]["cost_lo"], peer[0]["cost_hi"]
+            want = "ahead" if hi < plo * (1 - 1e-9) else "behind" if lo > phi * (1 + 1e-9) else "within spread"
+            assert text(row["verdict"]) == want
+        else:
+            assert math.isnan(row["ratio"])
+            assert text(row["verdict"]) == ("ours only" if ours else "peers only" if peer else "not reached")
 
 
 def front_by_the_rule(methods, cost_field, timed):

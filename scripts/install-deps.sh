@@ -8,6 +8,7 @@ packages=(
   libbenchmark-dev libbenchmark-tools libcli11-dev libfmt-dev nlohmann-json3-dev libboost-dev
   googletest libgtest-dev
   python3-h5py python3-matplotlib python3-numpy python3-scipy python3-pytest python3-markdown
+  chromium  # renders the report in tests/python/test_report_browser.py
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -1,11 +1,14 @@
-"""scripts/report [study.h5] [--out results/report]"""
+"""scripts/report [study.h5] [--out results/report] [--problem P] [--self-contained] [--jobs N]
+[--markdown FILE] [--readme FILE]"""
 import argparse
 import os
+import shlex
 import shutil
 import signal
 import sys
 import tempfile
 import time
+from dataclasses import replace
 
 from . import study
 
@@ -13,23 +16,109 @@ from . import study
 MARKER = ".stepbench-report"
 
 
+def _positive_int(text):
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a positive integer, not '{text}'")
+    return value
+
+
+def _write_text(path, text):
+    """Writes `text` to `path` through a temporary file renamed into place."""
+    folder = os.path.dirname(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(path)}.tmp-", dir=folder)
+    try:
+        with os.fdopen(fd, "w") as f:
+            f.write(text)
+        if os.path.exists(path):
+            os.chmod(tmp, os.stat(path).st_mode & 0o777)
+        else:  # what open() would have made (mkstemp makes 0600)
+            umask = os.umask(0)
+            os.umask(umask)
+            os.chmod(tmp, 0o666 & ~umask)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise
+
+
+def _command(argv):
+    """The command line as a reader would type it again."""
+    return " ".join(["scripts/report"] + [shlex.quote(a) for a in argv])
+
+
+def _answers(s, args, argv):
+    """--markdown and --readme: the verdict as Markdown; 0, or 1 with one line on stderr."""
+    from . import render, verdict
+    if s.verdict is None:
+        print(f"report: error: '{args.study}' has no /verdict group (a study written before stepbench computed "
+              "one): nothing to write; run the study again", file=sys.stderr)
+        return 1
+    if args.problem is not None:
+        s = replace(s, verdict=s.verdict.only(args.problem))
+    command = _command(argv)
+    try:
+        if args.markdown:
+            _write_text(args.markdown, render.markdown(verdict.results_doc(s, command)))
+        if args.readme:
+            try:
+                with open(args.readme) as f:
+                    text = f.read()
+                text = verdict.rewrite_block(text, verdict.readme_block(s, command))
+            except ValueError as e:
+                print(f"report: error: '{args.readme}': {e}; nothing written", file=sys.stderr)
+                return 1
+            _write_text(args.readme, text)
+    except OSError as e:
+        print(f"report: error: cannot write '{e.filename or args.markdown or args.readme}': {e.strerror}",
+              file=sys.stderr)
+        return 1
+    for path in (args.markdown, args.readme):
+        if path:
+            print(f"report: wrote {path}")
+    return 0
+
+
 def main(argv=None, start=None):
     start = time.perf_counter() if start is None else start
+    argv = sys.argv[1:] if argv is None else list(argv)
     ap = argparse.ArgumentParser(
         prog="report",
-        description="Turn a stepbench study file into a report folder: index.html (opens offline), REPORT.md and "
-                    "fig/*.png. The folder is replaced whole: it is built beside the target and renamed into place.")
+        description="Turn a stepbench study file into a report folder: index.html (opens offline; the verdict "
+                    "first), REPORT.md, summary.json and fig/*.png. The folder is replaced whole: it is built beside "
+                    "the target and renamed into place. --markdown and --readme write only the verdict tables "
+                    "(and the folder too when --out is given).")
     ap.add_argument("study", nargs="?", default="results/study.h5", help="study file (default: %(default)s)")
-    ap.add_argument("--out", default="results/report", help="report folder (default: %(default)s)")
-    ap.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1),
-                    help="processes drawing the figures (default: %(default)s)")
+    ap.add_argument("--out", default=None, help="report folder (default: results/report)")
+    ap.add_argument("--problem", metavar="P", help="a report (or --markdown, --readme) of this problem only")
+    ap.add_argument("--self-contained", action="store_true",
+                    help="index.html carries its figures (data: URIs): one file to send")
+    ap.add_argument("--jobs", type=_positive_int, default=min(2, os.cpu_count() or 1),
+                    help="processes drawing the figures, a positive integer (default: %(default)s)")
+    ap.add_argument("--markdown", metavar="FILE", help="write the verdict tables, the findings and where the "
+                    "study ran as Markdown to FILE (docs/results.md)")
+    ap.add_argument("--readme", metavar="FILE", help="rewrite the block between <!-- results:begin --> and "
+                    "<!-- results:end --> in FILE (README.md) with the headline table")
     args = ap.parse_args(argv)
     try:
         s = study.load(args.study)
     except study.StudyError as e:
         print(f"report: error: {e}", file=sys.stderr)
         return 1
-
+    if args.problem is not None and args.problem not in [p.name for p in s.problems]:
+        print(f"report: error: unknown problem '{args.problem}' (the study has "
+              f"{', '.join(p.name for p in s.problems)})", file=sys.stderr)
+        return 2
+    if args.markdown or args.readme:
+        status = _answers(s, args, argv)
+        if status or args.out is None:
+            return status
+    if args.out is None:
+        args.out = "results/report"
     if not args.out.strip():
         print("report: error: --out must name a folder", file=sys.stderr)
         return 1
@@ -59,7 +148,7 @@ def main(argv=None, start=None):
     try:
         # matplotlib is imported only now: a file the report refuses is refused at once.
         from . import report
-        report.build(s, tmp, workers=max(1, args.jobs))
+        report.build(s, tmp, workers=args.jobs, problem=args.problem, self_contained=args.self_contained)
         with open(os.path.join(tmp, MARKER), "w") as f:
             f.write("This folder is generated by scripts/report and is replaced whole on the next run.\n")
         os.chmod(tmp, 0o755)  # mkdtemp makes it 0700

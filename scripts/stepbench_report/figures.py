@@ -17,31 +17,64 @@ plt.rcParams.update({
     "axes.grid": True, "grid.alpha": 0.3, "grid.linewidth": 0.6, "savefig.dpi": DPI,
 })
 
-OUR_MARKERS = ["o", "s", "^", "D", "v", "P", "X", "h"]
-PEER_MARKERS = ["o", "s", "^", "D", "v", "P", "X", "h", "<", ">", "p", "d"]
-# The baseline is a timing floor, not a method to pick: black, dotted, a star.
-BASELINE_STYLE = dict(color="black", marker="*", linestyle=":", markerfacecolor="white")
+# The lecture's methods (build/stepbench list): drawn and labelled in every
+# work-precision figure, each with a colour no other method of the report has.
+LECTURE = ("euler", "semi_implicit_euler", "midpoint", "rk4", "momentum")
+LECTURE_COLORS = ("#d62728", "#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd")
+# The other methods' colours and everyone's markers: a method takes the next colour and
+# the next marker, so that no two methods share both (13 x 7 pairs before one repeats).
+COLORS = ("#8c564b", "#e377c2", "#17becf", "#bcbd22", "#393b79", "#843c39", "#637939", "#c51b7d", "#7b4173",
+          "#000000", "#01665e", "#6b6ecf", "#e7ba52")
+MARKERS = ("o", "s", "^", "D", "v", "P", "X")
+LINESTYLES = {"ours": "-", "peer": "--", "baseline": ":"}
+# Methods drawn behind the labelled ones, without a legend entry.
+GREY = "#c4c4c4"
+
+
+def method_names(study):
+    """(name, origin) of every method the study names, ours first, each group sorted by
+    name: what Styles is built from, before a report is cut to one problem."""
+    origins = {}
+    for p in study.problems:
+        for m in p.methods:
+            origins.setdefault(m.name, m.origin)
+    others = set()
+    if study.stability is not None:
+        others.update(study.stability.regions)
+    if study.energy_runs is not None:
+        others.update(n for p in study.energy_runs.problems for n in p.series)
+    if study.loop is not None:
+        others.update(m.name for p in study.loop.problems for m in p.methods)
+    if study.substeps is not None:
+        others.update(m.name for s in study.substeps.scenes for m in s.methods)
+    for n in others:
+        origins.setdefault(n, "ours")
+    rank = {"ours": 0, "peer": 1, "baseline": 2}
+    return sorted(origins.items(), key=lambda item: (rank.get(item[1], 3), item[0]))
 
 
 class Styles:
-    """One colour and marker per method, the same in every figure: ours solid with
-    filled markers, peers dashed with hollow ones, the baseline black and dotted."""
+    """One colour and marker per method, the same in every figure of the report: the
+    lecture's methods their own colours, every other method the next colour and marker
+    of the palette in the order of method_names; ours solid with filled markers, peers
+    dashed with hollow ones, the baseline dotted."""
 
-    def __init__(self, study):
-        # First appearance over the problems keeps the study's order (ours by order, then peers).
-        names = list(dict.fromkeys((m.name, m.origin) for p in study.problems for m in p.methods))
-        ours = [n for n, o in names if o == "ours"]
-        peers = [n for n, o in names if o == "peer"]
-        tab10 = plt.get_cmap("tab10").colors
-        # Peer colours from a second palette so that none repeats one of ours (Dark2,
-        # then the darker half of tab20b).
-        peer_colors = list(plt.get_cmap("Dark2").colors) + list(plt.get_cmap("tab20b").colors)[::4]
-        self.style = {n: dict(BASELINE_STYLE) for n, o in names if o == "baseline"}
-        for i, n in enumerate(ours):
-            self.style[n] = dict(color=tab10[i % 10], marker=OUR_MARKERS[i % len(OUR_MARKERS)], linestyle="-")
-        for i, n in enumerate(peers):
-            self.style[n] = dict(color=peer_colors[i % len(peer_colors)], marker=PEER_MARKERS[i % len(PEER_MARKERS)],
-                                 linestyle="--", markerfacecolor="white")
+    def __init__(self, names):
+        """`names`: method_names of a study, or the study itself."""
+        if hasattr(names, "problems"):
+            names = method_names(names)
+        self.style = {}
+        k = 0
+        for name, origin in names:
+            st = dict(linestyle=LINESTYLES.get(origin, "-"))
+            if name in LECTURE:
+                st.update(color=LECTURE_COLORS[LECTURE.index(name)], marker=MARKERS[LECTURE.index(name)])
+            else:
+                st.update(color=COLORS[k % len(COLORS)], marker=MARKERS[k % len(MARKERS)])
+                k += 1
+            if origin != "ours":
+                st["markerfacecolor"] = "white"
+            self.style[name] = st
 
     def __call__(self, name):
         return self.style[name]
@@ -246,138 +279,150 @@ def _guides(ax, orders, data, top=1.0):
                 bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="0.8", linewidth=0.5))
 
 
-def _grid(n):
-    cols = 2 if n > 1 else 1
-    rows = math.ceil(n / cols)
-    return rows, cols
-
-
-def _panels(n, legend_entries, title_lines):
-    """A grid of n panels with room above for a title and below for a shared legend,
-    sized in inches so that nothing overlaps whatever n is."""
-    rows, cols = _grid(n)
-    ncol = 4 if legend_entries > 6 else 3
-    legend_h = 0.24 * math.ceil(legend_entries / ncol) + 0.15
-    panel_h, gap, top, bottom = 3.3, 0.95, 0.35 + 0.25 * title_lines, legend_h + 0.6
-    height = panel_h * rows + gap * (rows - 1) + top + bottom
-    fig, axes = plt.subplots(rows, cols, figsize=(12, height), squeeze=False)
-    fig.subplots_adjust(left=0.07, right=0.98, top=1 - top / height, bottom=bottom / height,
-                        hspace=gap / panel_h, wspace=0.22)
-    for ax in list(axes.flat)[n:]:
-        ax.set_visible(False)
-    return fig, axes, ncol
-
-
-def _finish(fig, handles, labels, ncol, title):
-    fig.suptitle(title, fontsize=12, y=1 - 0.1 / fig.get_figheight(), va="top")
-    fig.legend(handles, labels, loc="lower center", ncol=ncol, frameon=False, bbox_to_anchor=(0.5, 0.0))
-
-
 # Where each work-precision figure takes its cost from: the rows' field, the factor to
-# the plotted unit, and the C++ front drawn on it.
+# the plotted unit, the axis label.
 WORK_AXES = {
     "force_evals": ("force_evals", 1.0, "force evaluations per run"),
     "time": ("time_ns", 1e-9, "median wall time per run [s]"),
 }
 
 
-def work_precision(study, styles, path, front_key):
-    """Error against cost, one panel per problem, every method (peers dashed, the
-    baseline dotted, for scale); the Pareto front the study computed (`front_<key>`)
-    drawn as a thick gold band under them."""
-    field, to_unit, xlabel = WORK_AXES[front_key]
-    probs = study.problems
-    names = list(dict.fromkeys(m.name for p in probs for m in p.methods))
-    fig, axes, ncol = _panels(len(probs), len(names) + 2, 1 if study.timed else 2)
-    seen, any_zero = {}, False
-    for ax, p in zip(axes.flat, probs):
-        # Every row with an error and a cost: completed, and in a timed study not cut
-        # (the rows the front was taken over).
-        curves = []
-        for m in p.methods:
-            x, e = m.col(field) * to_unit, m.col("err_pos_max")
-            ok = m.completed & np.isfinite(x) & (x > 0) & np.isfinite(e) & ~(study.timed & m.cut)
-            if ok.any():
-                curves.append((m, x[ok], e[ok]))
-        same_as = coincident([(m.name, x, e) for m, x, e in curves])
-        lo, hi = _log_limits([v for _, _, e in curves for v in e])
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_ylim(lo, hi)
-        front = p.fronts[front_key]
-        if len(front):
-            ax.step(front["cost"] * to_unit, np.maximum(front["err_pos_max"], lo), where="post", color="gold",
-                    linewidth=7, alpha=0.45, zorder=1, solid_capstyle="round")
-        for m, xs, es in curves:
-            st = styles(m.name)
-            pos = es > 0
-            size = 4.0 if m.name in same_as else 6.0
-            if m.origin == "baseline":
-                size += 2  # a star reads smaller than a circle
-            ax.plot(xs[pos], es[pos], markersize=size, linewidth=1.1, zorder=3, **st)
-            if (~pos).any():
-                any_zero = True
-                _edge_markers(ax, xs[~pos], 0, dict(marker=st["marker"], color=st["color"], markerfacecolor="white"),
-                              size=6)
-            seen.setdefault(m.name, (Line2D([], [], markersize=6, **st), m))
-        ax.set_title(p.name)
-        ax.set_xlabel(xlabel)
-        ax.set_ylabel(error_label("err_pos_max", p.unit))
-    handles = [h for h, _ in seen.values()]
-    labels = [formatting.label(m) for _, m in seen.values()]
-    handles.append(Line2D([], [], color="gold", linewidth=7, alpha=0.45))
-    labels.append("Pareto front (nothing beats it in both cost and error; baseline excluded)")
+def _legend_beside(ax, handles, labels):
+    ax.legend(handles, labels, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0, frameon=False,
+              fontsize=9)
+
+
+def work_curves(problem, front_key, timed):
+    """(method, cost, error) of every method with a row to draw: completed, with a cost
+    and an error, and in a timed study not cut by the time budget (the rows the front was
+    taken over)."""
+    field, to_unit, _ = WORK_AXES[front_key]
+    curves = []
+    for m in problem.methods:
+        x, e = m.col(field) * to_unit, m.col("err_pos_max")
+        ok = m.completed & np.isfinite(x) & (x > 0) & np.isfinite(e) & ~(timed & m.cut)
+        if ok.any():
+            curves.append((m, x[ok], e[ok]))
+    return curves
+
+
+def labelled(problem, front_key):
+    """The methods a work-precision figure draws in colour and names: those on the
+    study's Pareto front (in the front's order), then the lecture's."""
+    front = list(dict.fromkeys(problem.fronts[front_key]["method"].tolist()))
+    names = {m.name for m in problem.methods}
+    return front + [n for n in LECTURE if n in names and n not in front]
+
+
+def work_precision(problem, styles, path, front_key, timed):
+    """Error against cost on one problem, log-log: the methods of `labelled` in their
+    colours with a legend beside the axes, every other method light grey behind them
+    (the table under the figure lists them all), and the Pareto front the study computed
+    (`front_<key>`) as a thin black step line."""
+    _, to_unit, xlabel = WORK_AXES[front_key]
+    fig, ax = plt.subplots(figsize=(11.2, 5.6))
+    curves = work_curves(problem, front_key, timed)
+    shown = labelled(problem, front_key)
+    front_names = set(problem.fronts[front_key]["method"].tolist())
+    lo, hi = _log_limits([v for _, _, e in curves for v in e])
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_ylim(lo, hi)
+    same_as = coincident([(m.name, x, e) for m, x, e in curves if m.name in shown])
+    greys = 0
+    for m, xs, es in curves:
+        if m.name in shown:
+            continue
+        greys += 1
+        pos = es > 0
+        ax.plot(xs[pos], es[pos], color=GREY, marker="o", markersize=3, linewidth=0.8, zorder=1)
+    handles, labels = [], []
+    any_zero = False
+    by_name = {m.name: (m, xs, es) for m, xs, es in curves}
+    for k, name in enumerate(shown):
+        if name not in by_name:
+            continue
+        m, xs, es = by_name[name]
+        st = styles(name)
+        pos = es > 0
+        size = 4.5 if name in same_as else 6.5
+        ax.plot(xs[pos], es[pos], markersize=size, linewidth=1.3, zorder=3 + 0.01 * k, **st)
+        if (~pos).any():
+            any_zero = True
+            _edge_markers(ax, xs[~pos], 0, dict(marker=st["marker"], color=st["color"], markerfacecolor="white"),
+                          size=6)
+        tags = [t for t, yes in (("front", name in front_names), ("lecture", name in LECTURE)) if yes]
+        text = formatting.label(m) + (f" [{', '.join(tags)}]" if tags else "")
+        if name in same_as:
+            text += f" (= {same_as[name]})"
+        handles.append(Line2D([], [], markersize=6, linewidth=1.3, **st))
+        labels.append(text)
+    front = problem.fronts[front_key]
+    if len(front):
+        ax.step(front["cost"] * to_unit, np.maximum(front["err_pos_max"], lo), where="post", color="black",
+                linewidth=1.0, alpha=0.8, zorder=5)
+        handles.append(Line2D([], [], color="black", linewidth=1.0, alpha=0.8))
+        labels.append("Pareto front: no run beats it in both\ncost and error (baseline excluded)")
+    if greys:
+        handles.append(Line2D([], [], color=GREY, marker="o", markersize=3, linewidth=0.8))
+        labels.append(f"{greys} other methods (listed below)")
     if any_zero:
         handles.append(Line2D([], [], color="grey", marker="o", markerfacecolor="white", linestyle="none"))
         labels.append("on the bottom edge: error exactly 0")
-    title = f"Work-precision: error against {'time' if front_key == 'time' else 'force evaluations'}"
-    if not study.timed:
-        title += "\n(the study has no timings: run the benchmark study for error against time)"
-    _finish(fig, handles, labels, ncol, title)
-    _save(fig, path, tight=False)
+    _legend_beside(ax, handles, labels)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(error_label("err_pos_max", problem.unit))
+    ax.set_title(f"{problem.name}: error against {'time' if front_key == 'time' else 'force evaluations'}")
+    fig.subplots_adjust(left=0.08, right=0.64, top=0.93, bottom=0.1)
+    _save(fig, path)
 
 
-def energy(study, styles, path):
-    """|energy drift| at the horizon against dt, per problem with an energy."""
-    probs = [p for p in study.problems if int(p.attrs["has_energy"]) == 1]
-    if not probs:
+def energy(problem, styles, path):
+    """|energy drift| at the horizon against dt on one problem with an energy, our
+    fixed-step methods (filled: gained energy, hollow: lost it); False when there is
+    nothing to draw."""
+    ours = problem.by_origin("ours", adaptive=False)
+    if int(problem.attrs["has_energy"]) != 1 or not ours:
         return False
-    names = list(dict.fromkeys(m.name for p in probs for m in p.by_origin("ours", adaptive=False)))
-    fig, axes, ncol = _panels(len(probs), len(names) + 2, 1)
-    seen = {}
-    for ax, p in zip(axes.flat, probs):
-        vals = []
-        ours = p.by_origin("ours", adaptive=False)
-        for m in ours:
-            d = m.col("energy_drift")
-            ok = m.completed & np.isfinite(d) & (np.abs(d) > 0)
-            vals += list(np.abs(d[ok]))
-        lo, hi = _log_limits(vals)
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_ylim(lo, hi)
-        same_as = coincident([(m.name, m.param, np.abs(m.col("energy_drift"))) for m in ours])
-        for m in ours:
-            st = styles(m.name)
-            dt, d = m.param, m.col("energy_drift")
-            ok = m.completed & np.isfinite(d) & (np.abs(d) > 0)
-            size = 3.5 if m.name in same_as else 5.5  # coinciding curves nest instead of hiding
-            ax.plot(dt[ok], np.abs(d[ok]), color=st["color"], linewidth=1.1, zorder=2)
-            gain, loss = ok & (d > 0), ok & (d < 0)
-            ax.plot(dt[gain], d[gain], linestyle="none", marker=st["marker"], color=st["color"], markersize=size,
-                    zorder=3)
-            ax.plot(dt[loss], -d[loss], linestyle="none", marker=st["marker"], color=st["color"],
-                    markerfacecolor="white", markersize=size, zorder=3)
-            seen.setdefault(m.name, Line2D([], [], color=st["color"], marker=st["marker"]))
-        ax.set_title(p.name)
-        ax.set_xlabel("timestep dt [s]")
-        ax.set_ylabel("|energy drift| / energy scale [-]")
-    handles = list(seen.values()) + [Line2D([], [], color="grey", marker="o", linestyle="none"),
-                                     Line2D([], [], color="grey", marker="o", markerfacecolor="white",
-                                            linestyle="none")]
-    labels = list(seen) + ["filled: gained energy", "hollow: lost energy"]
-    _finish(fig, handles, labels, ncol, "Energy error at the horizon (relative to the energy scale)")
-    _save(fig, path, tight=False)
+    fig, ax = plt.subplots(figsize=(11.2, 5.0))
+    vals = []
+    for m in ours:
+        d = m.col("energy_drift")
+        ok = m.completed & np.isfinite(d) & (np.abs(d) > 0)
+        vals += list(np.abs(d[ok]))
+    if not vals:
+        plt.close(fig)
+        return False
+    lo, hi = _log_limits(vals)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_ylim(lo, hi)
+    same_as = coincident([(m.name, m.param, np.abs(m.col("energy_drift"))) for m in ours])
+    handles, labels = [], []
+    for m in ours:
+        st = styles(m.name)
+        dt, d = m.param, m.col("energy_drift")
+        ok = m.completed & np.isfinite(d) & (np.abs(d) > 0)
+        if not ok.any():
+            continue
+        size = 3.5 if m.name in same_as else 5.5  # coinciding curves nest instead of hiding
+        ax.plot(dt[ok], np.abs(d[ok]), color=st["color"], linewidth=1.1, zorder=2)
+        gain, loss = ok & (d > 0), ok & (d < 0)
+        ax.plot(dt[gain], d[gain], linestyle="none", marker=st["marker"], color=st["color"], markersize=size,
+                zorder=3)
+        ax.plot(dt[loss], -d[loss], linestyle="none", marker=st["marker"], color=st["color"],
+                markerfacecolor="white", markersize=size, zorder=3)
+        handles.append(Line2D([], [], color=st["color"], marker=st["marker"]))
+        labels.append(m.name + (f" (= {same_as[m.name]})" if m.name in same_as else ""))
+    handles += [Line2D([], [], color="grey", marker="o", linestyle="none"),
+                Line2D([], [], color="grey", marker="o", markerfacecolor="white", linestyle="none")]
+    labels += ["filled: gained energy", "hollow: lost energy"]
+    _legend_beside(ax, handles, labels)
+    ax.set_xlabel("timestep dt [s]")
+    ax.set_ylabel("|energy drift| / energy scale [-]")
+    ax.set_title(f"{problem.name}: energy error at the horizon")
+    fig.subplots_adjust(left=0.08, right=0.64, top=0.92, bottom=0.11)
+    _save(fig, path)
     return True
 
 

@@ -1,9 +1,27 @@
-"""A small document model written out as REPORT.md, and REPORT.md turned into a
-self-contained index.html by python3-markdown (inline CSS, images beside it in fig/,
-no network)."""
+"""A small document model written out as Markdown (REPORT.md, --markdown, --readme)
+and as index.html through python3-markdown (inline CSS, images beside it in fig/ or
+inlined, no network). A table whose cells carry their own HTML (Cell) or a class is
+written into the HTML as an HTML table (python3-markdown passes a raw HTML block
+through as it is), and into the Markdown as a Markdown table of the cells' text."""
+import base64
 import html
+import os
+import re
+from dataclasses import dataclass
 
 import markdown as md_lib
+
+
+@dataclass(frozen=True)
+class Cell:
+    """A table cell with a Markdown text and an HTML form (already escaped), and a CSS class."""
+    md: str
+    html: str
+    cls: str = ""
+
+
+def esc(text):
+    return html.escape(str(text), quote=True)
 
 
 class Doc:
@@ -14,37 +32,79 @@ class Doc:
     def h(self, level, text):
         self.blocks.append(("h", level, text))
 
-    def p(self, text):
-        self.blocks.append(("p", text))
+    def p(self, text, cls=None):
+        """A paragraph; `cls`: its class in index.html (then only `code` spans are marked up)."""
+        self.blocks.append(("p", text, cls))
 
     def note(self, text):
         self.blocks.append(("note", text))
 
-    def table(self, headers, rows, caption=None):
-        self.blocks.append(("table", headers, [[("" if c is None else str(c)) for c in r] for r in rows], caption))
+    def items(self, lines):
+        """A bullet list."""
+        self.blocks.append(("items", [str(x) for x in lines]))
+
+    def table(self, headers, rows, caption=None, cls=None):
+        """`cls`: the HTML table's class (written as an HTML table); a row's cells are
+        text or Cell."""
+        cells = [[c if isinstance(c, Cell) else ("" if c is None else str(c)) for c in r] for r in rows]
+        self.blocks.append(("table", headers, cells, caption, cls))
 
     def img(self, src, alt):
         self.blocks.append(("img", src, alt))
 
+    def toc(self):
+        """Where the contents go in index.html (REPORT.md has none: its viewer lists the headings)."""
+        self.blocks.append(("toc",))
 
-def _md_cell(text):
+
+def _inline(text):
+    """Markdown's `code` spans in escaped text, for a paragraph written as HTML."""
+    return re.sub(r"`([^`]+)`", r"<code>\1</code>", esc(text))
+
+
+def _md_cell(cell):
+    text = cell.md if isinstance(cell, Cell) else cell
     return text.replace("|", "\\|").replace("\n", " ")
 
 
-def markdown(doc):
+def _html_table(headers, rows, cls):
+    out = [f'<table class="{esc(cls)}">' if cls else "<table>", "<thead><tr>"]
+    out += [f"<th>{esc(h)}</th>" for h in headers]
+    out.append("</tr></thead><tbody>")
+    for r in rows:
+        out.append("<tr>")
+        for c in r:
+            if isinstance(c, Cell):
+                out.append(f'<td class="{esc(c.cls)}">{c.html}</td>' if c.cls else f"<td>{c.html}</td>")
+            else:
+                out.append(f"<td>{esc(c)}</td>")
+        out.append("</tr>")
+    out.append("</tbody></table>")
+    return "".join(out)
+
+
+def markdown(doc, for_html=False):
+    """The document as Markdown; `for_html`: the text index.html is converted from (rich
+    tables as HTML, the contents' marker)."""
     out = [f"# {doc.title}", ""]
     for b in doc.blocks:
         kind = b[0]
         if kind == "h":
             out += ["#" * b[1] + " " + b[2], ""]
         elif kind == "p":
-            out += [b[1], ""]
+            _, text, cls = b
+            out += [f'<p class="{esc(cls)}">{_inline(text)}</p>' if for_html and cls else text, ""]
         elif kind == "note":
             out += ["> " + b[1], ""]
+        elif kind == "items":
+            out += [f"- {line}" for line in b[1]] + [""]
         elif kind == "table":
-            _, headers, rows, caption = b
+            _, headers, rows, caption, cls = b
             if caption:
                 out += [caption, ""]
+            if for_html and (cls or any(isinstance(c, Cell) for r in rows for c in r)):
+                out += [_html_table(headers, rows, cls), ""]
+                continue
             out.append("| " + " | ".join(_md_cell(h) for h in headers) + " |")
             out.append("|" + "|".join("---" for _ in headers) + "|")
             for r in rows:
@@ -53,35 +113,58 @@ def markdown(doc):
         elif kind == "img":
             _, src, alt = b
             out += [f"![{alt}]({src})", ""]
+        elif kind == "toc" and for_html:
+            out += ["[TOC]", ""]
     return "\n".join(out).rstrip() + "\n"
 
 
 CSS = """
 body { font-family: -apple-system, "Segoe UI", Roboto, "DejaVu Sans", sans-serif; margin: 0 auto;
-       max-width: 1180px; padding: 1.2em 1.6em 4em; color: #1d1d1f; line-height: 1.45; }
-h1 { font-size: 1.7em; margin-bottom: 0.2em; }
-h2 { border-bottom: 2px solid #ddd; padding-bottom: 0.2em; margin-top: 2em; }
-h3 { margin-top: 1.6em; }
-table { border-collapse: collapse; margin: 0.6em 0 1.2em; font-size: 0.9em; }
-th, td { border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: left; vertical-align: top; }
+       max-width: 1320px; padding: 0.5em 1.4em 4em; color: #1d1d1f; line-height: 1.45; }
+h1 { font-size: 1.4em; margin: 0.2em 0 0.1em; }
+h1 + p { margin: 0 0 0.3em; color: #555; font-size: 0.88em; }
+h2 { border-bottom: 2px solid #ddd; padding-bottom: 0.15em; margin-top: 1.8em; font-size: 1.3em; }
+h1 + p + h2 { margin-top: 0.4em; font-size: 1.1em; }
+h3 { margin-top: 1.5em; font-size: 1.1em; }
+p, ul, blockquote { max-width: 78em; }
+table { border-collapse: collapse; margin: 0.5em 0 1.1em; font-size: 0.88em; max-width: 100%; }
+th, td { border: 1px solid #ccc; padding: 0.2em 0.5em; text-align: left; vertical-align: top;
+         overflow-wrap: anywhere; }
 th { background: #f2f2f2; }
 tr:nth-child(even) td { background: #fafafa; }
 td { font-variant-numeric: tabular-nums; }
-img { max-width: 100%; border: 1px solid #e4e4e4; margin: 0.8em 0 1.6em; }
+table.verdict, table.frames { width: 100%; table-layout: fixed; font-size: 12px; line-height: 1.3;
+                               margin: 0.3em 0; }
+table.verdict th:first-child, table.frames th:first-child { width: 11.5em; }
+table.verdict td, table.frames td { padding: 0.15em 0.35em; }
+table.verdict td.ahead { background: #e4f3e0; }
+table.verdict td.behind { background: #fbe4e1; }
+table.verdict td.within { background: #efefef; color: #555; }
+table.verdict td.none, table.frames td.none { color: #999; }
+.small { color: #666; font-size: 0.92em; }
+.caption { font-size: 0.82em; color: #555; margin: 0 0 0.6em; }
+img { max-width: 100%; height: auto; border: 1px solid #e4e4e4; margin: 0.6em 0 1.2em; }
 blockquote { background: #fff8e1; border-left: 4px solid #f0b400; padding: 0.4em 0.8em; margin: 1em 0; }
 blockquote p { margin: 0; }
-.toc ul { columns: 2; font-size: 0.95em; }
+.toc ul { columns: 3; font-size: 0.92em; }
+.toc .toctitle { font-weight: bold; }
 code { font-family: "DejaVu Sans Mono", monospace; font-size: 0.92em; }
 """
 
 
-def to_html(markdown_text, title):
-    """index.html from REPORT.md: python3-markdown's tables, and its toc extension for
-    the heading ids and the contents (second-level headings) at the top."""
-    converter = md_lib.Markdown(extensions=["tables", "toc"], extension_configs={"toc": {"toc_depth": "2-2"}})
-    body = converter.convert(markdown_text)
-    # The contents go right under the title.
-    body = body.replace("</h1>", f'</h1>\n<nav class="toc">{converter.toc}</nav>', 1)
+def to_html(doc, figdir=None):
+    """index.html: the document converted by python3-markdown (its tables, and its toc
+    extension for the heading ids and the contents, second-level headings). `figdir`:
+    the folder holding the figures, to inline each as a data: URI (one file to send)."""
+    converter = md_lib.Markdown(extensions=["tables", "toc"],
+                                extension_configs={"toc": {"toc_depth": "2-2", "title": "Contents"}})
+    body = converter.convert(markdown(doc, for_html=True))
+    if figdir is not None:
+        def inline(m):
+            with open(os.path.join(figdir, os.path.basename(m.group(1))), "rb") as f:
+                return 'src="data:image/png;base64,' + base64.b64encode(f.read()).decode("ascii") + '"'
+        body = re.sub(r'src="(fig/[^"]+\.png)"', inline, body)
     return "\n".join(["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
-                      f"<title>{html.escape(title)}</title>", f"<style>{CSS}</style></head><body>",
+                      '<meta name="viewport" content="width=device-width, initial-scale=1">',
+                      f"<title>{html.escape(doc.title)}</title>", f"<style>{CSS}</style></head><body>",
                       body, "</body></html>"]) + "\n"

@@ -1,6 +1,10 @@
-"""The report: figures into <dir>/fig, the same document as REPORT.md and index.html."""
+"""The report: figures into <dir>/fig, the same document as REPORT.md and index.html,
+and the verdict as summary.json. It opens on the answer (verdict.opening), then one
+section per problem, the study-wide sections, and the study's metadata last."""
+import json
 import os
 from concurrent.futures import ProcessPoolExecutor
+from dataclasses import replace
 
 import numpy as np
 
@@ -8,14 +12,16 @@ from . import figures, render, tables
 from . import energy_runs as energy_section
 from . import loop as loop_section
 from . import substeps as substeps_section
+from . import verdict as verdict_section
 from .formatting import fmt_num
 
-TITLE = "stepbench report: accuracy, stability and cost of time integrators"
+TITLE = "stepbench: which integrator for which need"
 META_KEYS = ["version", "git_commit", "compiler", "build_type", "dependencies", "created_utc", "cpu", "cores",
              "format_version", "levels", "base_steps", "tolerances", "sample_count", "reference_rtol",
              "reference_atol", "fit_metric", "divergence_factor", "equal_error_targets", "wall_seconds", "timing"]
 BENCH_KEYS = ["benchmark_mode", "benchmark_min_time_s", "benchmark_repetitions", "benchmark_case_budget_s",
               "benchmark_wall_seconds", "cpu_scaling_enabled", "num_cpus", "mhz_per_cpu"]
+
 
 def _parameter(q):
     """One declared parameter as `name = value unit` (a named value by its name)."""
@@ -32,44 +38,49 @@ def _value(v):
     return str(v)
 
 
-def _figure_jobs(study, figdir):
+def _figure_jobs(study, figdir, whole):
     """(kind, argument, path) for every figure; they are independent, so they can be
-    drawn in parallel processes. The panel figures take longest and go first, so that
-    the workers finish together."""
-    jobs = [("wp", "force_evals", os.path.join(figdir, "work_precision_force_evals.png"))]
-    if study.timed:
-        jobs.append(("wp", "time", os.path.join(figdir, "work_precision_time.png")))
-    jobs.append(("energy", None, os.path.join(figdir, "energy_drift.png")))
+    drawn in parallel processes. `whole`: the study-wide figures too (not for a report
+    of one problem)."""
+    jobs = []
+    for p in study.problems:
+        jobs += [("wp", p.name, os.path.join(figdir, f"work_precision_{p.name}.png")),
+                 ("convergence", p.name, os.path.join(figdir, f"convergence_{p.name}.png")),
+                 ("energy", p.name, os.path.join(figdir, f"energy_drift_{p.name}.png"))]
+    if not whole:
+        return jobs
     if study.energy_runs is not None:
         jobs.append(("energy_runs", None, os.path.join(figdir, "energy_long_runs.png")))
-    jobs += [("convergence", p.name, os.path.join(figdir, f"convergence_{p.name}.png")) for p in study.problems]
     if study.stability is not None:
         jobs.append(("stability", None, os.path.join(figdir, "stability_regions.png")))
     if study.substeps is not None:
         jobs.append(("substeps", None, os.path.join(figdir, substeps_section.FIGURE)))
     if study.loop is not None:
         jobs.append(("loop", None, os.path.join(figdir, "loop_shown_error.png")))
-    return jobs
+    # The slowest first, so that the workers finish together.
+    slow = {"loop": 0, "substeps": 1, "energy_runs": 2, "stability": 3}
+    return sorted(jobs, key=lambda j: slow.get(j[0], 9))
 
 
-_STUDY = None
+_STUDY = _NAMES = None
 
 
-def _init_worker(study):
-    global _STUDY
-    _STUDY = study
+def _init_worker(study, names):
+    global _STUDY, _NAMES
+    _STUDY, _NAMES = study, names
 
 
 def _draw(job):
     kind, arg, path = job
     study = _STUDY
-    styles = figures.Styles(study)
+    styles = figures.Styles(_NAMES)
+    problem = next((p for p in study.problems if p.name == arg), None)
     if kind == "convergence":
-        figures.convergence(next(p for p in study.problems if p.name == arg), styles, path)
+        figures.convergence(problem, styles, path)
     elif kind == "wp":
-        figures.work_precision(study, styles, path, arg)
+        figures.work_precision(problem, styles, path, "time" if study.timed else "force_evals", study.timed)
     elif kind == "energy":
-        if not figures.energy(study, styles, path):
+        if not figures.energy(problem, styles, path):
             return None
     elif kind == "stability":
         figures.stability(study.stability, styles, path)
@@ -82,137 +93,188 @@ def _draw(job):
     return path
 
 
-def draw_figures(study, figdir, workers):
-    jobs = _figure_jobs(study, figdir)
+def draw_figures(study, figdir, workers, names, whole=True):
+    jobs = _figure_jobs(study, figdir, whole)
     if workers <= 1:
-        _init_worker(study)
+        _init_worker(study, names)
         return [p for p in map(_draw, jobs) if p]
-    with ProcessPoolExecutor(max_workers=workers, initializer=_init_worker, initargs=(study,)) as ex:
+    with ProcessPoolExecutor(max_workers=workers, initializer=_init_worker, initargs=(study, names)) as ex:
         return [p for p in ex.map(_draw, jobs) if p]
 
 
-def build(study, outdir, workers=2):
-    """Writes fig/*.png, REPORT.md and index.html into outdir (which exists)."""
+def in_verdict_order(study):
+    """The problems in the order the verdict lists them (the registry's, from the simple
+    scenes to the contacts), where the study has one; else as /problems holds them."""
+    if study.verdict is None:
+        return study
+    order = {name: k for k, name in enumerate(study.verdict.problems)}
+    return replace(study, problems=sorted(study.problems, key=lambda p: order.get(p.name, len(order))))
+
+
+def one_problem(study, name):
+    """The study cut to the problem `name` (which it has), for a report of one problem."""
+    p = next(p for p in study.problems if p.name == name)
+    return replace(study, problems=[p], verdict=study.verdict.only(name) if study.verdict is not None else None,
+                   gaps=[g for g in study.gaps if g.startswith(f"{name}:")])
+
+
+def build(study, outdir, workers=2, problem=None, self_contained=False):
+    """Writes fig/*.png, REPORT.md, index.html and summary.json into outdir (which
+    exists): of the whole study, or of the one problem named. `self_contained`: the
+    figures inlined into index.html as well."""
+    names = figures.method_names(study)  # of the whole study: the same colours in a report of one problem
+    study = in_verdict_order(study)
+    whole = problem is None
+    if not whole:
+        study = one_problem(study, problem)
     figdir = os.path.join(outdir, "fig")
     os.makedirs(figdir, exist_ok=True)
-    made = set(os.path.basename(p) for p in draw_figures(study, figdir, workers))
-    text = render.markdown(document(study, made))
+    made = set(os.path.basename(p) for p in draw_figures(study, figdir, workers, names, whole))
+    doc = document(study, made, whole)
     with open(os.path.join(outdir, "REPORT.md"), "w") as f:
-        f.write(text)
+        f.write(render.markdown(doc))
     with open(os.path.join(outdir, "index.html"), "w") as f:
-        f.write(render.to_html(text, TITLE))
+        f.write(render.to_html(doc, figdir if self_contained else None))
+    with open(os.path.join(outdir, "summary.json"), "w") as f:
+        json.dump(verdict_section.summary(study), f, indent=1)
+        f.write("\n")
 
 
-def document(study, figs):
+def headline(study):
+    """The line under the title: the study, where and when it ran (the rest in the appendix)."""
+    a = study.attrs
+    how = f"timed ({a['benchmark_mode']})" if study.timed else "untimed (costs in force evaluations)"
+    return (f"Study `{os.path.basename(study.path)}`, {how}, {a['cpu']}, {a['created_utc']}, commit "
+            f"{a['git_commit']}; build and machine in the appendix.")
+
+
+def document(study, figs, whole=True):
     doc = render.Doc(TITLE)
-    doc.note("Generated by `scripts/report` from the study file; do not edit, regenerate it. "
-             "Errors are absolute, in the problem's position unit (see the problems table). Every ranking, "
-             "front and fit below was computed by stepbench when it wrote the file; this report draws and "
-             "formats it.")
+    doc.p(headline(study))
+    if study.verdict is not None:
+        verdict_section.opening(doc, study.verdict)
+    else:
+        _absent(doc, study)
+    for gap in study.gaps:
+        doc.note(f"Incomplete study file: {gap}. The tables below rank only what the file holds.")
+    if not whole:
+        doc.note(f"One problem only ({study.problems[0].name}): the study-wide sections (stability, small steps, "
+                 "energy over long runs, game loop) are in the report of the whole study.")
+    doc.toc()
+    for p in study.problems:
+        _problem(doc, study, p, figs)
+    if whole:
+        _stability(doc, study, figs)
+        substeps_section.section(doc, study, figs)
+        _energy(doc, study, figs)
+        loop_section.section(doc, study, figs)
+    _how_made(doc, study)
     _metadata(doc, study)
-    _summary(doc, study)
-    _convergence(doc, study, figs)
-    _work_precision(doc, study)
-    _stability(doc, study, figs)
-    substeps_section.section(doc, study, figs)
-    _energy(doc, study, figs)
-    loop_section.section(doc, study, figs)
-    _references(doc, study)
     return doc
 
 
-def _metadata(doc, study):
-    a = study.attrs
-    doc.h(2, "Study")
-    doc.table(["field", "value"], [["study file", study.path]] + [[k, _value(a[k])] for k in META_KEYS])
-    for gap in study.gaps:
-        doc.note(f"Incomplete study file: {gap}. The tables below rank only what the file holds.")
-    if study.timed:
-        doc.table(["benchmark setting", "value"], [[k, _value(a[k])] for k in BENCH_KEYS],
-                  caption="Timing run (Google Benchmark):")
-        if int(a["cpu_scaling_enabled"]) == 1:
-            doc.note("CPU frequency scaling was on during the timing run: times may be noisy.")
-    else:
-        doc.p("Timings: absent (a plain sweep). Costs are counted force evaluations; "
-              "`stepbench_bench --study_out` adds measured times.")
-    rows = []
-    for p in study.problems:
-        pa = p.attrs
-        params = ", ".join(_parameter(q) for q in p.parameters)
-        truth = pa["truth_source"] if int(pa["truth_trusted"]) else f"none trusted: {pa['truth_note']}"
-        rows.append([p.name, pa["description"], fmt_num(pa["horizon"], 4) + " s", p.unit, truth, params])
-    doc.table(["problem", "scene", "horizon", "position unit", "truth", "parameters"], rows, caption="Problems:")
-    for p in study.problems:
-        if not int(p.attrs["truth_trusted"]):
-            doc.note(f"{p.name} has no trusted truth ({p.attrs['truth_note']}): every error on it is NaN, "
-                     "every run is marked failed, and it has no cheapest method or front.")
+def _absent(doc, study):
+    """The opening of a study without /verdict: said at once, then the cheapest measured
+    run per target in its place (`equal_error`, by max error over the run)."""
+    doc.h(2, "Fastest at equal error")
+    doc.note("This study file has no /verdict group (it was written before stepbench computed one): no "
+             "comparison with the peers at equal error and no frame-rate answers. Run the study again with this "
+             "stepbench for them. In their place: the cheapest measured run reaching each target.")
+    targets = tables.SUMMARY_TARGETS
+    doc.table(["problem [unit]"] + [verdict_section.target_text(t) for t in targets],
+              [[f"{p.name} [{p.unit}]"] + [tables.cheapest_cell(p, t) for t in targets] for p in study.problems],
+              cls="verdict")
 
 
-def _summary(doc, study):
-    doc.h(2, "Summary: cheapest method per error target")
-    doc.p("For each problem and each target error (absolute, in the problem's unit), the cheapest method whose "
-          "run reaches it, from the study's `equal_error` table: by measured time when the study has a time for "
-          "every qualifying run, else by counted force evaluations; diverged or failed runs and runs the time "
-          "budget cut do not count; only measured rows, no interpolation. The hand-written baseline is a timing "
-          "floor, never the answer: where it reaches the target its cost is shown for scale. The first table asks "
-          "for the final position error (`err_pos_final`, at the horizon); the second for the max position error "
-          "over the run (`err_pos_max`), which a game needs at every frame: a final error can be small by luck "
-          "(a damped motion that has died out, a pendulum back at its turning point) and the note says so. "
-          "`stepbench advise --problem P --tol X` answers the same question for any target by the same rule.")
-    for p in study.problems:
-        doc.h(3, f"{p.name}: cheapest method")
-        for metric, title in tables.SUMMARY_METRICS:
-            doc.h(4, f"{p.name}: cheapest {title}")
-            doc.table(*tables.summary_rows(p, metric))
-
-
-def _convergence(doc, study, figs):
-    doc.h(2, "Convergence")
-    doc.p("Max position error over the run (`err_pos_max`, the study's fit metric) against the timestep, log-log, "
-          "for every fixed-step method: ours in full, the peers and the baseline faint and dashed behind them. "
-          "The legend gives the fitted slope (observed order); dashed grey lines are reference slopes 1, 2 and 4. "
-          "Filled markers are the ladder levels the fit used; hollow ones were left out (round-off floor, or "
-          "errors above 10 % of the motion before the asymptotic range). Adaptive methods run over tolerances, "
-          "not timesteps: they are under Work-precision. \"Declared order holds\" is stepbench's verdict: the "
-          "observed order within 0.5 of the declared one.")
-    for p in study.problems:
-        doc.h(3, f"{p.name}: convergence")
-        name = f"convergence_{p.name}.png"
-        if name in figs:
-            doc.img(f"fig/{name}", f"convergence on {p.name}")
-        doc.h(4, f"{p.name}: observed order")
-        doc.table(tables.ORDER_HEAD, tables.order_rows(p))
-
-
-def _work_precision(doc, study):
-    doc.h(2, "Work-precision")
-    if study.timed:
-        doc.p("Error against measured time (median wall time of one whole run) and against counted force "
-              "evaluations, every method: ours solid, the peers dashed, the hand-written baseline dotted (for scale). "
-              "The thick gold band is the study's Pareto front: runs that no other run beats in both cost and "
-              "error (the baseline left out). Runs the time budget cut are not drawn.")
-        doc.img("fig/work_precision_time.png", "work-precision against time")
-    else:
-        doc.note("Timings are absent from this study, so work-precision is shown against force evaluations only "
-                 "(a proxy for cost that ignores per-step overhead). Run the benchmark study for error against time.")
-    doc.img("fig/work_precision_force_evals.png", "work-precision against force evaluations")
+def _problem(doc, study, p, figs):
+    """Everything about one problem: the scene, its verdict, its figures and tables."""
+    doc.h(2, p.name)
+    pa = p.attrs
+    truth = pa["truth_source"] if int(pa["truth_trusted"]) else f"none trusted: {pa['truth_note']}"
+    params = ", ".join(_parameter(q) for q in p.parameters)
+    doc.p(f"{pa['description']}. Horizon {fmt_num(pa['horizon'], 4)} s, position unit {p.unit}, truth: {truth}. "
+          f"Parameters: {params}.")
+    if not int(pa["truth_trusted"]):
+        doc.note(f"{p.name} has no trusted truth ({pa['truth_note']}): every error on it is NaN, every run is "
+                 "marked failed, and it has no cheapest method or front.")
+    if study.verdict is not None:
+        verdict_section.problem_section(doc, study.verdict, p.name)
     primary = "time" if study.timed else "force_evals"
-    for p in study.problems:
-        doc.h(3, f"{p.name}: Pareto front")
-        methods = tables.front_methods(p, primary)
-        text = (f"Methods on the front by {'time' if study.timed else 'force evaluations'}: "
-                + (", ".join(methods) if methods else "none") + ".")
-        if study.timed:
-            by_evals = tables.front_methods(p, "force_evals")
-            text += " By force evaluations: " + (", ".join(by_evals) if by_evals else "none") + "."
-        doc.p(text)
-        doc.table(*tables.front_rows(p, primary))
-        rows = tables.adaptive_rows(p)
-        if rows:
-            doc.h(4, f"{p.name}: adaptive methods")
-            doc.p("The adaptive methods run over the tolerance ladder (rtol = atol = tol). The slope is fitted to "
-                  "log `err_pos_max` against log tol: near 1, the error follows the tolerance asked for.")
-            doc.table(tables.ADAPTIVE_HEAD, rows)
+    doc.h(3, f"{p.name}: work-precision")
+    name = f"work_precision_{p.name}.png"
+    if name in figs:
+        doc.img(f"fig/{name}", f"work-precision on {p.name}")
+    curves = figures.work_curves(p, primary, study.timed)
+    doc.table(*tables.method_rows(p, curves, figures.labelled(p, primary), primary))
+    doc.h(3, f"{p.name}: Pareto front")
+    methods = tables.front_methods(p, primary)
+    text = (f"Methods on the front by {'time' if study.timed else 'force evaluations'}: "
+            + (", ".join(methods) if methods else "none") + ".")
+    if study.timed:
+        by_evals = tables.front_methods(p, "force_evals")
+        text += " By force evaluations: " + (", ".join(by_evals) if by_evals else "none") + "."
+    doc.p(text)
+    doc.table(*tables.front_rows(p, primary))
+    rows = tables.adaptive_rows(p)
+    if rows:
+        doc.h(4, f"{p.name}: adaptive methods")
+        doc.table(tables.ADAPTIVE_HEAD, rows)
+    doc.h(3, f"{p.name}: convergence")
+    name = f"convergence_{p.name}.png"
+    if name in figs:
+        doc.img(f"fig/{name}", f"convergence on {p.name}")
+    doc.h(4, f"{p.name}: observed order")
+    doc.table(tables.ORDER_HEAD, tables.order_rows(p))
+    name = f"energy_drift_{p.name}.png"
+    if name in figs:
+        doc.h(3, f"{p.name}: energy at the horizon")
+        doc.img(f"fig/{name}", f"energy drift at the horizon on {p.name}")
+    doc.h(3, f"{p.name}: cheapest measured run")
+    for metric, title in tables.SUMMARY_METRICS:
+        doc.h(4, f"{p.name}: cheapest {title}")
+        doc.table(*tables.summary_rows(p, metric))
+    doc.h(3, f"{p.name}: references")
+    rows = tables.reference_rows(p)
+    if rows:
+        doc.table(tables.REFERENCE_HEAD, rows)
+    else:
+        doc.p("No references recorded.")
+
+
+def _how_made(doc, study):
+    """How to read the problem sections' figures and tables: said once, after them."""
+    doc.h(2, "Appendix: how the problem sections are made")
+    doc.p("Verdict at equal error: stepbench interpolates each method's measured work-precision curve (log-log, "
+          "between the two runs that bracket the target, never beyond them) and compares the fastest of ours with "
+          "the fastest library peer; the hand-written baselines never count. At a frame rate: our fixed-step "
+          "methods at one step a frame, and with n substeps a frame (n = 1, 2, 4, ..., 64).")
+    doc.p("Work-precision: error against " + ("measured time (median wall time of one whole run)" if study.timed
+                                              else "counted force evaluations (a proxy for cost that ignores "
+                                                   "per-step overhead; a timed study shows time)")
+          + ". Drawn in colour and named: the methods on the study's Pareto front (runs that no other run beats "
+          "in both cost and error, the baseline left out; the thin black line) and the lecture's methods ("
+          + ", ".join(figures.LECTURE) + "); every other method light grey. Ours solid, the peers dashed, the "
+          "baseline dotted. A method has one colour and marker in every figure of the report. Runs the time budget "
+          "cut are not drawn. The table under each figure lists every method.")
+    doc.p("Convergence: max position error over the run (`err_pos_max`, the study's fit metric) against the "
+          "timestep, log-log, for every fixed-step method: ours in full, the peers and the baseline faint and "
+          "dashed behind them. The legend gives the fitted slope (observed order); dashed grey lines are reference "
+          "slopes 1, 2 and 4. Filled markers are the ladder levels the fit used; hollow ones were left out "
+          "(round-off floor, or errors above 10 % of the motion before the asymptotic range). \"Declared order "
+          "holds\" is stepbench's verdict: the observed order within 0.5 of the declared one. The adaptive methods "
+          "run over the tolerance ladder (rtol = atol = tol); their slope is fitted to log `err_pos_max` against "
+          "log tol: near 1, the error follows the tolerance asked for.")
+    doc.p("Cheapest measured run: for each target error, the cheapest method whose run reaches it, from the "
+          "study's `equal_error` table: by measured time when the study has a time for every qualifying run, else "
+          "by counted force evaluations; diverged or failed runs and runs the time budget cut do not count. The "
+          "hand-written baseline is a timing floor, never the answer: where it reaches the target its cost is "
+          "shown for scale. One table asks for the final position error (`err_pos_final`, at the horizon), the "
+          "other for the max over the run (`err_pos_max`), which a game needs at every frame: a final error can be "
+          "small by luck and the note says so. `stepbench advise --problem P --tol X` answers for any target.")
+    doc.p("References: the reference solutions every error is measured against (or checked with, where a closed "
+          "form exists): status, accepted steps, rejected attempts, right-hand-side calls as the solver reports "
+          "them, the extra calls CVODE makes for its difference-quotient Jacobian, and every call counted by a "
+          "wrapper; agreement is the max over the sample times of |difference| relative to the motion's scale.")
 
 
 def _limit_cell(row, column):
@@ -277,21 +339,29 @@ def _stability(doc, study, figs):
 def _energy(doc, study, figs):
     doc.h(2, "Energy")
     energy_section.section(doc, study, figs)
-    doc.h(3, "Energy at the horizon of every study run")
-    if "energy_drift.png" in figs:
-        doc.img("fig/energy_drift.png", "energy drift at the horizon")
 
 
-def _references(doc, study):
-    doc.h(2, "References")
-    doc.p("The reference solutions every error is measured against (or checked with, where a closed form exists): "
-          "status, accepted steps, rejected attempts, right-hand-side calls as the solver reports them, the extra "
-          "calls CVODE makes for its difference-quotient Jacobian, and every call counted by a wrapper; agreement "
-          "is the max over the sample times of |difference| relative to the motion's scale.")
+def _metadata(doc, study):
+    """The appendix: how the study was made, on what, and its problems."""
+    a = study.attrs
+    doc.h(2, "Appendix: the study")
+    doc.note("Generated by `scripts/report` from the study file; do not edit, regenerate it. Every verdict, "
+             "ranking, front and fit in this report was computed by stepbench when it wrote the file; the report "
+             "draws and formats it.")
+    doc.table(["field", "value"], [["study file", study.path]] + [[k, _value(a[k])] for k in META_KEYS],
+              caption="Build and machine:")
+    if study.timed:
+        doc.table(["benchmark setting", "value"], [[k, _value(a[k])] for k in BENCH_KEYS],
+                  caption="Timing run (Google Benchmark):")
+        if int(a["cpu_scaling_enabled"]) == 1:
+            doc.note("CPU frequency scaling was on during the timing run: times may be noisy.")
+    else:
+        doc.p("Timings: absent (a plain sweep). Costs are counted force evaluations; "
+              "`stepbench_bench --study_out` adds measured times.")
+    rows = []
     for p in study.problems:
-        doc.h(3, f"{p.name}: references")
-        rows = tables.reference_rows(p)
-        if rows:
-            doc.table(tables.REFERENCE_HEAD, rows)
-        else:
-            doc.p("No references recorded.")
+        pa = p.attrs
+        params = ", ".join(_parameter(q) for q in p.parameters)
+        truth = pa["truth_source"] if int(pa["truth_trusted"]) else f"none trusted: {pa['truth_note']}"
+        rows.append([p.name, pa["description"], fmt_num(pa["horizon"], 4) + " s", p.unit, truth, params])
+    doc.table(["problem", "scene", "horizon", "position unit", "truth", "parameters"], rows, caption="Problems:")

@@ -23,6 +23,7 @@ from . import energy_runs as energy_section
 from . import loop as loop_section
 from . import schema
 from . import substeps as substeps_section
+from . import verdict as verdict_section
 
 
 # What docs/study-format.md documents, and the report reads, at each level.
@@ -52,6 +53,11 @@ PARAMETER_FIELDS = schema.fields("parameters")
 # The targets of the report's summary: the file must have computed `equal_error` for
 # each (the issue's "errors of 1e-2, 1e-4 and 1e-6").
 SUMMARY_TARGETS = (1e-2, 1e-4, 1e-6)
+
+# Older formats the report still reads, each with the fields of the current schema its
+# tables lack (table -> fields). Format 3 is the last without /verdict: its report says
+# the verdict is absent and goes on with the rest.
+OLDER_FORMATS = {3: {"equal_error": ("cost_lo", "cost_hi", "interpolated")}}
 
 # The closed vocabularies of the format: any other value is an error, not a guess.
 ORIGINS = ("ours", "peer", "baseline")
@@ -202,6 +208,7 @@ class Study:
     loop: object = None  # loop.Loop: /loop, the game-loop study; None when the study has none
     energy_runs: object = None  # energy_runs.EnergyRuns: /energy, the long-run energy study; None when absent
     substeps: object = None  # substeps.Substeps: /substeps, small steps or one implicit step; None when absent
+    verdict: object = None  # verdict.Verdict: /verdict, the answer the report opens on; None in an older file
 
     @property
     def timed(self):
@@ -229,6 +236,7 @@ class _Reader:
 
     def __init__(self, path, f):
         self.path, self.f = path, f
+        self.lacks = {}  # table -> fields of the current schema an older format lacks (OLDER_FORMATS)
         self.read_types = {}  # (class, size) -> [(stored type, _ReadType)]: see read_type
         self.transfer = _small_buffer_transfer()
 
@@ -371,17 +379,22 @@ class _Reader:
         fronts = {"force_evals": self.need_table(g, "front_force_evals", FRONT_FIELDS)}
         if timed:
             fronts["time"] = self.need_table(g, "front_time", FRONT_FIELDS)
+        equal_error_fields = tuple(n for n in EQUAL_ERROR_FIELDS if n not in self.lacks.get("equal_error", ()))
         p = Problem(g.name.rsplit("/", 1)[1], attrs, methods, references,
-                    self.need_table(g, "equal_error", EQUAL_ERROR_FIELDS), fronts,
+                    self.need_table(g, "equal_error", equal_error_fields), fronts,
                     self.need_table(g, "parameters", PARAMETER_FIELDS))
         self.check_derived(g, p)
         return p
 
     def check_derived(self, g, p):
         """The derived tables name rows of `runs` by (method, param): each must exist, or
-        the report would print a figure it cannot trace to a run."""
+        the report would print a figure it cannot trace to a run. An interpolated row of
+        `equal_error` lies between two runs and names none."""
         params = {m.name: set(m.param.tolist()) for m in p.methods}
-        tables = [("equal_error", p.equal_error)] + [(f"front_{k}", v) for k, v in p.fronts.items()]
+        measured = p.equal_error
+        if "interpolated" in (measured.dtype.names or ()):
+            measured = measured[measured["interpolated"] == 0]
+        tables = [("equal_error", measured)] + [(f"front_{k}", v) for k, v in p.fronts.items()]
         for table, rows in tables:
             for method, param in zip(rows["method"].tolist(), rows["param"].tolist()):
                 if param not in params.get(method, ()):
@@ -424,9 +437,13 @@ class _Reader:
         if version > schema.FORMAT_VERSION:
             raise self.error(f"written by a newer stepbench (format_version {version}; "
                              f"this report reads {schema.FORMAT_VERSION})")
-        if version < schema.FORMAT_VERSION:
-            raise self.error(f"format_version {version} is older than this report reads ({schema.FORMAT_VERSION}); "
+        oldest = min([schema.FORMAT_VERSION] + list(OLDER_FORMATS))
+        if version < oldest:
+            reads = f"{oldest}" if oldest == schema.FORMAT_VERSION else f"{oldest} to {schema.FORMAT_VERSION}"
+            raise self.error(f"format_version {version} is older than this report reads ({reads}); "
                              "run the study again with this stepbench")
+        if version < schema.FORMAT_VERSION:
+            self.lacks = OLDER_FORMATS[version]
         attrs = self.need_attrs(f, ROOT_ATTRS)
         self.need_value(f, "timing", int(attrs["timing"]), (0, 1))
         targets = np.atleast_1d(attrs["equal_error_targets"])
@@ -445,7 +462,7 @@ class _Reader:
             return Study(path=str(self.path), attrs=attrs, problems=problems)
         return Study(path=str(self.path), attrs=attrs, problems=problems, stability=self.stability(),
                      loop=loop_section.read(self, f), energy_runs=energy_section.read(self, f),
-                     substeps=substeps_section.read(self, f))
+                     substeps=substeps_section.read(self, f), verdict=verdict_section.read(self, f))
 
 
 def _problem_share(share, shares):

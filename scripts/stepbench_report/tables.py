@@ -4,7 +4,8 @@ fits or selects: the cheapest methods come from `equal_error`, the fronts from
 in C++, core/work_precision.hpp and core/convergence_fit.hpp)."""
 import numpy as np
 
-from .formatting import fmt_num, fmt_time_ns, label
+from .formatting import fmt_count, fmt_num, fmt_sci, fmt_seconds, fmt_time_ns, label
+from .render import Cell, esc
 from .study import SUMMARY_TARGETS
 
 SUMMARY_METRICS = (("err_pos_final", "by final error"), ("err_pos_max", "by max error over the run"))
@@ -95,13 +96,19 @@ def summary_rows(problem, metric):
         if len(answer):
             a = answer[0]
             m = problem.method(a["method"])
-            run = m.runs[m.row_at(a["param"])]
+            at_run = m.row_at(a["param"])
             note = ""
-            if metric == "err_pos_final" and run["err_pos_max"] > 10 * target:
-                note = (f"small at the horizon only: the max error over the run is {fmt_num(run['err_pos_max'])} "
-                        f"{problem.unit}")
+            if at_run is None:  # an interpolated row: between two runs, its error is the target's
+                errors = {metric: a["error"]}
+                note = "interpolated between two runs"
+            else:
+                run = m.runs[at_run]
+                errors = {"err_pos_final": run["err_pos_final"], "err_pos_max": run["err_pos_max"]}
+                if metric == "err_pos_final" and run["err_pos_max"] > 10 * target:
+                    note = (f"small at the horizon only: the max error over the run is "
+                            f"{fmt_num(run['err_pos_max'])} {problem.unit}")
             row = [f"{target:g}", label(m), fmt_param(m, a["param"]), fmt_cost(a["cost_kind"], a["cost"]),
-                   fmt_num(run["err_pos_final"]), fmt_num(run["err_pos_max"]), note]
+                   fmt_num(errors.get("err_pos_final")), fmt_num(errors.get("err_pos_max")), note]
         else:
             row = [f"{target:g}", "none reaches it", "", "", "", "", ""]
         if has_baseline:
@@ -113,6 +120,44 @@ def summary_rows(problem, metric):
             f"err_pos_final [{problem.unit}]", f"err_pos_max [{problem.unit}]", "note"]
     if has_baseline:
         head.append("hand-written floor (baseline, for scale)")
+    return head, rows
+
+
+def cheapest_cell(problem, target):
+    """The opening table of a study without /verdict: the cheapest measured run reaching
+    `target` in max error over the run (the `is_answer` row of `equal_error`)."""
+    ee = problem.equal_error
+    at = ee[(ee["metric"] == "err_pos_max") & np.isclose(ee["target"], target, rtol=1e-9, atol=0)
+            & (ee["is_answer"] == 1)]
+    if not len(at):
+        return Cell("none reaches it", "&ndash;", "none")
+    a = at[0]
+    m = problem.method(a["method"])
+    param = f"tol {fmt_sci(a['param'])}" if m.adaptive else f"dt {fmt_seconds(a['param'])}"
+    cost = fmt_time_ns(a["cost"]) if a["cost_kind"] == "time_ns" else f"{fmt_count(a['cost'])} evals"
+    return Cell(f"{label(m)} {param}, {cost}", f"<b>{esc(label(m))}</b> {esc(param)} &middot; {esc(cost)}")
+
+
+def method_rows(problem, curves, shown, front_key):
+    """Every method of a work-precision figure, drawn in colour or grey: how it is drawn,
+    its kind, the front rows it has, and its lowest error with that run's cost."""
+    front = problem.fronts[front_key]["method"].tolist()
+    drawn = {m.name: (x, e) for m, x, e in curves}
+    cost = fmt_time_ns if front_key == "time" else (lambda n: fmt_count(n))
+    to_cost = 1e9 if front_key == "time" else 1.0
+    rows = []
+    for m in problem.methods:
+        if m.name in drawn:
+            x, e = drawn[m.name]
+            k = int(np.argmin(e))
+            best, at = fmt_num(e[k]), cost(x[k] * to_cost)
+        else:
+            best, at = "no completed run", ""
+        how = "labelled" if m.name in shown else "grey"
+        rows.append([label(m), m.attrs["kind"], how, str(front.count(m.name)) if m.name in front else "",
+                     best, at, f"{int(m.completed.sum())} of {len(m.runs)}"])
+    head = ["method", "kind", "in the figure", "front rows", f"lowest err_pos_max [{problem.unit}]",
+            "its cost" + (" (time per run)" if front_key == "time" else " (force evals)"), "runs completed"]
     return head, rows
 
 

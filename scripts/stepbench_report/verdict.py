@@ -1,0 +1,391 @@
+"""The answer first: /verdict as stored (docs/study-format.md), the tables the report
+opens on, each problem's share of them, summary.json, and the Markdown of --markdown
+and --readme. Every number is the study file's: the equal-error costs, the ratios and
+their verdicts, the frame-rate answers and the findings were computed by stepbench
+(study/verdict.cpp). Nothing here interpolates, ranks or selects: rows are looked up
+by (problem, target) or (problem, hz) and formatted."""
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from . import schema
+from .formatting import fmt_count, fmt_sci, fmt_seconds, fmt_time_ns
+from .render import Cell, esc
+
+VERDICT_ATTRS = ("metric", "targets", "frame_hz", "cost_kind", "findings", "rule")
+VERDICTS = ("ahead", "behind", "within spread", "ours only", "peers only", "not reached")
+COST_KINDS = ("time_ns", "force_evals")
+# The cell's class in index.html: green ahead, red behind, grey within the repetition spread.
+VERDICT_CLASS = {"ahead": "ahead", "behind": "behind", "within spread": "within", "peers only": "behind",
+                 "not reached": "none"}
+# Names shortened in the frame-rate table, whose cells list several methods; the key is printed under it.
+SHORT = {"semi_implicit_euler": "sie", "velocity_verlet": "vv", "forest_ruth": "fr", "implicit_euler": "ie",
+         "implicit_midpoint": "im"}
+# The README's headline: two typical error targets and a frame rate with its target.
+README_TARGETS = (1e-4, 1e-8)
+README_FRAME = (60.0, 1e-4)
+
+
+@dataclass
+class Verdict:
+    attrs: dict
+    equal_error: np.ndarray  # one row per (problem, target), strings decoded
+    frame_rate: np.ndarray  # one row per (problem, hz, method)
+    frame_answer: np.ndarray  # one row per (problem, hz, target)
+
+    @property
+    def targets(self):
+        return [float(t) for t in np.atleast_1d(self.attrs["targets"])]
+
+    @property
+    def shown_targets(self):
+        """The targets of the opening tables, every second decade (1e-2, 1e-4, ...) so
+        that they fit a screen; a problem's section has them all."""
+        even = [t for t in self.targets if round(math.log10(t)) % 2 == 0]
+        return even if len(even) >= 2 else self.targets
+
+    @property
+    def frame_hz(self):
+        return [float(h) for h in np.atleast_1d(self.attrs["frame_hz"])]
+
+    @property
+    def cost_kind(self):
+        return self.attrs["cost_kind"]
+
+    @property
+    def findings(self):
+        return [line.strip() for line in str(self.attrs["findings"]).split("\n") if line.strip()]
+
+    @property
+    def problems(self):
+        """The problems in the order of the equal-error table."""
+        return list(dict.fromkeys(self.equal_error["problem"].tolist()))
+
+    def only(self, problem):
+        """The verdict of one problem."""
+        return replace(self, equal_error=self.equal_error[self.equal_error["problem"] == problem],
+                       frame_rate=self.frame_rate[self.frame_rate["problem"] == problem],
+                       frame_answer=self.frame_answer[self.frame_answer["problem"] == problem])
+
+    def equal(self, problem, target):
+        rows = self.equal_error[(self.equal_error["problem"] == problem)
+                                & np.isclose(self.equal_error["target"], target, rtol=1e-9, atol=0)]
+        return rows[0] if len(rows) else None
+
+    def answer(self, problem, hz, target):
+        fa = self.frame_answer
+        rows = fa[(fa["problem"] == problem) & (fa["hz"] == hz) & np.isclose(fa["target"], target, rtol=1e-9, atol=0)]
+        return rows[0] if len(rows) else None
+
+    def rates(self, problem, hz):
+        fr = self.frame_rate
+        return fr[(fr["problem"] == problem) & (fr["hz"] == hz)]
+
+    def unit(self, problem):
+        rows = self.equal_error[self.equal_error["problem"] == problem]
+        return rows[0]["unit"] if len(rows) else ""
+
+
+def read(reader, f):
+    """/verdict, checked through the study reader; None when the file has none (a study
+    written before format 4)."""
+    g = f.get("verdict")
+    if g is None:
+        return None
+    attrs = reader.need_attrs(g, VERDICT_ATTRS)
+    reader.need_value(g, "cost_kind", attrs["cost_kind"], COST_KINDS)
+    ee = reader.need_table(g, "equal_error", schema.fields("verdict_equal_error"))
+    reader.need_column(g, "equal_error", ee, "verdict", VERDICTS)
+    return Verdict(attrs, ee, reader.need_table(g, "frame_rate", schema.fields("verdict_frame_rate")),
+                   reader.need_table(g, "frame_answer", schema.fields("verdict_frame_answer")))
+
+
+# --- text ----------------------------------------------------------------------------------------
+
+def target_text(t):
+    return fmt_sci(t, 1) if math.isclose(10 ** round(math.log10(t)), t, rel_tol=1e-9) else fmt_sci(t)
+
+
+def param_text(kind, value):
+    """An interpolated dt (a fixed-step method) or relative tolerance (an adaptive one)."""
+    return f"tol {fmt_sci(value)}" if kind == "adaptive" else f"dt {fmt_seconds(value)}"
+
+
+def cost_text(kind, value):
+    if kind == "time_ns":
+        return fmt_time_ns(value)
+    count = fmt_count(value)
+    return f"{count} eval{'' if count == '1' else 's'}"
+
+
+def ratio_text(ratio):
+    return f"{ratio:.2g}x" if abs(ratio) < 100 else f"{ratio:.0f}x"
+
+
+def _spread(kind, r, side):
+    """A side's cost with its repetition spread, where it has one."""
+    cost, lo, hi = (float(r[f"{side}_cost{s}"]) for s in ("", "_lo", "_hi"))
+    text = cost_text(kind, cost)
+    if np.isfinite(lo) and np.isfinite(hi) and (lo != cost or hi != cost):
+        text += f" ({cost_text(kind, lo)} to {cost_text(kind, hi)})"
+    return text
+
+
+def equal_error_cell(r, kind):
+    """One (problem, target) of the opening table: our fastest method, its dt or
+    tolerance and cost; under it the ratio to the fastest peer."""
+    verdict = r["verdict"]
+    cls = VERDICT_CLASS.get(verdict, "")
+    ours, peer = r["ours_method"], r["peer_method"]
+    if ours:
+        param, cost = param_text(r["ours_kind"], r["ours_param"]), cost_text(kind, r["ours_cost"])
+        md = f"{ours} {param}, {cost}"
+        html = f"<b>{esc(ours)}</b> {esc(param)} &middot; {esc(cost)}"
+        if peer:
+            md += f" ({ratio_text(r['ratio'])} {peer})"
+            html += f'<br><span class="small">{esc(ratio_text(r["ratio"]))} {esc(peer)}</span>'
+        else:
+            md += " (no peer reaches it)"
+            html += '<br><span class="small">no peer reaches it</span>'
+        return Cell(md, html, cls)
+    if peer:
+        param, cost = param_text(r["peer_kind"], r["peer_param"]), cost_text(kind, r["peer_cost"])
+        return Cell(f"none of ours; peer {peer} {param}, {cost}",
+                    f'<span class="small">none of ours</span><br>{esc(peer)} {esc(param)} &middot; {esc(cost)}', cls)
+    return Cell("not reached", "&ndash;", cls)
+
+
+def problem_cell(verdict, problem):
+    best = verdict.equal(problem, verdict.targets[0])
+    best_error = float(best["best_error"]) if best is not None else float("nan")
+    unit = verdict.unit(problem)
+    return Cell(f"{problem} [{unit}]", f'<a href="#{esc(problem)}">{esc(problem)}</a> [{esc(unit)}]'
+                f'<br><span class="small">best {esc(fmt_sci(best_error))}</span>')
+
+
+def short(name):
+    return SHORT.get(name, name)
+
+
+def stable_text(rates, shorten=True):
+    """Which of our fixed-step methods are stable at one step a frame, briefly: all, none,
+    or the shorter of the two lists."""
+    name = short if shorten else (lambda n: n)
+    stable = [name(m) for m, s in zip(rates["method"].tolist(), rates["stable"]) if s]
+    unstable = [name(m) for m, s in zip(rates["method"].tolist(), rates["stable"]) if not s]
+    if not len(rates):
+        return "no runs"
+    if not unstable:
+        return f"all {len(stable)} stable"
+    if not stable:
+        return "none stable"
+    if len(unstable) <= len(stable):
+        return "unstable: " + ", ".join(unstable)
+    return "stable: only " + ", ".join(stable)
+
+
+def frame_answers(verdict, problem, hz):
+    """`(target, row)` for each shown target up to the first that no method meets
+    (monotone: a tighter target is not met either)."""
+    out = []
+    for t in verdict.shown_targets:
+        row = verdict.answer(problem, hz, t)
+        if row is None:
+            continue
+        out.append((t, row))
+        if not row["method"]:
+            break
+    return out
+
+
+def frame_cell(verdict, problem, hz):
+    rates = verdict.rates(problem, hz)
+    parts = []
+    for t, row in frame_answers(verdict, problem, hz):
+        if row["method"]:
+            parts.append(f"{target_text(t)} {short(row['method'])} x{int(row['substeps'])}")
+        else:
+            parts.append(f"{target_text(t)} none in 64")
+    md = stable_text(rates) + "; " + ", ".join(parts)
+    html = esc(stable_text(rates)) + '<br><span class="small">' + " &middot; ".join(esc(p) for p in parts) + "</span>"
+    return Cell(md, html)
+
+
+def used_short_names(verdict):
+    names = set(verdict.frame_rate["method"].tolist()) | set(verdict.frame_answer["method"].tolist())
+    return [(s, n) for n, s in SHORT.items() if n in names]
+
+
+def frame_cost_text(kind, row):
+    cost = cost_text(kind, float(row["cost_per_frame"]))
+    share = 100 * float(row["frame_share"])
+    if not np.isfinite(share):
+        return cost
+    return cost + (", under 0.01 % of the frame" if share < 0.01 else f", {share:.2g} % of the frame")
+
+
+# --- the opening of the report -------------------------------------------------------------------
+
+def opening(doc, verdict):
+    """The two tables and the findings the report opens on."""
+    kind = verdict.cost_kind
+    by = "measured time" if kind == "time_ns" else "counted force evaluations"
+    doc.h(2, "Fastest at equal error")
+    shown = verdict.shown_targets
+    head = ["problem [unit]"] + [target_text(t) for t in shown]
+    rows = [[problem_cell(verdict, p)] + [equal_error_cell(r, kind) if (r := verdict.equal(p, t)) is not None else ""
+                                          for t in shown] for p in verdict.problems]
+    doc.table(head, rows, cls="verdict")
+    doc.p(f"Each cell: the fastest of our methods whose max position error over the run (`{verdict.attrs['metric']}`, "
+          f"in the problem's unit) reaches the column's target, its dt or tolerance there and its cost by {by}; under "
+          "it, that cost as a multiple of the fastest library peer's at the same error (0.5x: half the peer's). Green: "
+          "ours ahead beyond the repetition spread; red: behind, or none of ours reaches it; grey: within the spread; "
+          f"best: the lowest error any method reached. Rule: {verdict.attrs['rule']}.", cls="caption")
+    doc.h(2, "At a frame rate")
+    doc.table(["problem [unit]"] + [f"{hz:g} Hz" for hz in verdict.frame_hz],
+              [[problem_cell(verdict, p)] + [frame_cell(verdict, p, hz) for hz in verdict.frame_hz]
+               for p in verdict.problems], cls="frames")
+    key = ", ".join(f"{s} = {n}" for s, n in used_short_names(verdict))
+    doc.p("Each cell: which of our fixed-step methods stay stable at one step a frame (dt = 1 / rate); under it, "
+          "for each error target, the cheapest of them with n substeps a frame (x n, n up to 64) that meets it. "
+          + (f"Short names: {key}." if key else ""), cls="caption")
+    doc.h(2, "Findings")
+    doc.items(verdict.findings or ["(none stored)"])
+
+
+# --- one problem's share -------------------------------------------------------------------------
+
+def problem_section(doc, verdict, problem):
+    v = verdict.only(problem)
+    kind = v.cost_kind
+    unit = v.unit(problem)
+    doc.h(3, f"{problem}: verdict at equal error")
+    rows = []
+    for t in v.targets:
+        r = v.equal(problem, t)
+        if r is None:
+            continue
+        ours = [r["ours_method"], param_text(r["ours_kind"], r["ours_param"]), _spread(kind, r, "ours")] \
+            if r["ours_method"] else ["none", "", ""]
+        peer = [r["peer_method"], param_text(r["peer_kind"], r["peer_param"]), _spread(kind, r, "peer")] \
+            if r["peer_method"] else ["none", "", ""]
+        ratio = ratio_text(r["ratio"]) if np.isfinite(r["ratio"]) else ""
+        rows.append([target_text(t)] + ours + peer + [ratio, r["verdict"]])
+    cost = "time" if kind == "time_ns" else "force evals"
+    doc.table([f"target [{unit}]", "fastest of ours", "its dt or tolerance", f"{cost} (spread)", "fastest peer",
+               "its dt or tolerance", f"{cost} (spread)", "ours / peer", "verdict"], rows)
+    doc.h(3, f"{problem}: at a frame rate")
+    rows = []
+    for hz in v.frame_hz:
+        rates = v.rates(problem, hz)
+        bad = [f"{m} ({note or 'diverged'})" for m, s, note in zip(rates["method"].tolist(), rates["stable"],
+                                                                   rates["note"].tolist()) if not s]
+        good = [m for m, s in zip(rates["method"].tolist(), rates["stable"]) if s]
+        rows.append([f"{hz:g}", ", ".join(good) or "none", ", ".join(bad) or "none"])
+    doc.table(["rate [Hz]", "stable at one step a frame", "not stable"], rows,
+              caption="Our fixed-step methods at one step a frame (dt = 1 / rate):")
+    rows = []
+    for t in v.targets:
+        row = [target_text(t)]
+        for hz in v.frame_hz:
+            a = v.answer(problem, hz, t)
+            row.append(f"{a['method']} x{int(a['substeps'])}: {frame_cost_text(kind, a)}"
+                       if a is not None and a["method"] else "none within 64 substeps")
+        rows.append(row)
+    doc.table([f"target [{unit}]"] + [f"{hz:g} Hz" for hz in v.frame_hz], rows,
+              caption="The cheapest of them with n substeps a frame (x n) within each target, its cost per frame:")
+
+
+# --- summary.json, --markdown, --readme ----------------------------------------------------------
+
+def _plain(v):
+    if isinstance(v, (np.floating, float)):
+        return float(v) if np.isfinite(v) else None
+    if isinstance(v, np.integer):
+        return int(v)
+    if isinstance(v, bytes):
+        return v.decode()
+    return v
+
+
+def _records(rows):
+    return [{name: _plain(r[name]) for name in rows.dtype.names} for r in rows]
+
+
+def summary(study):
+    """summary.json: the verdict tables as stored, and where the study ran."""
+    a = study.attrs
+    out = {"study": study.path, "git_commit": a["git_commit"], "cpu": a["cpu"], "created_utc": a["created_utc"],
+           "timed": study.timed, "verdict": None}
+    v = study.verdict
+    if v is not None:
+        out["verdict"] = {"metric": v.attrs["metric"], "cost_kind": v.cost_kind, "rule": v.attrs["rule"],
+                          "targets": v.targets, "frame_hz": v.frame_hz, "findings": v.findings,
+                          "equal_error": _records(v.equal_error), "frame_rate": _records(v.frame_rate),
+                          "frame_answer": _records(v.frame_answer)}
+    return out
+
+
+def provenance(study):
+    """Where and when the study ran, in one line."""
+    a = study.attrs
+    how = (f"timed by Google Benchmark ({a['benchmark_mode']})" if study.timed
+           else "untimed (costs are force evaluations)")
+    return (f"study `{study.path}`, {how}, stepbench {a['version']} at commit {a['git_commit']}, "
+            f"{a['cpu']} ({int(a['cores'])} cores), {a['created_utc']}")
+
+
+def results_doc(study, command):
+    """--markdown: the answer-first tables as Markdown (docs/results.md)."""
+    from .render import Doc
+    doc = Doc("stepbench results: which integrator for which need")
+    doc.p(f"From the {provenance(study)}. Written by `{command}`; do not edit, run it again.")
+    opening(doc, study.verdict)
+    return doc
+
+
+def readme_block(study, command):
+    """--readme: the headline table (per problem: the fastest of ours at two typical
+    targets and the cheapest at 60 Hz) and the line naming the study."""
+    v = study.verdict
+    kind = v.cost_kind
+    targets = [t for t in README_TARGETS if any(np.isclose(v.targets, t, rtol=1e-9, atol=0))]
+    hz, frame_target = README_FRAME
+    lines = ["| problem | " + " | ".join(f"error {target_text(t)}" for t in targets)
+             + f" | {hz:g} Hz, error {target_text(frame_target)} |",
+             "|---|" + "---|" * (len(targets) + 1)]
+    for p in v.problems:
+        cells = [f"{p} ({v.unit(p)})"]
+        for t in targets:
+            r = v.equal(p, t)
+            cells.append(equal_error_cell(r, kind).md if r is not None else "")
+        a = v.answer(p, hz, frame_target)
+        rates = v.rates(p, hz)
+        if a is not None and a["method"]:
+            cells.append(f"{a['method']} x{int(a['substeps'])}, {frame_cost_text(kind, a)}; "
+                         f"{stable_text(rates, shorten=False)}")
+        else:
+            cells.append(f"none within 64 substeps; {stable_text(rates, shorten=False)}")
+        lines.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
+    a = study.attrs
+    lines += ["", f"Error: `{v.attrs['metric']}`, the max position error over the run, in the problem's unit. "
+              "At an error: the fastest of our methods, its dt or tolerance and its cost, and in brackets that "
+              "cost as a multiple of the fastest library peer's at the same error. At a frame rate: the cheapest of "
+              "our fixed-step methods with n substeps a frame (x n) and its cost per frame, then which of them are "
+              "stable at one step a frame.",
+              "", f"Study `{study.path}`, commit {a['git_commit']}, {a['cpu']}, {a['created_utc']}; written by "
+              f"`{command}`."]
+    return "\n".join(lines)
+
+
+BEGIN, END = "<!-- results:begin -->", "<!-- results:end -->"
+
+
+def rewrite_block(text, block):
+    """`text` with only what lies between the markers replaced by `block`; ValueError
+    when the markers are absent or out of order."""
+    start, end = text.find(BEGIN), text.find(END)
+    if start < 0 or end < 0 or end < start:
+        raise ValueError(f"no '{BEGIN}' ... '{END}' block")
+    return text[:start + len(BEGIN)] + "\n" + block.rstrip("\n") + "\n" + text[end:]

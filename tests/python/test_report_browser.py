@@ -1,0 +1,108 @@
+"""The report as a reader meets it: index.html rendered by headless Chromium in a
+1400 x 900 window. The first screen holds the whole verdict table, every image loads,
+and no table (and so the page) is wider than the window. A copy of index.html beside
+it carries a script that measures the page once everything has loaded and writes the
+measurements into the DOM, which Chromium dumps (--dump-dom).
+
+Skipped only where Chromium is absent (scripts/install-deps.sh installs it)."""
+import html
+import json
+import re
+import shutil
+import subprocess
+
+import pytest
+from test_report import PYTHON, REPORT
+
+WIDTH, HEIGHT = 1400, 900
+CHROMIUM = next((c for c in ("chromium", "chromium-browser", "google-chrome") if shutil.which(c)), None)
+
+MEASURE = """
+<script>
+window.addEventListener("load", function () {
+  var page = document.documentElement.clientWidth;
+  var verdict = document.querySelector("table.verdict");
+  var out = {
+    page: page, inner: [window.innerWidth, window.innerHeight],
+    scroll_width: document.documentElement.scrollWidth,
+    verdict: verdict ? verdict.getBoundingClientRect().toJSON() : null,
+    images: [], tables: []
+  };
+  document.querySelectorAll("img").forEach(function (img) {
+    out.images.push({src: img.getAttribute("src").slice(0, 60), ok: img.complete && img.naturalWidth > 0});
+  });
+  document.querySelectorAll("table").forEach(function (t) {
+    var r = t.getBoundingClientRect();
+    out.tables.push({head: t.rows.length ? t.rows[0].innerText.slice(0, 50) : "", scroll_width: t.scrollWidth,
+                     right: r.right});
+  });
+  var pre = document.createElement("pre");
+  pre.id = "stepbench-measure";
+  pre.textContent = JSON.stringify(out);
+  document.body.appendChild(pre);
+});
+</script>
+"""
+
+
+def measure(index):
+    """The measurements of the page `index` (a pathlib.Path) in a WIDTH x HEIGHT window."""
+    probe = index.with_name(".measure.html")
+    probe.write_text(index.read_text().replace("</body>", MEASURE + "</body>"))
+    try:
+        done = subprocess.run([CHROMIUM, "--headless=new", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
+                               f"--window-size={WIDTH},{HEIGHT}", "--virtual-time-budget=10000", "--dump-dom",
+                               probe.as_uri()], capture_output=True, text=True, timeout=120)
+    finally:
+        probe.unlink()
+    found = re.search(r'<pre id="stepbench-measure">(.*?)</pre>', done.stdout, re.S)
+    assert found, f"no measurements in Chromium's DOM (exit {done.returncode}): {done.stderr[-2000:]}"
+    return json.loads(html.unescape(found.group(1)))
+
+
+@pytest.fixture(scope="module")
+def pages(plain_study, timed_study, tmp_path_factory):
+    """The measurements of the report of each study, the timed one with its figures
+    inlined (--self-contained), and of a report of one problem."""
+    if CHROMIUM is None:
+        pytest.skip("Chromium is not installed (scripts/install-deps.sh installs it)")
+    d = tmp_path_factory.mktemp("browser")
+    out = {}
+    for shape, study, extra in (("plain", plain_study, []), ("timed", timed_study[0], ["--self-contained"]),
+                                ("one problem", plain_study, ["--problem", "pendulum"])):
+        folder = d / shape.replace(" ", "_")
+        p = subprocess.run([PYTHON, REPORT, str(study), "--out", str(folder), "--jobs", "2"] + extra,
+                           capture_output=True, text=True, timeout=300)
+        assert p.returncode == 0, p.stderr
+        out[shape] = measure(folder / "index.html")
+    return out
+
+
+@pytest.mark.parametrize("shape", ["plain", "timed", "one problem"])
+def test_the_first_screen_holds_the_verdict_table(pages, shape):
+    m = pages[shape]
+    # The layout depends on the width alone; Chromium's headless window keeps some of
+    # its height for itself (a viewport of 813 px in a 900 px window), so the fold is
+    # measured against the screen's height, from the top of the page.
+    assert m["inner"][0] == WIDTH, m["inner"]
+    v = m["verdict"]
+    assert v is not None, "no table.verdict"
+    assert 0 <= v["top"] and v["bottom"] <= HEIGHT, v
+    assert v["right"] <= m["page"] + 0.5, v
+
+
+@pytest.mark.parametrize("shape", ["plain", "timed", "one problem"])
+def test_every_image_loads(pages, shape):
+    images = pages[shape]["images"]
+    assert len(images) >= 3
+    assert [i["src"] for i in images if not i["ok"]] == []
+    if shape == "timed":  # --self-contained: the figures are in the page
+        assert all(i["src"].startswith("data:image/png;base64,") for i in images)
+
+
+@pytest.mark.parametrize("shape", ["plain", "timed", "one problem"])
+def test_no_table_is_wider_than_the_page(pages, shape):
+    m = pages[shape]
+    wide = [t for t in m["tables"] if t["scroll_width"] > m["page"] or t["right"] > m["page"] + 0.5]
+    assert wide == [], wide
+    assert m["scroll_width"] <= m["page"], "the page scrolls sideways"

@@ -14,6 +14,7 @@
 #include "cli/commands.hpp"
 #include "core/work_precision.hpp"
 #include "study/compare_render.hpp"
+#include "study/verdict.hpp"
 
 namespace stepbench::cli {
 namespace {
@@ -140,10 +141,24 @@ int run_compare(const compare_args& a) {
     const std::vector<study_data> files = read_studies({a.base, a.next});  // read at once
     const study_data &base = files[0], &next = files[1];
     const comparison c = compare_studies(base, next, opts);
-    if (format == "json")
-      std::cout << comparison_json(c).dump(2) << "\n";
-    else
+    // The equal-error verdicts of two timed studies side by side (informs, never gates).
+    std::optional<verdict_agreement> verdicts;
+    if (c.base_timed && c.new_timed) try {
+        verdicts = compare_verdicts(read_verdict(a.base), read_verdict(a.next));
+      } catch (const std::runtime_error&) {  // a file without /verdict: nothing to set side by side
+      }
+    if (format == "json") {
+      json out = comparison_json(c);
+      if (verdicts)
+        out["verdicts"] = {{"both_decided", verdicts->both_decided},
+                           {"agree", verdicts->agree},
+                           {"decided_in_one", verdicts->decided_in_one},
+                           {"flips", verdicts->flips}};
+      std::cout << out.dump(2) << "\n";
+    } else {
       std::cout << (format == "md" ? format_markdown(c) : format_text(c));
+      if (verdicts) std::cout << "\n" << format_verdict_agreement(*verdicts);
+    }
     std::cout.flush();
     // The verdict on stderr too, where a CI log shows it whatever the output went to.
     if (format != "text") fmt::print(stderr, "stepbench compare: {} (exit {})\n", summary_line(c), c.exit_status());

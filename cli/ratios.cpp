@@ -122,9 +122,9 @@ json equal_error(const study_problem& p, double target, const std::string& metri
   };
   out["ours"] = named(ours);
   out["peer"] = named(peer);
-  // Ahead or behind only when the spreads do not overlap (the repetitions' fastest and
-  // slowest, interpolated like the median).
-  out["spread_verdict"] = ours && peer ? json(compare_at_equal_error(*ours, *peer)) : json(nullptr);
+  // Ahead or behind only beyond the timing noise (core/work_precision.hpp).
+  out["spread_verdict"] =
+      ours && peer ? json(compare_at_equal_error(band_of(*ours), band_of(*peer), r.cost == "time_ns")) : json(nullptr);
   out["peer_over_ours"] = ours && peer && r.cost == "time_ns" ? json(peer->cost / ours->cost) : json(nullptr);
   out["ours_over_peer"] = ours && peer && r.cost == "time_ns" ? json(ours->cost / peer->cost) : json(nullptr);
   out["target_0_5"] = verdict(out["ours_over_peer"].is_null() ? NAN : out["ours_over_peer"].get<double>());
@@ -231,7 +231,7 @@ void print_equal_error(const json& out) {
            {"fastest peer"},
            right_column("peer / ours"),
            right_column("ours / peer"),
-           {"beyond the spread"},
+           {"beyond the noise"},
            {"target <= 0.5"}},
           {}};
   std::string open;

@@ -108,15 +108,18 @@ std::optional<wp_pick> at_equal_error(const wp_method& m, double target, bool by
   return best;
 }
 
-const char* compare_at_equal_error(double a_lo, double a_hi, double b_lo, double b_hi) {
-  constexpr double rounding = 1e-9;
-  if (a_hi < b_lo * (1.0 - rounding)) return "ahead";
-  if (a_lo > b_hi * (1.0 + rounding)) return "behind";
+const char* compare_at_equal_error(const cost_band& a, const cost_band& b, bool timed) {
+  double threshold = 1e-9;
+  if (timed) {
+    const auto spread = [](const cost_band& c) { return c.hi > c.lo ? (c.hi - c.lo) / c.cost : 0.0; };
+    const bool both_spread = a.hi > a.lo && b.hi > b.lo;
+    threshold = std::max(both_spread ? timing_noise_floor : timing_single_run_floor,
+                         timing_spread_multiple * std::max(spread(a), spread(b)));
+  }
+  const double ratio = a.cost / b.cost;
+  if (ratio < 1.0 / (1.0 + threshold)) return "ahead";
+  if (ratio > 1.0 + threshold) return "behind";
   return "within spread";
-}
-
-const char* compare_at_equal_error(const wp_pick& a, const wp_pick& b) {
-  return compare_at_equal_error(a.cost_lo, a.cost_hi, b.cost_lo, b.cost_hi);
 }
 
 cheapest_result cheapest(const std::vector<wp_method>& methods, double target, bool timed, const std::string& metric,

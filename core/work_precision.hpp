@@ -92,12 +92,31 @@ struct cheapest_result {
 // rows are off the curve. `pick.method` is left 0 for the caller to set.
 std::optional<wp_pick> at_equal_error(const wp_method& m, double target, bool by_time, bool timed);
 
-// Two costs at equal error compared with their spreads: "ahead" when a's slowest is
-// below b's fastest, "behind" when a's fastest is above b's slowest, else "within
-// spread". Counted costs (force evaluations) have no spread; they are equal, not ahead,
-// when they agree to 1e-9 relative (the interpolation's rounding).
-const char* compare_at_equal_error(const wp_pick& a, const wp_pick& b);
-const char* compare_at_equal_error(double a_lo, double a_hi, double b_lo, double b_hi);
+// Timing noise, for `stepbench compare` and the equal-error verdict: a row is flagged when new/old > 1 + threshold
+// (slower) or < 1 / (1 + threshold) (faster), threshold = max(floor, 3 x the larger relative spread (max - min) /
+// median of the two files' repetitions). The repetitions are taken back to back, so their spread misses the drift
+// between two runs (clock, load, cache state of the whole machine): two runs of the same build (stepbench_bench
+// --quick, 3 repetitions, a 2-core shared machine) differed by more than 13 % in 5 % of their rows and by more than 23
+// % in 1 %, with within-run spreads of a few percent. Hence floor = 15 % when both sides have at least two repetitions,
+// and 25 % when a side has a single one (no spread to measure at all).
+inline constexpr double timing_noise_floor = 0.15;
+inline constexpr double timing_single_run_floor = 0.25;
+inline constexpr double timing_spread_multiple = 3.0;
+
+// Two costs at equal error: "ahead" when a / b < 1 / (1 + threshold), "behind" when
+// a / b > 1 + threshold, else "within spread", with the threshold of two timings above
+// (the larger of the floor and 3 x either side's relative spread (hi - lo) / cost, the
+// spread interpolated at equal error; the floor for a single repetition when a side
+// has no spread). Back-to-back repetitions miss the drift between runs, which is why
+// the spread alone does not decide: two full runs of the same build flipped a verdict
+// at 1.05x against 0.86x with spreads of 1 %. Counted costs (force evaluations,
+// `timed` false) are exact: equal, not ahead, only within 1e-9 relative (the
+// interpolation's rounding).
+struct cost_band {
+  double cost = 0.0, lo = 0.0, hi = 0.0;
+};
+const char* compare_at_equal_error(const cost_band& a, const cost_band& b, bool timed);
+inline cost_band band_of(const wp_pick& p) { return {p.cost, p.cost_lo, p.cost_hi}; }
 
 // Which methods compete. The two callers genuinely differ:
 //  - every_method: advise and the study file's equal-error table rank every method; one

@@ -43,18 +43,8 @@ inline constexpr double agreement_floor = 1e-13;
 // A stability limit (/stability/limits, theory) that moves by more than this regresses.
 inline constexpr double stability_tolerance = 0.01;
 
-// Timing noise: a row is flagged when new/old > 1 + threshold (slower) or
-// < 1 / (1 + threshold) (faster), threshold = max(floor, 3 x the larger relative spread
-// (max - min) / median of the two files' repetitions). The repetitions are taken back to
-// back, so their spread misses the drift between two runs (clock, load, cache state of
-// the whole machine): two runs of the same build (stepbench_bench --quick, 3
-// repetitions, a 2-core shared machine) differed by more than 13 % in 5 % of their rows
-// and by more than 23 % in 1 %, with within-run spreads of a few percent. Hence floor =
-// 15 % when both sides have at least two repetitions, and 25 % when a side has a single
-// one (no spread to measure at all).
-inline constexpr double timing_noise_floor = 0.15;
-inline constexpr double timing_single_run_floor = 0.25;
-inline constexpr double timing_spread_multiple = 3.0;
+// Timing noise (timing_noise_floor and the rest): core/work_precision.hpp, where the
+// equal-error verdict uses the same band.
 
 struct compare_options {
   double error_factor = 2.0;  // an error or a reference's agreement growing by more than this regresses

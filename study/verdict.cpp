@@ -116,11 +116,12 @@ cost_at_error cost_of(const std::vector<wp_method>& methods, const wp_pick* p) {
   return {m.name, std::string(to_string(m.kind)), p->param, p->cost, p->cost_lo, p->cost_hi};
 }
 
-std::string verdict_of(const cost_at_error& ours, const cost_at_error& peer) {
+std::string verdict_of(const cost_at_error& ours, const cost_at_error& peer, bool timed) {
   if (!ours.found() && !peer.found()) return "not reached";
   if (!peer.found()) return "ours only";
   if (!ours.found()) return "peers only";
-  return compare_at_equal_error(ours.cost_lo, ours.cost_hi, peer.cost_lo, peer.cost_hi);
+  return compare_at_equal_error({ours.cost, ours.cost_lo, ours.cost_hi}, {peer.cost, peer.cost_lo, peer.cost_hi},
+                                timed);
 }
 
 std::string cost_text(const std::string& kind, double c) {
@@ -148,7 +149,7 @@ std::vector<std::string> findings_of(const study& s, const verdict_tables& v) {
     }
     std::string line = fmt::format(
         "At equal error ({}, interpolated on each method's measured curve), the fastest of ours against the "
-        "fastest library peer: ahead on {}, behind on {}, within the repetition spread on {} of the {} "
+        "fastest library peer: ahead on {}, behind on {}, within the timing noise on {} of the {} "
         "problem-and-target pairs both reach; only ours reach {}, only a peer {}.",
         timed ? "measured time" : "force evaluations", ahead, behind, within, ahead + behind + within, ours_only,
         peers_only);
@@ -250,7 +251,7 @@ verdict_tables compute_verdict(const study& s) {
       e.ours = cost_of(methods, ours);
       e.peer = cost_of(methods, peer);
       e.ratio = ours && peer ? ours->cost / peer->cost : nan;
-      e.verdict = verdict_of(e.ours, e.peer);
+      e.verdict = verdict_of(e.ours, e.peer, timed);
       e.best_error = std::isfinite(best_error) ? best_error : nan;
       v.equal_error.push_back(std::move(e));
     }
@@ -304,7 +305,8 @@ void write_verdict(H5::Group& root, const study& s) {
   attr(g, "rule",
        "time (or force evaluations) at equal error, interpolated log-log between the two measured rows that bracket "
        "the target on each method's work-precision curve, never extrapolated; ahead or behind only when the ratio "
-       "lies outside the repetition spread");
+       "lies outside the timing noise: the larger of 15 % (25 % from one repetition) and 3 x the repetitions' "
+       "relative spread, the band stepbench compare uses between two runs");
   {
     std::vector<std::string> problem, unit, om, ok, pm, pk, verdict;
     std::vector<double> target, op, oc, ol, oh, pp, pc, pl, ph, ratio, best;
@@ -476,7 +478,8 @@ std::string format_verdict_text(const verdict_tables& v) {
     }
     out += fmt::format(
         "Fastest of ours at equal error (err_pos_max in the problem's unit, m or rad), and its {} over the fastest "
-        "library peer's: + ahead, - behind, ~ within the repetition spread; (peer) when none of ours reaches it.\n",
+        "library peer's: + ahead, - behind, ~ within the timing noise (15 % or 3x the repetitions' spread); (peer) "
+        "when none of ours reaches it.\n",
         timed ? "time" : "force evaluations");
     out += render_text(tb);
   }
@@ -513,6 +516,39 @@ std::string format_verdict_text(const verdict_tables& v) {
   }
   out += "\nFindings:\n";
   for (const auto& f : v.findings) out += "  - " + f + "\n";
+  return out;
+}
+
+verdict_agreement compare_verdicts(const verdict_tables& base, const verdict_tables& next) {
+  verdict_agreement out;
+  const auto decided = [](const std::string& v) { return v == "ahead" || v == "behind"; };
+  for (const auto& b : base.equal_error)
+    for (const auto& n : next.equal_error) {
+      if (b.problem != n.problem || b.target != n.target) continue;
+      if (decided(b.verdict) && decided(n.verdict)) {
+        ++out.both_decided;
+        if (b.verdict == n.verdict)
+          ++out.agree;
+        else
+          out.flips.push_back(fmt::format("{} at {:g} {}: {} ({:.3g}x {}) -> {} ({:.3g}x {})", b.problem, b.target,
+                                          b.unit, b.verdict, b.ratio, b.ours.method, n.verdict, n.ratio,
+                                          n.ours.method));
+      } else if (decided(b.verdict) != decided(n.verdict) && b.verdict != "ours only" && n.verdict != "ours only" &&
+                 b.verdict != "peers only" && n.verdict != "peers only") {
+        ++out.decided_in_one;
+      }
+    }
+  return out;
+}
+
+std::string format_verdict_agreement(const verdict_agreement& a) {
+  std::string out = fmt::format(
+      "Equal-error verdicts (fastest of ours against the fastest peer): {} of {} problem-and-target pairs decided "
+      "(ahead or behind beyond the timing noise) in both files agree; {} decided in one file are within the noise in "
+      "the "
+      "other.\n",
+      a.agree, a.both_decided, a.decided_in_one);
+  for (const auto& f : a.flips) out += "  flips: " + f + "\n";
   return out;
 }
 

@@ -80,6 +80,17 @@ void write_verdict(H5::Group& root, const study& s);
 std::string format_verdict_text(const study& s);
 std::string format_verdict_text(const verdict_tables& v);
 
+// Two studies' equal-error verdicts side by side (`stepbench compare`): over the
+// (problem, target) pairs where both say "ahead" or "behind", how many agree and which
+// flip; and how many are decided in one and within the spread in the other. Of the same
+// code, a flip means the spread understates the noise; between versions, a change.
+struct verdict_agreement {
+  int both_decided = 0, agree = 0, decided_in_one = 0;
+  std::vector<std::string> flips;  // "pendulum at 1e-06: ahead (0.94x) -> behind (1.03x)"
+};
+verdict_agreement compare_verdicts(const verdict_tables& base, const verdict_tables& next);
+std::string format_verdict_agreement(const verdict_agreement& a);
+
 // Reads /verdict back from a study file (`stepbench advise --hz`); throws
 // std::runtime_error naming what is missing.
 verdict_tables read_verdict(const std::string& path);

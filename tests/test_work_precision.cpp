@@ -113,15 +113,17 @@ TEST(work_precision, cost_at_equal_error_is_interpolated_never_extrapolated) {
   ASSERT_TRUE(coarse.has_value());
   EXPECT_FALSE(coarse->interpolated);
   EXPECT_DOUBLE_EQ(coarse->cost, 100.0);
-  // Ahead or behind only beyond the spread.
-  wp_pick a, b;
-  a.cost_lo = 90, a.cost_hi = 110, b.cost_lo = 105, b.cost_hi = 130;
-  EXPECT_STREQ(compare_at_equal_error(a, b), "within spread");
-  b.cost_lo = 111;
-  EXPECT_STREQ(compare_at_equal_error(a, b), "ahead");
-  EXPECT_STREQ(compare_at_equal_error(b, a), "behind");
-  // Counted costs equal up to the interpolation's rounding are equal.
-  EXPECT_STREQ(compare_at_equal_error(100.0, 100.0, 100.0 * (1 + 1e-12), 100.0 * (1 + 1e-12)), "within spread");
+  // Ahead or behind only beyond the noise band: the larger of 15 % (both sides with a
+  // spread) and 3 x the larger relative spread; 25 % when a side has a single repetition.
+  EXPECT_STREQ(compare_at_equal_error({100, 99, 101}, {114, 113, 115}, true), "within spread");  // 1.14 < 1.15
+  EXPECT_STREQ(compare_at_equal_error({100, 99, 101}, {116, 115, 117}, true), "ahead");
+  EXPECT_STREQ(compare_at_equal_error({116, 115, 117}, {100, 99, 101}, true), "behind");
+  EXPECT_STREQ(compare_at_equal_error({100, 90, 110}, {140, 139, 141}, true), "within spread");  // 3 x 20 % = 60 %
+  EXPECT_STREQ(compare_at_equal_error({100, 90, 110}, {170, 169, 171}, true), "ahead");
+  EXPECT_STREQ(compare_at_equal_error({100, 100, 100}, {120, 119, 121}, true), "within spread");  // single: 25 %
+  // Counted costs are exact: equal up to the interpolation's rounding, else decided.
+  EXPECT_STREQ(compare_at_equal_error({100, 100, 100}, {100 * (1 + 1e-12), 100, 100}, false), "within spread");
+  EXPECT_STREQ(compare_at_equal_error({100, 100, 100}, {101, 101, 101}, false), "ahead");
 }
 
 TEST(work_precision, diverged_everywhere_is_a_reason) {

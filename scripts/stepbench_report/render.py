@@ -52,6 +52,14 @@ class Doc:
     def img(self, src, alt):
         self.blocks.append(("img", src, alt))
 
+    def fold(self, summary):
+        """What follows, up to unfold(), folded in index.html under `summary` (a <details>
+        element, closed); REPORT.md shows it as it is."""
+        self.blocks.append(("fold", summary))
+
+    def unfold(self):
+        self.blocks.append(("unfold",))
+
     def toc(self):
         """Where the contents go in index.html (REPORT.md has none: its viewer lists the headings)."""
         self.blocks.append(("toc",))
@@ -115,6 +123,10 @@ def markdown(doc, for_html=False):
             out += [f"![{alt}]({src})", ""]
         elif kind == "toc" and for_html:
             out += ["[TOC]", ""]
+        elif kind == "fold" and for_html:  # md_in_html: Markdown inside the element is converted
+            out += ['<details markdown="1">', f"<summary>{esc(b[1])}</summary>", ""]
+        elif kind == "unfold" and for_html:
+            out += ["</details>", ""]
     return "\n".join(out).rstrip() + "\n"
 
 
@@ -147,16 +159,19 @@ img { max-width: 100%; height: auto; border: 1px solid #e4e4e4; margin: 0.6em 0 
 blockquote { background: #fff8e1; border-left: 4px solid #f0b400; padding: 0.4em 0.8em; margin: 1em 0; }
 blockquote p { margin: 0; }
 .toc ul { columns: 3; font-size: 0.92em; }
+details { margin: 0.3em 0 0.8em; }
+summary { cursor: pointer; color: #0b57a4; font-size: 0.92em; }
 .toc .toctitle { font-weight: bold; }
 code { font-family: "DejaVu Sans Mono", monospace; font-size: 0.92em; }
 """
 
 
 def to_html(doc, figdir=None):
-    """index.html: the document converted by python3-markdown (its tables, and its toc
-    extension for the heading ids and the contents, second-level headings). `figdir`:
+    """index.html: the document converted by python3-markdown (its tables, its toc
+    extension for the heading ids and the contents, second-level headings, and md_in_html
+    for the folded parts). `figdir`:
     the folder holding the figures, to inline each as a data: URI (one file to send)."""
-    converter = md_lib.Markdown(extensions=["tables", "toc"],
+    converter = md_lib.Markdown(extensions=["tables", "toc", "md_in_html"],
                                 extension_configs={"toc": {"toc_depth": "2-2", "title": "Contents"}})
     body = converter.convert(markdown(doc, for_html=True))
     if figdir is not None:

@@ -204,9 +204,6 @@ def _problem(doc, study, p, figs):
     name = f"work_precision_{p.name}.png"
     if name in figs:
         doc.img(f"fig/{name}", f"work-precision on {p.name}")
-    curves = figures.work_curves(p, primary, study.timed)
-    doc.table(*tables.method_rows(p, curves, figures.labelled(p, primary), primary))
-    doc.h(3, f"{p.name}: Pareto front")
     methods = tables.front_methods(p, primary)
     text = (f"Methods on the front by {'time' if study.timed else 'force evaluations'}: "
             + (", ".join(methods) if methods else "none") + ".")
@@ -214,31 +211,40 @@ def _problem(doc, study, p, figs):
         by_evals = tables.front_methods(p, "force_evals")
         text += " By force evaluations: " + (", ".join(by_evals) if by_evals else "none") + "."
     doc.p(text)
+    doc.fold(f"{p.name}: every method of the figure, the front run by run, the adaptive methods")
+    doc.table(*tables.method_rows(p, figures.work_curves(p, primary, study.timed), figures.labelled(p, primary),
+                                  primary))
+    doc.h(4, f"{p.name}: Pareto front")
     doc.table(*tables.front_rows(p, primary))
     rows = tables.adaptive_rows(p)
     if rows:
         doc.h(4, f"{p.name}: adaptive methods")
         doc.table(tables.ADAPTIVE_HEAD, rows)
+    doc.unfold()
     doc.h(3, f"{p.name}: convergence")
     name = f"convergence_{p.name}.png"
     if name in figs:
         doc.img(f"fig/{name}", f"convergence on {p.name}")
+    doc.fold(f"{p.name}: observed orders")
     doc.h(4, f"{p.name}: observed order")
     doc.table(tables.ORDER_HEAD, tables.order_rows(p))
+    doc.unfold()
     name = f"energy_drift_{p.name}.png"
     if name in figs:
         doc.h(3, f"{p.name}: energy at the horizon")
         doc.img(f"fig/{name}", f"energy drift at the horizon on {p.name}")
-    doc.h(3, f"{p.name}: cheapest measured run")
+    doc.h(3, f"{p.name}: measured runs and references")
+    doc.fold(f"{p.name}: the cheapest measured run per target, the reference solutions")
     for metric, title in tables.SUMMARY_METRICS:
         doc.h(4, f"{p.name}: cheapest {title}")
         doc.table(*tables.summary_rows(p, metric))
-    doc.h(3, f"{p.name}: references")
+    doc.h(4, f"{p.name}: references")
     rows = tables.reference_rows(p)
     if rows:
         doc.table(tables.REFERENCE_HEAD, rows)
     else:
         doc.p("No references recorded.")
+    doc.unfold()
 
 
 def _how_made(doc, study):

@@ -222,7 +222,7 @@ def frame_cost_text(kind, row):
     share = 100 * float(row["frame_share"])
     if not np.isfinite(share):
         return cost
-    return cost + (", under 0.01 % of the frame" if share < 0.01 else f", {share:.2g} % of the frame")
+    return cost + (" (< 0.01 %)" if share < 0.01 else f" ({share:.2g} %)")
 
 
 # --- the opening of the report -------------------------------------------------------------------
@@ -294,7 +294,8 @@ def problem_section(doc, verdict, problem):
                        if a is not None and a["method"] else "none within 64 substeps")
         rows.append(row)
     doc.table([f"target [{unit}]"] + [f"{hz:g} Hz" for hz in v.frame_hz], rows,
-              caption="The cheapest of them with n substeps a frame (x n) within each target, its cost per frame:")
+              caption="The cheapest of them with n substeps a frame (x n) within each target, its cost per frame "
+                      "(in brackets, in a timed study: its share of the frame):")
 
 
 # --- summary.json, --markdown, --readme ----------------------------------------------------------
@@ -372,8 +373,8 @@ def readme_block(study, command):
     lines += ["", f"Error: `{v.attrs['metric']}`, the max position error over the run, in the problem's unit. "
               "At an error: the fastest of our methods, its dt or tolerance and its cost, and in brackets that "
               "cost as a multiple of the fastest library peer's at the same error. At a frame rate: the cheapest of "
-              "our fixed-step methods with n substeps a frame (x n) and its cost per frame, then which of them are "
-              "stable at one step a frame.",
+              "our fixed-step methods with n substeps a frame (x n) and its cost per frame (in brackets: its share of "
+              "the frame), then which of them are stable at one step a frame.",
               "", f"Study `{study.path}`, commit {a['git_commit']}, {a['cpu']}, {a['created_utc']}; written by "
               f"`{command}`."]
     return "\n".join(lines)

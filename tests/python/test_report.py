@@ -248,7 +248,7 @@ def test_front_tables_are_the_files_fronts(reports, shape):
     front = "front_time" if shape == "timed" else "front_force_evals"
     with h5py.File(study) as f:
         for pname, g in f["problems"].items():
-            _, rows = md_table(md, f"### {pname}: Pareto front")
+            _, rows = md_table(md, f"#### {pname}: Pareto front")
             names = [text(m) for m in g[front]["method"]]
             merged = [n for i, n in enumerate(names) if i == 0 or names[i - 1] != n]
             assert [r[0].replace(" (peer)", "") for r in rows] == merged, pname
@@ -261,7 +261,7 @@ def test_references_table_matches_the_file(reports):
     md = report_text(folder)
     with h5py.File(study) as f:
         for pname, g in f["problems"].items():
-            table = md_dict(md, f"### {pname}: references")
+            table = md_dict(md, f"#### {pname}: references")
             for src, ref in g["reference"].items():
                 row = table[src]
                 reason = text(ref.attrs["reason"]) if "reason" in ref.attrs else ""

@@ -1,8 +1,8 @@
 """The report as a reader meets it: index.html rendered by headless Chromium in a
 1400 x 900 window. The first screen holds the whole verdict table, every image loads,
-and no table (and so the page) is wider than the window. A copy of index.html beside
-it carries a script that measures the page once everything has loaded and writes the
-measurements into the DOM, which Chromium dumps (--dump-dom).
+and no table, folded or not (and so the page), is wider than the window. A copy of
+index.html beside it carries a script that measures the page once everything has
+loaded and writes the measurements into the DOM, which Chromium dumps (--dump-dom).
 
 Skipped only where Chromium is absent (scripts/install-deps.sh installs it)."""
 import html
@@ -28,6 +28,8 @@ window.addEventListener("load", function () {
     verdict: verdict ? verdict.getBoundingClientRect().toJSON() : null,
     images: [], tables: []
   };
+  // The folded tables too: open every <details> before measuring the tables.
+  document.querySelectorAll("details").forEach(function (d) { d.open = true; });
   document.querySelectorAll("img").forEach(function (img) {
     out.images.push({src: img.getAttribute("src").slice(0, 60), ok: img.complete && img.naturalWidth > 0});
   });

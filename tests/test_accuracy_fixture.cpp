@@ -47,7 +47,9 @@ TEST(accuracy_fixture, our_rows_are_bit_identical) {
     const method_study* ms = find(key);
     ASSERT_NE(ms, nullptr) << key;
     const auto& rows = expected["rows"];
-    ASSERT_EQ(ms->rows.size(), rows.size()) << key;
+    // The fixture's ladder ends at tol 1e-12; the study's runs on to 1e-14 (issue 18), its
+    // first rows the same tolerances in the same order.
+    ASSERT_EQ(ms->rows.size(), rows.size() + (ms->info.kind == method_kind::adaptive ? 2 : 0)) << key;
     for (std::size_t i = 0; i < rows.size(); ++i) {
       const auto& r = rows[i];
       const auto& got = ms->rows[i];
@@ -78,7 +80,9 @@ TEST(accuracy_fixture, peer_errors_agree_with_the_old_benchmark) {
     const method_study* ms = find(key);
     ASSERT_NE(ms, nullptr) << key;
     const auto& rows = expected["rows"];
-    ASSERT_EQ(ms->rows.size(), rows.size()) << key;
+    // The fixture's ladder ends at tol 1e-12; the study's runs on to 1e-14 (issue 18), its
+    // first rows the same tolerances in the same order.
+    ASSERT_EQ(ms->rows.size(), rows.size() + (ms->info.kind == method_kind::adaptive ? 2 : 0)) << key;
     for (std::size_t i = 0; i < rows.size(); ++i) {
       const auto& r = rows[i];
       const auto& got = ms->rows[i];

@@ -46,7 +46,9 @@ std::optional<wp_pick> at_equal_error(const wp_method& m, double target, bool by
   for (std::size_t i = 0; i < m.rows.size(); ++i) {
     const auto& r = m.rows[i];
     const double c = cost_of(r);
-    if (r.completed && std::isfinite(r.error) && r.error > 0.0 && std::isfinite(c) && c > 0.0 && !(timed && r.cut))
+    // An error of exactly 0 (a method exact for the problem) is on the curve: it meets
+    // every target, and bounds the cost like any row that does.
+    if (r.completed && std::isfinite(r.error) && r.error >= 0.0 && std::isfinite(c) && c > 0.0 && !(timed && r.cut))
       curve.push_back(i);
   }
   // The spread of a row's cost: its fastest and slowest repetition when timed and
@@ -74,19 +76,18 @@ std::optional<wp_pick> at_equal_error(const wp_method& m, double target, bool by
   const auto consider = [&](const wp_pick& p) {
     if (!best || p.cost < best->cost) best = p;
   };
-  // An upper bound: the coarsest row of the curve already at or under the target (no
-  // cheaper row was measured, and the curve is not extrapolated beyond it).
-  if (!curve.empty() && m.rows[curve.front()].error <= target) consider(at_row(curve.front()));
-  // Log-log interpolation between neighbours that bracket the target.
+  // Upper bounds: every measured row at or under the target (the curve is not
+  // extrapolated beyond the coarsest, and on a curve whose cost does not rise steadily,
+  // an adaptive method's or a noisy timing's, a measured row may undercut a crossing).
+  for (const std::size_t i : curve)
+    if (m.rows[i].error <= target) consider(at_row(i));
+  // Log-log interpolation between neighbours that bracket the target (both errors
+  // positive: a row of error 0 is a bound above, not a point of a log-log line).
   const double lt = std::log(target);
   for (std::size_t k = 0; k + 1 < curve.size(); ++k) {
     const auto &a = m.rows[curve[k]], &b = m.rows[curve[k + 1]];
     const bool brackets = (a.error >= target && b.error <= target) || (a.error <= target && b.error >= target);
-    if (!brackets) continue;
-    if (a.error == b.error) {  // flat at exactly the target: the cheaper row
-      consider(at_row(cost_of(a) <= cost_of(b) ? curve[k] : curve[k + 1]));
-      continue;
-    }
+    if (!brackets || a.error == b.error || a.error == 0.0 || b.error == 0.0) continue;
     const double s = (lt - std::log(a.error)) / (std::log(b.error) - std::log(a.error));
     const auto lerp = [&](double va, double vb) {
       if (!(std::isfinite(va) && std::isfinite(vb) && va > 0.0 && vb > 0.0))

@@ -9,16 +9,16 @@
 // diverge or fail), its error is finite and positive, its cost is measured and, in a
 // timed study, its timing was not cut by the time budget. The cost at a target error is
 // interpolated log-log between two rows next to each other on the ladder whose errors
-// bracket the target (log cost and log param linear in log error), never extrapolated:
-// a method whose coarsest row already meets the target is charged that row's cost (an
-// upper bound, flagged `interpolated = false`), and one whose finest row misses it does
-// not reach it. Where the curve crosses the target more than once (a pre-asymptotic
-// bump, a round-off plateau) the cheapest crossing counts. The repetition spread
-// (fastest and slowest repetition) is interpolated the same way, so a comparison can
-// say whether two methods differ by more than the noise. Interpolating the curve, as
-// work-precision comparisons in the field do (DiffEqDevTools, SciMLBenchmarks), removes
-// the factor-2 quantisation of "the cheapest rung that reaches the target" on a halving
-// ladder, which flipped verdicts between two runs of the same code.
+// bracket the target (log cost and log param linear in log error), never extrapolated.
+// Every measured row at or under the target bounds the cost from above (a method whose
+// coarsest row already meets the target is charged that row's cost, flagged
+// `interpolated = false`; a row of error exactly 0, a method exact for the problem, is
+// such a bound); one whose finest row misses the target does not reach it. Where the curve crosses the target more than
+// once (a pre-asymptotic bump, a round-off plateau) the cheapest crossing counts. The repetition spread (fastest and
+// slowest repetition) is interpolated the same way, so a comparison can say whether two methods differ by more than the
+// noise. Interpolating the curve, as work-precision comparisons in the field do (DiffEqDevTools, SciMLBenchmarks),
+// removes the factor-2 quantisation of "the cheapest rung that reaches the target" on a halving ladder, which flipped
+// verdicts between two runs of the same code.
 //
 // The cost is the measured time (the median wall time of one whole run) when every
 // competing method's curve is timed, else the counted force evaluations. Methods are
@@ -65,7 +65,7 @@ struct wp_pick {
   double param = 0.0;                       // the dt or tolerance at equal error, interpolated the same way
   double error = 0.0;                       // the target, or the bounding row's error
   double time_ns = 0.0, force_evals = 0.0;  // both costs at equal error (time NaN when untimed)
-  bool interpolated = false;  // between two bracketing rows; false: the coarsest row already met the target
+  bool interpolated = false;  // between two bracketing rows; false: a measured row under the target (a bound)
   // The params at which this method diverged: the largest and smallest (the edge of
   // stability seen in the study) and how many rows; nullopt if never.
   std::optional<double> largest_diverged, smallest_diverged;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <set>
 #include <stdexcept>
 
 #include "study/h5.hpp"
@@ -130,7 +131,9 @@ frame_advice advise_frame(const std::string& path, const std::string& problem, d
   f.problem = problem;
   f.hz = hz;
   f.tol = tol;
-  h5::table_data runs;
+  std::vector<double> rate, substeps, completed, diverged, err, cost;
+  std::vector<std::string> method, note;
+  std::size_t rows = 0;
   try {
     if (!std::filesystem::exists(path)) throw std::runtime_error("no such file");
     if (!H5::H5File::isHdf5(path)) throw std::runtime_error("not an HDF5 file");
@@ -145,7 +148,11 @@ frame_advice advise_frame(const std::string& path, const std::string& problem, d
     const H5::Group g = all.openGroup(problem);
     f.unit = h5::string_attr(g, "position_unit");
     f.horizon = h5::double_attr(g, "horizon");
-    runs = h5::read_table(g.openDataSet("runs"));
+    const h5::table_data runs = h5::read_table(g.openDataSet("runs"));
+    rows = runs.rows();
+    rate = runs.doubles("hz"), substeps = runs.doubles("substeps"), completed = runs.doubles("completed");
+    diverged = runs.doubles("diverged"), err = runs.doubles("err_pos_max"), cost = runs.doubles("cost_per_frame");
+    method = runs.strings("method"), note = runs.strings("note");
   } catch (const H5::Exception& e) {
     throw std::runtime_error(fmt::format("cannot read study file '{}': {}", path, e.getDetailMsg()));
   } catch (const std::invalid_argument&) {
@@ -153,10 +160,6 @@ frame_advice advise_frame(const std::string& path, const std::string& problem, d
   } catch (const std::runtime_error& e) {
     throw std::runtime_error(fmt::format("cannot read study file '{}': {}", path, e.what()));
   }
-  const auto rate = runs.doubles("hz"), substeps = runs.doubles("substeps"), completed = runs.doubles("completed"),
-             diverged = runs.doubles("diverged"), err = runs.doubles("err_pos_max"),
-             cost = runs.doubles("cost_per_frame");
-  const auto &method = runs.strings("method"), &note = runs.strings("note");
   std::vector<double> rates;
   for (double r : rate)
     if (std::find(rates.begin(), rates.end(), r) == rates.end()) rates.push_back(r);
@@ -165,7 +168,8 @@ frame_advice advise_frame(const std::string& path, const std::string& problem, d
         fmt::format("--hz {:g}: the study ran {} at {} Hz only", hz, problem, fmt::join(rates, ", ")));
   std::map<std::string, frame_option> best, closest;  // per method: cheapest meeting tol; lowest error
   std::vector<std::string> order;
-  for (std::size_t i = 0; i < runs.rows(); ++i) {
+  std::set<std::string> untimed;  // meets the tolerance in a run the benchmark did not time
+  for (std::size_t i = 0; i < rows; ++i) {
     if (rate[i] != hz) continue;
     frame_option o{method[i], note[i], static_cast<int>(substeps[i]), completed[i] != 0, diverged[i] != 0,
                    err[i],    cost[i]};
@@ -173,6 +177,7 @@ frame_advice advise_frame(const std::string& path, const std::string& problem, d
     if (o.substeps == 1) f.one_step.push_back(o);
     if (!o.completed || !std::isfinite(o.err_pos_max)) continue;
     if (!closest.count(o.method) || o.err_pos_max < closest[o.method].err_pos_max) closest[o.method] = o;
+    if (o.err_pos_max <= tol && !std::isfinite(o.cost_per_frame)) untimed.insert(o.method);
     if (o.err_pos_max <= tol && std::isfinite(o.cost_per_frame) &&
         (!best.count(o.method) || o.cost_per_frame < best[o.method].cost_per_frame))
       best[o.method] = o;
@@ -180,6 +185,9 @@ frame_advice advise_frame(const std::string& path, const std::string& problem, d
   for (const auto& m : order) {
     if (best.count(m))
       f.ranked.push_back(best[m]);
+    else if (untimed.count(m))
+      f.not_meeting.push_back(
+          fmt::format("{}: meets it, but the benchmark did not time it on {} (no cost a frame)", m, problem));
     else if (closest.count(m))
       f.not_meeting.push_back(fmt::format("{}: best {:.3g} {} at {} substep{}", m, closest[m].err_pos_max, f.unit,
                                           closest[m].substeps, closest[m].substeps == 1 ? "" : "s"));
@@ -225,7 +233,7 @@ std::string format_frame_advice(const frame_advice& f) {
     out += "also meeting it:\n" + render_text(t);
   }
   if (!f.not_meeting.empty()) {
-    out += "not meeting it:\n";
+    out += "not ranked:\n";
     for (const auto& n : f.not_meeting) out += "  " + n + "\n";
   }
   table t{{{"method"}, {"one step a frame"}, right_column("err_pos_max", f.unit)}, {}};

@@ -128,11 +128,17 @@ constexpr field substeps_verdict_fields[] = {{"implicit_method", str},
                                              {"cost_to_match", f64},
                                              {"summary", str}};
 
-constexpr field verdict_equal_error_fields[] = {
-    {"problem", str},    {"unit", str},       {"target", f64},       {"ours_method", str},  {"ours_kind", str},
-    {"ours_param", f64}, {"ours_cost", f64},  {"ours_cost_lo", f64}, {"ours_cost_hi", f64}, {"peer_method", str},
-    {"peer_kind", str},  {"peer_param", f64}, {"peer_cost", f64},    {"peer_cost_lo", f64}, {"peer_cost_hi", f64},
-    {"ratio", f64},      {"verdict", str},    {"best_error", f64}};
+constexpr field verdict_equal_error_fields[] = {{"problem", str},          {"unit", str},
+                                                {"target", f64},           {"ours_method", str},
+                                                {"ours_kind", str},        {"ours_param", f64},
+                                                {"ours_cost", f64},        {"ours_cost_lo", f64},
+                                                {"ours_cost_hi", f64},     {"ours_interpolated", i8},
+                                                {"peer_method", str},      {"peer_kind", str},
+                                                {"peer_param", f64},       {"peer_cost", f64},
+                                                {"peer_cost_lo", f64},     {"peer_cost_hi", f64},
+                                                {"peer_interpolated", i8}, {"ratio", f64},
+                                                {"cost_kind", str},        {"verdict", str},
+                                                {"best_error", f64}};
 constexpr field frame_rate_fields[] = {{"problem", str}, {"unit", str},        {"hz", f64},  {"method", str},
                                        {"stable", i8},   {"err_pos_max", f64}, {"note", str}};
 constexpr field frame_answer_fields[] = {{"problem", str},     {"unit", str},           {"hz", f64},

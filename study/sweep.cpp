@@ -46,6 +46,15 @@ void validate(const sweep_options& opts) {
   for (double tol : opts.tolerances)
     if (!(tol > 0.0 && tol < 1.0)) throw std::invalid_argument(fmt::format("tolerance {:g} is not in (0, 1)", tol));
   for (const auto& name : opts.methods) find_method(name);
+  // The frame-rate study's truth is built at the fastest rate's frame ends and read at
+  // every rate's: each rate must divide the fastest.
+  if (!opts.frame_rates.hz.empty()) {
+    const double fastest = *std::max_element(opts.frame_rates.hz.begin(), opts.frame_rates.hz.end());
+    for (double hz : opts.frame_rates.hz)
+      if (!(hz > 0.0) || std::abs(fastest / hz - std::round(fastest / hz)) > 1e-9)
+        throw std::invalid_argument(
+            fmt::format("frame rate {:g} Hz does not divide the fastest, {:g} Hz", hz, fastest));
+  }
   for (const auto* names : {&opts.problems, &opts.methods})
     for (size_t i = 0; i < names->size(); ++i)
       for (size_t j = 0; j < i; ++j)

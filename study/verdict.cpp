@@ -113,15 +113,18 @@ const problem_study* find_problem(const study& s, std::string_view name) {
 cost_at_error cost_of(const std::vector<wp_method>& methods, const wp_pick* p) {
   if (!p) return {};
   const auto& m = methods[p->method];
-  return {m.name, std::string(to_string(m.kind)), p->param, p->cost, p->cost_lo, p->cost_hi};
+  return {m.name, std::string(to_string(m.kind)), p->param, p->cost, p->cost_lo, p->cost_hi, p->interpolated};
 }
 
 std::string verdict_of(const cost_at_error& ours, const cost_at_error& peer, bool timed) {
   if (!ours.found() && !peer.found()) return "not reached";
   if (!peer.found()) return "ours only";
   if (!ours.found()) return "peers only";
-  return compare_at_equal_error({ours.cost, ours.cost_lo, ours.cost_hi}, {peer.cost, peer.cost_lo, peer.cost_hi},
-                                timed);
+  const std::string v =
+      compare_at_equal_error({ours.cost, ours.cost_lo, ours.cost_hi}, {peer.cost, peer.cost_lo, peer.cost_hi}, timed);
+  // An upper bound on the side found cheaper proves nothing: its true cost may be lower.
+  if ((v == "ahead" && !peer.interpolated) || (v == "behind" && !ours.interpolated)) return "bounded";
+  return v;
 }
 
 std::string cost_text(const std::string& kind, double c) {
@@ -135,13 +138,14 @@ std::vector<std::string> findings_of(const study& s, const verdict_tables& v) {
   const bool timed = v.cost_kind == "time_ns";
   // Equal error.
   {
-    int ahead = 0, behind = 0, within = 0, ours_only = 0, peers_only = 0;
+    int ahead = 0, behind = 0, within = 0, bounded = 0, ours_only = 0, peers_only = 0;
     const equal_error_verdict* best_win = nullptr;
     const equal_error_verdict* worst_loss = nullptr;
     for (const auto& e : v.equal_error) {
       if (e.verdict == "ahead") ++ahead;
       if (e.verdict == "behind") ++behind;
       if (e.verdict == "within spread") ++within;
+      if (e.verdict == "bounded") ++bounded;
       if (e.verdict == "ours only") ++ours_only;
       if (e.verdict == "peers only") ++peers_only;
       if (e.verdict == "ahead" && (!best_win || e.ratio < best_win->ratio)) best_win = &e;
@@ -149,13 +153,15 @@ std::vector<std::string> findings_of(const study& s, const verdict_tables& v) {
     }
     std::string line = fmt::format(
         "At equal error ({}, interpolated on each method's measured curve), the fastest of ours against the "
-        "fastest library peer: ahead on {}, behind on {}, within the timing noise on {} of the {} "
-        "problem-and-target pairs both reach; only ours reach {}, only a peer {}.",
-        timed ? "measured time" : "force evaluations", ahead, behind, within, ahead + behind + within, ours_only,
-        peers_only);
+        "fastest library peer: ahead on {}, behind on {}, within the {} on {}, undecided on {} (the side found "
+        "cheaper only bounded: its ladder does not bracket the target) of the {} problem-and-target pairs both "
+        "reach; only ours reach {}, only a peer {}.",
+        timed ? "measured time" : "force evaluations", ahead, behind, timed ? "timing noise" : "rounding", within,
+        bounded, ahead + behind + within + bounded, ours_only, peers_only);
     if (best_win)
-      line += fmt::format(" Largest lead: {} on {} at {:g} {} ({:.2g}x the time of {}).", best_win->ours.method,
-                          best_win->problem, best_win->target, best_win->unit, best_win->ratio, best_win->peer.method);
+      line += fmt::format(" Largest lead: {} on {} at {:g} {} ({:.2g}x the {} of {}).", best_win->ours.method,
+                          best_win->problem, best_win->target, best_win->unit, best_win->ratio,
+                          timed ? "time" : "force evaluations", best_win->peer.method);
     if (worst_loss)
       line += fmt::format(" Largest deficit: {} on {} at {:g} {} ({:.2g}x {}).", worst_loss->ours.method,
                           worst_loss->problem, worst_loss->target, worst_loss->unit, worst_loss->ratio,
@@ -210,7 +216,10 @@ std::vector<std::string> findings_of(const study& s, const verdict_tables& v) {
     std::map<std::string, std::vector<std::string>> unstable;  // problem -> methods
     for (const auto& f : v.frame_rate)
       if (f.hz == 60.0 && !f.stable) unstable[f.problem].push_back(f.method);
-    if (unstable.empty()) {
+    const bool any_60 =
+        std::any_of(v.frame_rate.begin(), v.frame_rate.end(), [](const auto& f) { return f.hz == 60.0; });
+    if (!any_60) {
+    } else if (unstable.empty()) {
       out.push_back("At 60 Hz, one step a frame, every fixed-step method of ours stays stable on every problem.");
     } else {
       std::string parts;
@@ -251,7 +260,8 @@ verdict_tables compute_verdict(const study& s) {
       e.ours = cost_of(methods, ours);
       e.peer = cost_of(methods, peer);
       e.ratio = ours && peer ? ours->cost / peer->cost : nan;
-      e.verdict = verdict_of(e.ours, e.peer, timed);
+      e.cost_kind = r.cost;
+      e.verdict = verdict_of(e.ours, e.peer, r.cost == "time_ns");
       e.best_error = std::isfinite(best_error) ? best_error : nan;
       v.equal_error.push_back(std::move(e));
     }
@@ -297,7 +307,7 @@ void write_verdict(H5::Group& root, const study& s) {
   H5::Group g = root.createGroup("verdict");
   attr(g, "metric", metric);
   attr(g, "targets", verdict_targets());
-  attr(g, "frame_hz", frame_rate_options{}.hz);
+  attr(g, "frame_hz", s.options.frame_rates.hz);
   attr(g, "cost_kind", v.cost_kind);
   std::string findings;
   for (const auto& f : v.findings) findings += (findings.empty() ? "" : "\n") + f;
@@ -308,8 +318,9 @@ void write_verdict(H5::Group& root, const study& s) {
        "lies outside the timing noise: the larger of 15 % (25 % from one repetition) and 3 x the repetitions' "
        "relative spread, the band stepbench compare uses between two runs");
   {
-    std::vector<std::string> problem, unit, om, ok, pm, pk, verdict;
+    std::vector<std::string> problem, unit, om, ok, pm, pk, verdict, cost_kind;
     std::vector<double> target, op, oc, ol, oh, pp, pc, pl, ph, ratio, best;
+    std::vector<std::int8_t> oi, pi;
     for (const auto& e : v.equal_error) {
       problem.push_back(e.problem);
       unit.push_back(e.unit);
@@ -320,13 +331,16 @@ void write_verdict(H5::Group& root, const study& s) {
       oc.push_back(e.ours.found() ? e.ours.cost : nan);
       ol.push_back(e.ours.found() ? e.ours.cost_lo : nan);
       oh.push_back(e.ours.found() ? e.ours.cost_hi : nan);
+      oi.push_back(static_cast<std::int8_t>(e.ours.interpolated));
       pm.push_back(e.peer.method);
       pk.push_back(e.peer.kind);
       pp.push_back(e.peer.found() ? e.peer.param : nan);
       pc.push_back(e.peer.found() ? e.peer.cost : nan);
       pl.push_back(e.peer.found() ? e.peer.cost_lo : nan);
       ph.push_back(e.peer.found() ? e.peer.cost_hi : nan);
+      pi.push_back(static_cast<std::int8_t>(e.peer.interpolated));
       ratio.push_back(e.ratio);
+      cost_kind.push_back(e.cost_kind);
       verdict.push_back(e.verdict);
       best.push_back(e.best_error);
     }
@@ -340,13 +354,16 @@ void write_verdict(H5::Group& root, const study& s) {
     t.add("ours_cost", oc);
     t.add("ours_cost_lo", ol);
     t.add("ours_cost_hi", oh);
+    t.add("ours_interpolated", oi);
     t.add("peer_method", pm);
     t.add("peer_kind", pk);
     t.add("peer_param", pp);
     t.add("peer_cost", pc);
     t.add("peer_cost_lo", pl);
     t.add("peer_cost_hi", ph);
+    t.add("peer_interpolated", pi);
     t.add("ratio", ratio);
+    t.add("cost_kind", cost_kind);
     t.add("verdict", verdict);
     t.add("best_error", best);
     t.write(g, "equal_error", schema::find("verdict_equal_error"));
@@ -465,9 +482,10 @@ std::string format_verdict_text(const verdict_tables& v) {
             cell = e.ours.method;
             if (std::isfinite(e.ratio))
               cell += fmt::format(" {:.2g}x{}", e.ratio,
-                                  e.verdict == "ahead"    ? "+"
-                                  : e.verdict == "behind" ? "-"
-                                                          : "~");
+                                  e.verdict == "ahead"     ? "+"
+                                  : e.verdict == "behind"  ? "-"
+                                  : e.verdict == "bounded" ? "?"
+                                                           : "~");
           } else if (e.peer.found()) {
             cell = "(" + e.peer.method + ")";
           }
@@ -478,9 +496,11 @@ std::string format_verdict_text(const verdict_tables& v) {
     }
     out += fmt::format(
         "Fastest of ours at equal error (err_pos_max in the problem's unit, m or rad), and its {} over the fastest "
-        "library peer's: + ahead, - behind, ~ within the timing noise (15 % or 3x the repetitions' spread); (peer) "
-        "when none of ours reaches it.\n",
-        timed ? "time" : "force evaluations");
+        "library peer's: + ahead, - behind, ~ within the {}, ? undecided (the cheaper side's cost only bounded: "
+        "its ladder does not bracket the target); (peer) when none of ours reaches it.\n",
+        timed ? "time" : "force evaluations",
+        timed ? "timing noise (the larger of 15 %, 25 % from a single repetition, and 3x the repetitions' spread)"
+              : "interpolation's rounding");
     out += render_text(tb);
   }
   // The frame-rate table at 60 Hz.
@@ -571,18 +591,20 @@ verdict_tables read_verdict(const std::string& path) {
       const auto t = h5::read_table(g.openDataSet("equal_error"));
       const auto &problem = t.strings("problem"), &unit = t.strings("unit"), &om = t.strings("ours_method"),
                  &ok = t.strings("ours_kind"), &pm = t.strings("peer_method"), &pk = t.strings("peer_kind"),
-                 &verdict = t.strings("verdict");
+                 &verdict = t.strings("verdict"), &cost_kind = t.strings("cost_kind");
       const auto target = t.doubles("target"), op = t.doubles("ours_param"), oc = t.doubles("ours_cost"),
                  ol = t.doubles("ours_cost_lo"), oh = t.doubles("ours_cost_hi"), pp = t.doubles("peer_param"),
                  pc = t.doubles("peer_cost"), pl = t.doubles("peer_cost_lo"), ph = t.doubles("peer_cost_hi"),
-                 ratio = t.doubles("ratio"), best = t.doubles("best_error");
+                 ratio = t.doubles("ratio"), best = t.doubles("best_error"), oi = t.doubles("ours_interpolated"),
+                 pi = t.doubles("peer_interpolated");
       for (std::size_t i = 0; i < t.rows(); ++i)
         v.equal_error.push_back({problem[i],
                                  unit[i],
                                  target[i],
-                                 {om[i], ok[i], op[i], oc[i], ol[i], oh[i]},
-                                 {pm[i], pk[i], pp[i], pc[i], pl[i], ph[i]},
+                                 {om[i], ok[i], op[i], oc[i], ol[i], oh[i], oi[i] != 0},
+                                 {pm[i], pk[i], pp[i], pc[i], pl[i], ph[i], pi[i] != 0},
                                  ratio[i],
+                                 cost_kind[i],
                                  verdict[i],
                                  best[i]});
     }

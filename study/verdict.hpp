@@ -36,6 +36,7 @@ std::vector<double> verdict_targets();
 struct cost_at_error {
   std::string method, kind;  // empty method: none reaches the target
   double param = 0.0, cost = 0.0, cost_lo = 0.0, cost_hi = 0.0;
+  bool interpolated = false;  // false: an upper bound (a measured row under the target)
   bool found() const { return !method.empty(); }
 };
 
@@ -43,8 +44,12 @@ struct equal_error_verdict {
   std::string problem, unit;
   double target = 0.0;
   cost_at_error ours, peer;
-  double ratio = 0.0;   // ours / peer; NaN unless both
-  std::string verdict;  // "ahead", "behind", "within spread", "ours only", "peers only", "not reached"
+  double ratio = 0.0;     // ours / peer; NaN unless both
+  std::string cost_kind;  // time_ns or force_evals: what ranked this target (core/work_precision.hpp)
+  // "ahead", "behind", "within spread" (the timing noise), "bounded" (the side that would
+  // lose is charged an upper bound: its ladder does not bracket the target, so the
+  // comparison cannot be decided), "ours only", "peers only", "not reached".
+  std::string verdict;
   double best_error = 0.0;
 };
 

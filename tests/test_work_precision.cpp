@@ -113,6 +113,20 @@ TEST(work_precision, cost_at_equal_error_is_interpolated_never_extrapolated) {
   ASSERT_TRUE(coarse.has_value());
   EXPECT_FALSE(coarse->interpolated);
   EXPECT_DOUBLE_EQ(coarse->cost, 100.0);
+  // A method exact for the problem (error 0) meets every target at its cheapest row.
+  const wp_method exact = method("exact", {row(0.4, 10, 0.0), row(0.2, 20, 0.0)});
+  const auto e = at_equal_error(exact, 1e-12, false, false);
+  ASSERT_TRUE(e.has_value());
+  EXPECT_DOUBLE_EQ(e->cost, 10.0);
+  EXPECT_FALSE(e->interpolated);
+  // A finer row cheaper than the crossing (an adaptive method's cost need not rise):
+  // 1e-3 at 100, 1e-6 at 80; the crossing of 1e-4 would cost 100 * 0.8^(1/3) = 92.8.
+  const wp_method adaptive = method("adaptive", {row(1e-2, 100, 1e-3), row(1e-4, 80, 1e-6)});
+  const auto b = at_equal_error(adaptive, 1e-4, false, false);
+  ASSERT_TRUE(b.has_value());
+  EXPECT_DOUBLE_EQ(b->cost, 80.0);
+  EXPECT_EQ(b->row, 1u);
+
   // Ahead or behind only beyond the noise band: the larger of 15 % (both sides with a
   // spread) and 3 x the larger relative spread; 25 % when a side has a single repetition.
   EXPECT_STREQ(compare_at_equal_error({100, 99, 101}, {114, 113, 115}, true), "within spread");  // 1.14 < 1.15
@@ -269,12 +283,13 @@ TEST(advise, reads_a_study_file) {
   const auto answer = a.result.answer(a.methods);
   ASSERT_TRUE(answer.has_value());
   EXPECT_LE(answer->cost, best_evals);
-  double best_at_equal_error = INFINITY;
-  for (const auto& m : a.methods)
-    if (m.origin != method_origin::baseline)
-      if (const auto p = at_equal_error(m, 1e-4, false, false))
-        best_at_equal_error = std::min(best_at_equal_error, p->cost);
-  EXPECT_DOUBLE_EQ(answer->cost, best_at_equal_error);
+  EXPECT_LE(answer->error, 1e-4);
+  // Between its two bracketing rows (or one of its rows, a bound), never outside them.
+  const auto& rows = a.methods[answer->method].rows;
+  EXPECT_LE(answer->cost, rows[answer->row].force_evals);
+  if (answer->interpolated) {
+    EXPECT_GE(answer->cost, rows[answer->row - 1].force_evals);
+  }
 
   try {
     advise(file, "nope", "err_pos_max", 1e-4);

@@ -14,7 +14,7 @@ from .formatting import fmt_count, fmt_sci, fmt_seconds, fmt_time_ns
 from .render import Cell, esc
 
 VERDICT_ATTRS = ("metric", "targets", "frame_hz", "cost_kind", "findings", "rule")
-VERDICTS = ("ahead", "behind", "within spread", "ours only", "peers only", "not reached")
+VERDICTS = ("ahead", "behind", "within spread", "bounded", "ours only", "peers only", "not reached")
 COST_KINDS = ("time_ns", "force_evals")
 # The cell's class in index.html: green ahead, red behind, grey within the timing noise.
 VERDICT_CLASS = {"ahead": "ahead", "behind": "behind", "within spread": "within", "peers only": "behind",

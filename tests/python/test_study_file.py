@@ -166,22 +166,17 @@ def at_equal_error(runs, target, metric, cost, timed):
     coarsest row when it already meets the target; the cheapest crossing. (cost, error,
     param) or None."""
     err, c = runs[metric], runs[cost].astype(float)
-    on = completed(runs) & np.isfinite(err) & (err > 0) & np.isfinite(c) & (c > 0)
+    on = completed(runs) & np.isfinite(err) & (err >= 0) & np.isfinite(c) & (c > 0)
     if timed:
         on &= runs["cut"] == 0
     curve = runs[on]
     if len(curve) == 0:
         return None
-    found = []
-    if curve[metric][0] <= target:
-        found.append((float(curve[cost][0]), float(curve[metric][0]), float(curve["param"][0])))
+    # Every measured row under the target bounds the cost (error 0 included).
+    found = [(float(r[cost]), float(r[metric]), float(r["param"])) for r in curve if r[metric] <= target]
     for a, b in zip(curve[:-1], curve[1:]):
         ea, eb = float(a[metric]), float(b[metric])
-        if not (min(ea, eb) <= target <= max(ea, eb)):
-            continue
-        if ea == eb:
-            r = a if a[cost] <= b[cost] else b
-            found.append((float(r[cost]), float(r[metric]), float(r["param"])))
+        if not (min(ea, eb) <= target <= max(ea, eb)) or ea == eb or ea == 0 or eb == 0:
             continue
         s = math.log(target / ea) / math.log(eb / ea)
         lerp = lambda u, v: math.exp(math.log(u) + s * (math.log(v) - math.log(u)))  # noqa: E731
@@ -247,16 +242,22 @@ def test_verdict_is_the_fastest_of_ours_against_the_fastest_peer(plain, timed, s
         assert text(row["peer_method"]) == (text(peer[0]["method"]) if peer else "")
         if ours and peer:
             assert row["ratio"] == pytest.approx(ours[0]["cost"] / peer[0]["cost"], rel=1e-12)
+            assert text(row["cost_kind"]) == text(ours[0]["cost_kind"])
             # The noise band of core/work_precision.hpp (study/compare's timing threshold).
             threshold = 1e-9
-            if shape == "timed":
+            if text(row["cost_kind"]) == "time_ns":
                 def spread(r):
                     return (r["cost_hi"] - r["cost_lo"]) / r["cost"] if r["cost_hi"] > r["cost_lo"] else 0.0
                 both = all(r["cost_hi"] > r["cost_lo"] for r in (ours[0], peer[0]))
                 threshold = max(0.15 if both else 0.25, 3 * max(spread(ours[0]), spread(peer[0])))
             ratio = ours[0]["cost"] / peer[0]["cost"]
             want = "ahead" if ratio < 1 / (1 + threshold) else "behind" if ratio > 1 + threshold else "within spread"
+            # The side found cheaper charged only an upper bound decides nothing.
+            if (want == "ahead" and not peer[0]["interpolated"]) or (want == "behind" and not ours[0]["interpolated"]):
+                want = "bounded"
             assert text(row["verdict"]) == want
+            assert row["ours_interpolated"] == ours[0]["interpolated"]
+            assert row["peer_interpolated"] == peer[0]["interpolated"]
         else:
             assert math.isnan(row["ratio"])
             assert text(row["verdict"]) == ("ours only" if ours else "peers only" if peer else "not reached")

@@ -16,7 +16,8 @@ from .render import Cell, esc
 VERDICT_ATTRS = ("metric", "targets", "frame_hz", "cost_kind", "findings", "rule")
 VERDICTS = ("ahead", "behind", "within spread", "bounded", "ours only", "peers only", "not reached")
 COST_KINDS = ("time_ns", "force_evals")
-# The cell's class in index.html: green ahead, red behind, grey within the timing noise.
+# The cell's class in index.html: green ahead, red behind, grey within the timing noise; none
+# (white) for "bounded", "ours only".
 VERDICT_CLASS = {"ahead": "ahead", "behind": "behind", "within spread": "within", "peers only": "behind",
                  "not reached": "none"}
 # Names shortened in the frame-rate table, whose cells list several methods; the key is printed under it.
@@ -241,7 +242,9 @@ def opening(doc, verdict):
           f"in the problem's unit) reaches the column's target, its dt or tolerance there and its cost by {by}; under "
           "it, that cost as a multiple of the fastest library peer's at the same error (0.5x: half the peer's). The "
           "colour is the stored verdict: green ours ahead, red behind (or none of ours reaches the target), grey "
-          f"within the timing noise; best: the lowest error any method reached. Rule: {verdict.attrs['rule']}.",
+          "within the timing noise, white undecided (the side found cheaper is charged only an upper bound, a "
+          "measured row already under the target: its ladder does not bracket it) or no peer runs on the problem; "
+          f"best: the lowest error any method reached. Rule: {verdict.attrs['rule']}.",
           cls="caption")
     doc.h(2, "At a frame rate")
     doc.table(["problem [unit]"] + [f"{hz:g} Hz" for hz in verdict.frame_hz],

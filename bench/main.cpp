@@ -123,7 +123,7 @@ int main(int argc, char** argv) {
     // The accuracy sweep first: it gives each case its counters and the study its rows.
     sweep_options sopts;
     if (opts.quick) {
-      sopts.levels = 8;
+      sopts.levels = sopts.max_levels = 8;
       sopts.tolerances = tolerance_ladder(true);
     }
     sopts.overrides = opts.overrides;

@@ -29,7 +29,7 @@ std::string observed(const method_study& ms) {
 int run_sweep_command(sweep_args a) {
   for (const auto& s : a.sets) add_override(a.opts.overrides, s, a.opts.problems);
   if (a.quick) {
-    a.opts.levels = 8;
+    a.opts.levels = a.opts.max_levels = 8;
     a.opts.tolerances = tolerance_ladder(true);
   }
   a.opts.progress = !a.quiet;
@@ -70,12 +70,19 @@ command add_sweep(CLI::App& app) {
   auto* sub = app.add_subcommand("sweep", "accuracy study of every (problem, method) into an HDF5 study file");
   sub->add_option("--problem", a->opts.problems, "restrict to these problems (repeatable)");
   sub->add_option("--integrator,--method", a->opts.methods, "restrict to these methods (repeatable)");
-  sub->add_option("--levels", a->opts.levels, "timesteps in the halving ladder")->capture_default_str();
+  sub->add_option("--levels", a->opts.levels, "timesteps every fixed-step method runs in the halving ladder")
+      ->capture_default_str();
+  sub->add_option("--jobs", a->opts.jobs, "threads the problems are swept on (0: one a core)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  sub->add_option("--max-levels", a->opts.max_levels,
+                  "levels a fixed-step ladder may reach while its error still falls and the work budget allows")
+      ->capture_default_str();
   sub->add_option("--base-steps", a->opts.base_steps, "steps at the coarsest level")->capture_default_str();
   sub->add_option("--set", a->sets,
                   "override a parameter, problem.name=value, or name=value with one --problem (repeatable)");
   sub->add_option("--out", a->out, "study file to write")->capture_default_str();
-  sub->add_flag("--quick", a->quick, "8 levels and every other tolerance (the CI study)");
+  sub->add_flag("--quick", a->quick, "8 levels (no more) and every other tolerance (the CI study)");
   sub->add_flag("--quiet", a->quiet, "print only the summary line");
   sub->add_flag("--strict", a->strict, "exit 3 when a method failed on some case");
   sub->footer(

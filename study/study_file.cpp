@@ -92,6 +92,7 @@ void write_method(H5::Group& parent, const method_study& ms, bool timed) {
   attr(g, "fit_note", ms.fit.note);
   attr(g, "exact_for_problem", static_cast<int>(ms.fit.state == fit_result::status::exact));
   attr(g, "declared_order_holds", ms.declared_order_holds);
+  attr(g, "ladder_end", ms.ladder_end);
 
   runs_table(ms.rows, timed).write(g, "runs", schema::find("runs"));
 }
@@ -230,6 +231,7 @@ std::vector<unsigned char> study_image(const study& s, const std::string& name) 
   attr(file, "cpu", cpu_model());
   attr(file, "cores", core_count());
   attr(file, "levels", s.options.levels);
+  attr(file, "max_levels", s.options.max_levels);
   attr(file, "base_steps", s.options.base_steps);
   attr(file, "sample_count", s.options.sample_count);
   attr(file, "tolerances", s.options.tolerances);

@@ -3,12 +3,17 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
+#include <mutex>
 #include <stdexcept>
+#include <thread>
 
 #include "core/drive.hpp"
+#include "study/machine.hpp"
 #include "study/substeps.hpp"
 #include "study/verdict.hpp"
 
@@ -40,6 +45,9 @@ std::unique_ptr<problem_instance> configured_problem(const std::string& name, co
 
 void validate(const sweep_options& opts) {
   if (opts.levels < 2 || opts.levels > 20) throw std::invalid_argument("levels must be between 2 and 20");
+  if (opts.max_levels < opts.levels || opts.max_levels > 24)
+    throw std::invalid_argument(fmt::format("max levels must be between levels ({}) and 24", opts.levels));
+  if (!(opts.round_off_fall > 1.0)) throw std::invalid_argument("the round-off fall must be > 1");
   if (opts.base_steps < 1 || opts.sample_count < 1 || opts.base_steps % opts.sample_count != 0)
     throw std::invalid_argument("base_steps must be a positive multiple of sample_count");
   if (!(opts.tol.rtol > 0.0 && opts.tol.atol > 0.0)) throw std::invalid_argument("reference tolerances must be > 0");
@@ -59,11 +67,12 @@ void validate(const sweep_options& opts) {
     for (size_t i = 0; i < names->size(); ++i)
       for (size_t j = 0; j < i; ++j)
         if ((*names)[i] == (*names)[j]) throw std::invalid_argument(fmt::format("'{}' is named twice", (*names)[i]));
-  // A bound on the work: the finest level's steps (run has the same kind of bound).
-  const double finest = static_cast<double>(opts.base_steps) * std::ldexp(1.0, opts.levels - 1);
+  // A bound on the work: the finest level's steps (run has the same kind of bound; the
+  // levels beyond `levels` are bounded by the work budget as well).
+  const double finest = static_cast<double>(opts.base_steps) * std::ldexp(1.0, opts.max_levels - 1);
   if (finest > 1e8)
     throw std::invalid_argument(fmt::format(
-        "the ladder's finest level would take {:.3g} steps (base_steps 2^(levels-1)); the limit is 1e8", finest));
+        "the ladder's finest level would take {:.3g} steps (base_steps 2^(max_levels-1)); the limit is 1e8", finest));
   for (const auto& [name, params] : opts.overrides) {
     auto problem = make_problem(name);                                     // throws, naming an unknown problem
     for (const auto& [param, value] : params) problem->set(param, value);  // throws for an unknown parameter
@@ -83,7 +92,7 @@ void validate(const sweep_options& opts) {
 
 std::vector<double> dt_ladder(double horizon, const sweep_options& opts) {
   std::vector<double> out;
-  for (int k = 0; k < opts.levels; ++k)
+  for (int k = 0; k < opts.max_levels; ++k)
     out.push_back(horizon / (static_cast<double>(opts.base_steps) * std::ldexp(1.0, k)));
   return out;
 }
@@ -106,30 +115,94 @@ void fit_rows(method_study& ms, double pos_scale) {
       ms.info.kind == method_kind::fixed_step ? declared_order_holds(ms.info.declared_order, ms.fit) : -1;
 }
 
+namespace {
+
+method_row skipped_row(double param, const std::string& note) {
+  method_row row{param, 0, 0, {}, {}, {}};
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  auto& mt = row.metrics;
+  mt.err_pos_final = mt.err_vel_final = mt.err_pos_max = mt.err_pos_rms = mt.energy_drift = mt.energy_err_max = nan;
+  mt.angmom_drift = mt.angmom_err_max = mt.contact_count_err = mt.contact_time_err = mt.contact_pos_err = nan;
+  mt.skipped = true;
+  mt.note = note;
+  return row;
+}
+
+// Why a fixed-step ladder stops after its rows, or "" while it goes on. The first
+// `levels` rows always run (a level over the work budget is recorded as skipped); beyond
+// them the ladder halves dt while the last level completed, the next fits the work
+// budget, and the error still falls: it stops once the error fell by less than
+// `round_off_fall` over the last level, at round-off (within 100 times the typical
+// round-off eps sqrt(n) scale, the fit's own cut, core/convergence_fit.hpp), or else after
+// two such levels in a row (an error floor above round-off, as a contact's timing gives).
+std::string fixed_ladder_end(const std::vector<method_row>& rows, double dim, double scale, const sweep_options& opts) {
+  const int k = static_cast<int>(rows.size());
+  if (k >= opts.max_levels)
+    return fmt::format("the ladder's last level ({}){}", opts.max_levels,
+                       opts.max_levels == opts.levels ? "" : ", before round-off or the work budget");
+  if (k < opts.levels) return "";
+  const auto& last = rows.back();
+  if (last.metrics.skipped) return "the work budget (the finer levels were skipped)";
+  if (!last.metrics.completed()) return "divergence at the finest level";
+  const double err = last.metrics.err_pos_max;
+  if (!(err > 0.0)) return "an error of 0 (exact for the problem)";
+  // The fall over the level ending at row j (infinite after a level that did not complete).
+  const auto fall = [&](std::size_t j) {
+    const auto& before = rows[j - 1].metrics;
+    return before.completed() ? before.err_pos_max / rows[j].metrics.err_pos_max
+                              : std::numeric_limits<double>::infinity();
+  };
+  const std::size_t n = rows.size();
+  const double next_work = 2.0 * static_cast<double>(last.work.force_evals) * dim;
+  const std::string budget =
+      next_work > opts.limits.work_budget
+          ? fmt::format("the work budget: the next level would take {:.3g} coordinate force evaluations, over {:.3g}",
+                        next_work, opts.limits.work_budget)
+          : "";
+  if (fall(n - 1) > opts.round_off_fall) return budget;
+  if (err <= 100.0 * roundoff_noise(last.steps, scale))
+    return fmt::format(
+        "round-off: the error {:.3g} fell {:.3g}x over the last level, within 100 eps sqrt(n) of round-off", err,
+        fall(n - 1));
+  if (n >= 3 && rows[n - 2].metrics.completed() && rows[n - 2].metrics.err_pos_max > 0.0 &&
+      fall(n - 2) <= opts.round_off_fall)
+    return fmt::format(
+        "an error floor: the error {:.3g} fell {:.3g}x and {:.3g}x over the last two levels, above the eps sqrt(n) "
+        "round-off estimate",
+        err, fall(n - 2), fall(n - 1));
+  return budget;
+}
+
+}  // namespace
+
 method_study run_method(const problem_study& ps, const method_info& m, const sweep_options& opts) {
   method_study ms;
   ms.info = m;
   const double dim = ps.problem->dim();
-  for (double param : param_ladder(m, ps.horizon, opts)) {
-    // A fixed-step run whose work (twice the previous level's force evaluations, times
-    // the coordinates) would exceed the budget is skipped, with the reason.
-    if (m.kind == method_kind::fixed_step && !ms.rows.empty() && ms.rows.back().work.force_evals > 0 &&
-        2.0 * static_cast<double>(ms.rows.back().work.force_evals) * dim > opts.limits.work_budget) {
-      method_row row{param, 0, 0, {}, {}, {}};
-      const double nan = std::numeric_limits<double>::quiet_NaN();
-      auto& mt = row.metrics;
-      mt.err_pos_final = mt.err_vel_final = mt.err_pos_max = mt.err_pos_rms = mt.energy_drift = mt.energy_err_max = nan;
-      mt.angmom_drift = mt.angmom_err_max = mt.contact_count_err = mt.contact_time_err = mt.contact_pos_err = nan;
-      mt.skipped = true;
-      mt.note =
-          fmt::format("skipped: about {:.3g} force evaluations x {:g} coordinates exceed the work budget of {:.3g}",
-                      2.0 * static_cast<double>(ms.rows.back().work.force_evals), dim, opts.limits.work_budget);
-      ms.rows.push_back(std::move(row));
-      continue;
+  if (m.kind == method_kind::fixed_step) {
+    for (double param : dt_ladder(ps.horizon, opts)) {
+      if (ms.ladder_end = fixed_ladder_end(ms.rows, dim, ps.truth.pos_scale, opts); !ms.ladder_end.empty()) break;
+      // A level within `levels` whose work (twice the previous level's force evaluations,
+      // times the coordinates) would exceed the budget is skipped, with the reason.
+      if (!ms.rows.empty() && ms.rows.back().work.force_evals > 0 &&
+          2.0 * static_cast<double>(ms.rows.back().work.force_evals) * dim > opts.limits.work_budget) {
+        ms.rows.push_back(skipped_row(
+            param,
+            fmt::format("skipped: about {:.3g} force evaluations x {:g} coordinates exceed the work budget of {:.3g}",
+                        2.0 * static_cast<double>(ms.rows.back().work.force_evals), dim, opts.limits.work_budget)));
+        continue;
+      }
+      const run_result run = ps.problem->run(m.name, param, ps.horizon, ps.truth.times, opts.limits);
+      ms.rows.push_back({param, run.steps, run.rejected_steps, run.work, measure(*ps.problem, run, ps.truth), {}});
     }
-    const run_result run = ps.problem->run(m.name, param, ps.horizon, ps.truth.times, opts.limits);
-    method_row row{param, run.steps, run.rejected_steps, run.work, measure(*ps.problem, run, ps.truth), {}};
-    ms.rows.push_back(std::move(row));
+    if (ms.ladder_end.empty()) ms.ladder_end = fixed_ladder_end(ms.rows, dim, ps.truth.pos_scale, opts);
+  } else {
+    for (double param : opts.tolerances) {
+      const run_result run = ps.problem->run(m.name, param, ps.horizon, ps.truth.times, opts.limits);
+      ms.rows.push_back({param, run.steps, run.rejected_steps, run.work, measure(*ps.problem, run, ps.truth), {}});
+    }
+    if (!opts.tolerances.empty())
+      ms.ladder_end = fmt::format("the tolerance ladder's end ({:g})", opts.tolerances.back());
   }
   fit_rows(ms, ps.truth.pos_scale);
   return ms;
@@ -139,6 +212,37 @@ std::size_t sweep_parts(const sweep_options& opts) {
   return (opts.problems.empty() ? problem_names().size() : opts.problems.size()) + 3;
 }
 
+namespace {
+
+// One problem of the sweep: its truth and every selected method on its ladder.
+problem_study sweep_problem(const std::string& name, const sweep_options& opts,
+                            const std::function<void(const std::string&)>& warn) {
+  const auto t0 = std::chrono::steady_clock::now();
+  problem_study ps;
+  ps.problem = configured_problem(name, opts);
+  ps.horizon = ps.problem->horizon();
+  ps.truth = build_truth(*ps.problem, sample_times(ps.horizon, opts.sample_count), {.tol = opts.tol});
+  for (const auto& r : ps.truth.references)
+    if (r.status != "ok" && r.status != "unsupported")
+      warn(fmt::format("warning: {}: reference {} {}: {}", name, r.source, r.status, r.reason));
+  if (!ps.truth.trusted)
+    warn(fmt::format("warning: {}: no trusted truth ({}); its errors are recorded as NaN", name, ps.truth.note));
+  for (const auto& m : ps.problem->methods())
+    if (opts.methods.empty() || contains(opts.methods, m.name)) ps.methods.push_back(run_method(ps, m, opts));
+  if (opts.progress)
+    warn(fmt::format("swept {:<22} {:3} methods in {:.2f} s", name, ps.methods.size(),
+                     std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
+  return ps;
+}
+
+}  // namespace
+
+int sweep_jobs(const sweep_options& opts, std::size_t problems) {
+  const int cores = std::max(1, core_count());
+  const int jobs = opts.jobs > 0 ? opts.jobs : cores;
+  return static_cast<int>(std::max<std::size_t>(1, std::min<std::size_t>(jobs, problems)));
+}
+
 study run_sweep(const sweep_options& opts) {
   validate(opts);
   const auto start = std::chrono::steady_clock::now();
@@ -146,34 +250,44 @@ study run_sweep(const sweep_options& opts) {
   out.options = opts;
   const std::size_t parts = sweep_parts(opts);
   std::size_t done = 0;
+  // The problems run on `jobs` threads (each problem's runs own their state: the
+  // references and peers make their solver objects per run), each into its own slot, so
+  // the study is the same as on one thread; the callers' callbacks are called under one lock.
+  std::mutex callbacks;
   const auto part_done = [&] {
+    std::lock_guard lock(callbacks);
     if (opts.on_progress) opts.on_progress(++done, parts);
   };
   const auto warn = [&](const std::string& line) {
+    std::lock_guard lock(callbacks);
     if (opts.on_warning)
       opts.on_warning(line);
     else
       std::fprintf(stderr, "%s\n", line.c_str());
   };
-  for (const auto& name : opts.problems.empty() ? problem_names() : opts.problems) {
-    const auto t0 = std::chrono::steady_clock::now();
-    problem_study ps;
-    ps.problem = configured_problem(name, opts);
-    ps.horizon = ps.problem->horizon();
-    ps.truth = build_truth(*ps.problem, sample_times(ps.horizon, opts.sample_count), {.tol = opts.tol});
-    for (const auto& r : ps.truth.references)
-      if (r.status != "ok" && r.status != "unsupported")
-        warn(fmt::format("warning: {}: reference {} {}: {}", name, r.source, r.status, r.reason));
-    if (!ps.truth.trusted)
-      warn(fmt::format("warning: {}: no trusted truth ({}); its errors are recorded as NaN", name, ps.truth.note));
-    for (const auto& m : ps.problem->methods())
-      if (opts.methods.empty() || contains(opts.methods, m.name)) ps.methods.push_back(run_method(ps, m, opts));
-    if (opts.progress)
-      std::fprintf(stderr, "swept %-22s %3zu methods in %.2f s\n", name.c_str(), ps.methods.size(),
-                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-    out.problems.push_back(std::move(ps));
-    part_done();
+  const auto names = opts.problems.empty() ? problem_names() : opts.problems;
+  std::vector<problem_study> swept(names.size());
+  std::vector<std::exception_ptr> failures(names.size());
+  std::atomic<std::size_t> next{0};
+  const auto worker = [&] {
+    for (std::size_t i; (i = next++) < names.size();) {
+      try {
+        swept[i] = sweep_problem(names[i], opts, warn);
+      } catch (...) {
+        failures[i] = std::current_exception();
+        next = names.size();  // the others stop at their current problem
+      }
+      part_done();
+    }
+  };
+  {
+    std::vector<std::jthread> threads;
+    for (int t = 1; t < sweep_jobs(opts, names.size()); ++t) threads.emplace_back(worker);
+    worker();
   }
+  for (const auto& failure : failures)
+    if (failure) std::rethrow_exception(failure);
+  for (auto& ps : swept) out.problems.push_back(std::move(ps));
   out.substeps = run_substeps(out, opts.substeps);
   out.frame_rates = run_frame_rates(out, opts.frame_rates);
   part_done();

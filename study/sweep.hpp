@@ -51,7 +51,12 @@ struct sweep_options {
   std::vector<std::string> methods;   // empty: all that run on each problem
   // Parameter overrides per problem: overrides["pendulum"]["theta0_deg"] = 30.
   std::map<std::string, std::map<std::string, double>> overrides;
-  int levels = 12;        // dt ladder length (at least 8 for the default study)
+  int levels = 12;  // dt ladder length every fixed-step method runs (at least 8 for the default study)
+  // Beyond `levels` the ladder goes on halving, up to `max_levels`, while the error still
+  // falls by more than `round_off_fall` a level and the next level fits the work budget:
+  // each method is followed to its round-off (or to the budget), not cut at one step count.
+  int max_levels = 20;
+  double round_off_fall = 1.5;
   int base_steps = 32;    // steps at the coarsest level; dt_k = T / (base_steps 2^k)
   int sample_count = 32;  // fixed sample times j T / sample_count; must divide base_steps
   std::vector<double> tolerances = tolerance_ladder();
@@ -62,6 +67,7 @@ struct sweep_options {
   energy_options energy{};           // the long-run energy study (study/energy.hpp)
   frame_rate_options frame_rates{};  // the game programmer's frame-rate table (study/verdict.hpp)
   bool progress = false;             // one line per problem on stderr
+  int jobs = 0;                      // threads the problems are swept on (0: one a core)
   // A caller's live progress: called after each problem and each later study (frame
   // rates, loop, energy) with the parts done and the total (sweep_parts); and where the
   // sweep's warnings go (a reference that disagrees), so that they do not land on a
@@ -69,6 +75,9 @@ struct sweep_options {
   std::function<void(std::size_t done, std::size_t total)> on_progress;
   std::function<void(const std::string&)> on_warning;
 };
+
+// The threads run_sweep uses for `problems` problems (opts.jobs, 0: one a core).
+int sweep_jobs(const sweep_options& opts, std::size_t problems);
 
 // The parts on_progress counts: the problems, then the frame-rate, loop and energy studies.
 std::size_t sweep_parts(const sweep_options& opts);
@@ -97,6 +106,7 @@ struct method_study {
   std::vector<method_row> rows;
   fit_result fit;                 // against dt (fixed-step) or against the tolerance (adaptive)
   int declared_order_holds = -1;  // see core/convergence_fit.hpp
+  std::string ladder_end;         // why the ladder stopped after its last row
 };
 
 struct problem_study {
@@ -166,7 +176,8 @@ struct study {
 // with a one-line message on the first problem found; run before any work or output.
 void validate(const sweep_options& opts);
 
-// The ladder's timesteps for a horizon.
+// The ladder's timesteps for a horizon, to its longest (max_levels): a fixed-step
+// method's rows are a prefix of it, at least `levels` long.
 std::vector<double> dt_ladder(double horizon, const sweep_options& opts);
 // The ladder of a method: dts or tolerances.
 std::vector<double> param_ladder(const method_info& m, double horizon, const sweep_options& opts);

@@ -31,7 +31,7 @@ study small_study(std::vector<std::string> problems = {"damped_spring"},
   sweep_options o;
   o.problems = std::move(problems);
   o.methods = std::move(methods);
-  o.levels = levels;
+  o.levels = o.max_levels = levels;  // a ladder of exactly `levels` rows
   o.tolerances = tolerance_ladder(true);
   return run_sweep(o);
 }

@@ -52,8 +52,15 @@ TEST(sweep, every_method_on_its_ladder) {
   EXPECT_EQ(ps.methods.size(), ps.problem->methods().size());
   for (const auto& ms : ps.methods) {
     const auto ladder = param_ladder(ms.info, ps.horizon, default_study().options);
-    ASSERT_EQ(ms.rows.size(), ladder.size()) << ms.info.name;
-    for (std::size_t k = 0; k < ladder.size(); ++k) EXPECT_EQ(ms.rows[k].param, ladder[k]) << ms.info.name;
+    // Fixed-step rows are a prefix of the longest ladder, at least `levels` long.
+    if (ms.info.kind == method_kind::fixed_step) {
+      ASSERT_GE(ms.rows.size(), static_cast<std::size_t>(default_study().options.levels)) << ms.info.name;
+      ASSERT_LE(ms.rows.size(), ladder.size()) << ms.info.name;
+    } else {
+      ASSERT_EQ(ms.rows.size(), ladder.size()) << ms.info.name;
+    }
+    EXPECT_FALSE(ms.ladder_end.empty()) << ms.info.name;
+    for (std::size_t k = 0; k < ms.rows.size(); ++k) EXPECT_EQ(ms.rows[k].param, ladder[k]) << ms.info.name;
   }
   // The peers are there, measured, and none failed on this gentle problem.
   for (const char* peer : {"gsl_rk4", "gsl_rk8pd_adaptive", "cvode_bdf", "baseline_rk4"}) {
@@ -233,6 +240,87 @@ TEST(sweep, divergence_follows_the_stability_limit) {
       if (ms.info.name == "euler" || ms.info.origin != method_origin::ours) continue;
       for (const auto& row : ms.rows)
         EXPECT_FALSE(row.metrics.diverged) << p.problem->name() << "/" << ms.info.name << " " << row.param;
+    }
+  }
+}
+
+// The fixed-step ladder runs on past `levels` to each method's round-off where the work
+// budget allows (issue 18), and says why it stopped; the reason holds for the rows.
+TEST(sweep, fixed_ladder_runs_to_round_off_or_the_work_budget) {
+  const auto& opts = default_study().options;
+  for (const auto& ps : default_study().problems)
+    for (const auto& ms : ps.methods) {
+      if (ms.info.kind != method_kind::fixed_step) continue;
+      const std::string key = std::string(ps.problem->name()) + "/" + ms.info.name;
+      ASSERT_GE(ms.rows.size(), static_cast<std::size_t>(opts.levels)) << key;
+      ASSERT_LE(ms.rows.size(), static_cast<std::size_t>(opts.max_levels)) << key;
+      const auto& last = ms.rows.back();
+      const auto& end = ms.ladder_end;
+      if (end.starts_with("round-off")) {
+        EXPECT_LE(last.metrics.err_pos_max, 100.0 * roundoff_noise(last.steps, ps.truth.pos_scale)) << key;
+        EXPECT_LE(ms.rows[ms.rows.size() - 2].metrics.err_pos_max, opts.round_off_fall * last.metrics.err_pos_max)
+            << key;
+      } else if (end.starts_with("the work budget:")) {
+        EXPECT_GT(2.0 * static_cast<double>(last.work.force_evals) * ps.problem->dim(), opts.limits.work_budget) << key;
+      } else if (end.starts_with("the ladder's last level")) {
+        EXPECT_EQ(ms.rows.size(), static_cast<std::size_t>(opts.max_levels)) << key;
+      } else if (end.starts_with("an error floor")) {
+        EXPECT_LE(ms.rows[ms.rows.size() - 2].metrics.err_pos_max, opts.round_off_fall * last.metrics.err_pos_max)
+            << key;
+      } else if (!end.starts_with("an error of 0") && !end.starts_with("divergence") &&
+                 !end.starts_with("the work budget (")) {
+        ADD_FAILURE() << key << ": unexpected ladder end '" << end << "'";
+      }
+      // Each level run beyond `levels` was earned: the level before it completed, and its
+      // error had fallen by more than 1.5x, or (above round-off) the one before that had.
+      const auto fell = [&](std::size_t j) {
+        return ms.rows[j - 1].metrics.err_pos_max > opts.round_off_fall * ms.rows[j].metrics.err_pos_max;
+      };
+      for (std::size_t j = opts.levels; j < ms.rows.size(); ++j) {
+        const auto& before = ms.rows[j - 1];
+        ASSERT_TRUE(before.metrics.completed()) << key << " row " << j;
+        EXPECT_TRUE(
+            fell(j - 1) ||
+            (before.metrics.err_pos_max > 100.0 * roundoff_noise(before.steps, ps.truth.pos_scale) && fell(j - 2)))
+            << key << " row " << j;
+      }
+    }
+  // Closed-form truths: a second-order method goes past the 12-level ladder's 1e-8 to
+  // below 1e-12 on the damped spring; rk4 stops at round-off.
+  const auto& spring = find(default_study(), "damped_spring");
+  const auto& verlet = find(spring, "velocity_verlet");
+  EXPECT_GT(verlet.rows.size(), 12u);
+  EXPECT_LT(verlet.rows.back().metrics.err_pos_max, 1e-12);
+  EXPECT_TRUE(find(spring, "rk4").ladder_end.starts_with("round-off")) << find(spring, "rk4").ladder_end;
+  EXPECT_LT(find(spring, "rk4").rows.back().metrics.err_pos_max, 1e-13);
+}
+
+// The problems swept on one thread or several give the same rows, bit for bit.
+TEST(sweep, threads_do_not_change_a_row) {
+  sweep_options one;
+  one.problems = {"damped_spring", "pendulum", "bouncing_ball"};
+  one.levels = one.max_levels = 6;
+  one.tolerances = tolerance_ladder(true);
+  one.frame_rates.enabled = false;
+  one.energy.enabled = false;
+  one.loop.enabled = false;
+  one.substeps.enabled = false;
+  one.jobs = 1;
+  sweep_options three = one;
+  three.jobs = 3;
+  const study a = run_sweep(one), b = run_sweep(three);
+  ASSERT_EQ(a.problems.size(), b.problems.size());
+  for (std::size_t p = 0; p < a.problems.size(); ++p) {
+    EXPECT_EQ(a.problems[p].problem->name(), b.problems[p].problem->name());
+    ASSERT_EQ(a.problems[p].methods.size(), b.problems[p].methods.size());
+    for (std::size_t m = 0; m < a.problems[p].methods.size(); ++m) {
+      const auto &ra = a.problems[p].methods[m].rows, &rb = b.problems[p].methods[m].rows;
+      ASSERT_EQ(ra.size(), rb.size());
+      for (std::size_t k = 0; k < ra.size(); ++k) {
+        const double x = ra[k].metrics.err_pos_max, y = rb[k].metrics.err_pos_max;
+        EXPECT_TRUE(x == y || (std::isnan(x) && std::isnan(y))) << a.problems[p].methods[m].info.name << " row " << k;
+        EXPECT_EQ(ra[k].work.force_evals, rb[k].work.force_evals);
+      }
     }
   }
 }

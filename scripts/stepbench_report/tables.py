@@ -56,12 +56,22 @@ def order_rows(problem):
         fitted = m.attrs["fit_status"] == "fitted"
         rows.append([label(m), "n/a" if not np.isfinite(m.declared_order) else f"{m.declared_order:g}",
                      observed_text(m), ",".join(map(str, m.fit_levels)), _fit_range(m),
-                     fmt_num(m.attrs["fit_residual_log10"], 2) if fitted else "", holds_text(m)])
+                     fmt_num(m.attrs["fit_residual_log10"], 2) if fitted else "", holds_text(m),
+                     ladder_end_text(m)])
     return rows
 
 
+def ladder_end_text(method):
+    """Why the fixed-step ladder stopped, in a word (the study file has the sentence):
+    round-off, the work budget, its last level, divergence, an exact method."""
+    why = str(method.attrs.get("ladder_end", ""))  # absent in files before the ladder went on to round-off
+    steps = int(method.runs["steps"].max()) if len(method.runs) else 0
+    short = why.split(":")[0].split(" (")[0].removeprefix("the ")
+    return f"{len(method.runs)} levels, {steps} steps: {short}" if why else ""
+
+
 ORDER_HEAD = ["method", "declared order", "observed order", "fit levels", "fit dt range [s]", "fit residual (log10)",
-              "declared order holds"]
+              "declared order holds", "ladder stops at"]
 
 
 def adaptive_rows(problem):

@@ -22,7 +22,7 @@ ROOT_ATTRS = ["format_version", "version", "git_commit", "compiler", "build_type
 METHOD_ATTRS = ["origin", "kind", "param_kind", "declared_order", "description", "library", "symplectic",
                 "reuses_last_force", "needs_jacobian", "error_estimate", "dense_output", "fit_status", "fit_metric",
                 "fit_param", "fit_slope", "observed_order", "fit_levels", "fit_residual_log10", "fit_note",
-                "exact_for_problem", "declared_order_holds"]
+                "exact_for_problem", "declared_order_holds", "ladder_end"]
 
 
 @pytest.fixture(scope="module")

@@ -9,6 +9,7 @@
 
 #include "cli/args.hpp"
 #include "cli/commands.hpp"
+#include "study/scan.hpp"
 
 namespace stepbench::cli {
 namespace {
@@ -17,7 +18,8 @@ using json = nlohmann::json;
 
 struct advise_args {
   std::string problem, tol_text, metric = "err_pos_max", study = "results/study.h5";
-  std::string hz_text;  // set: the frame-rate question instead
+  std::string hz_text;          // set: the frame-rate question instead
+  std::string scan, scan_name;  // set: the range question, from a scan (study/scan.hpp)
   bool json = false;
 };
 
@@ -59,6 +61,22 @@ json frame_advice_json(const frame_advice& f) {
 int run_advise(const advise_args& args) {
   const double tol = parse_number(args.tol_text, "--tol");
   if (!(tol > 0.0)) throw std::invalid_argument(fmt::format("--tol must be > 0, got {}", args.tol_text));
+  if (!args.scan.empty()) {
+    if (!args.hz_text.empty()) throw std::invalid_argument("--scan answers at the scan's frame rates; drop --hz");
+    const scan_result s = read_scan(args.scan, args.scan_name);
+    if (!args.problem.empty() && args.problem != s.options.problem)
+      throw std::invalid_argument(
+          fmt::format("the scan in '{}' is of {}, not {}", args.scan, s.options.problem, args.problem));
+    const scan_answer a = answer_scan(s, tol);
+    if (args.json)
+      std::cout << scan_answer_json(a).dump(2) << "\n";
+    else
+      fmt::print("{}", format_scan_answer(a));
+    for (const auto& c : a.choices)
+      if (!c.method.empty()) return 0;
+    return advise_exit_no_method;
+  }
+  if (args.problem.empty()) throw std::invalid_argument("--problem is required (or --scan FILE)");
   if (!args.hz_text.empty()) {
     const double hz = parse_number(args.hz_text, "--hz");
     if (args.metric != "err_pos_max")
@@ -98,7 +116,7 @@ command add_advise(CLI::App& app) {
   auto a = std::make_shared<advise_args>();
   auto* sub = app.add_subcommand(
       "advise", "the cheapest stable method and its dt (or tolerance) for an error, from a study file");
-  sub->add_option("--problem", a->problem, "problem name (one in the study file)")->required();
+  sub->add_option("--problem", a->problem, "problem name (one in the study file; required unless --scan)");
   sub->add_option("--tol", a->tol_text, "largest acceptable error, in the problem's units (> 0)")->required();
   sub->add_option("--metric", a->metric, "err_pos_max, err_pos_final, err_pos_rms or err_vel_final")
       ->capture_default_str();
@@ -106,6 +124,10 @@ command add_advise(CLI::App& app) {
                   "frame rate: the methods stable at one step a frame, and the cheapest method and substeps a frame "
                   "that meet --tol (from the study's frame-rate runs: 30, 60, 120 or 240)");
   sub->add_option("--study", a->study, "study file to read")->capture_default_str();
+  sub->add_option("--scan", a->scan,
+                  "a file written by `stepbench scan`: the cheapest method and substeps that hold over the whole "
+                  "range at each rate, and where each method breaks at one step a frame");
+  sub->add_option("--name", a->scan_name, "the scan in that file (when it holds more than one)");
   sub->add_flag("--json", a->json, "print JSON");
   sub->footer("exit codes: 0 answer, 1 study file unreadable, 2 bad usage, 3 no method meets the tolerance\n");
   return {sub, [a] { return run_advise(*a); }};

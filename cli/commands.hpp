@@ -4,8 +4,13 @@
 // line and an exit code (2 bad usage: std::invalid_argument; 1 anything else).
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
+
+namespace stepbench {
+struct scan_answer;  // study/scan.hpp
+}
 
 namespace stepbench::cli {
 
@@ -24,5 +29,9 @@ command add_stability(CLI::App& app);
 command add_loop(CLI::App& app);
 command add_energy(CLI::App& app);
 command add_schema(CLI::App& app);
+command add_scan(CLI::App& app);
+
+// The range answer of a scan as JSON (`scan --json`, `advise --scan --json`).
+nlohmann::json scan_answer_json(const scan_answer& a);
 
 }  // namespace stepbench::cli

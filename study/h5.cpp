@@ -477,6 +477,16 @@ std::vector<long> int_array_attr(const H5::H5Object& obj, const std::string& nam
   return {raw.begin(), raw.end()};
 }
 
+std::vector<double> double_array_attr(const H5::H5Object& obj, const std::string& name) {
+  const H5::Attribute a = checked_attr(obj, name, attr_kind::number, false);
+  const H5::DataSpace space = a.getSpace();
+  if (space.getSimpleExtentType() == H5S_NULL) return {};
+  const std::string what = fmt::format("attribute '{}' on {}", name, object_name(obj));
+  std::vector<double> out(checked_extent(space, a.getDataType().getSize(), file_size(obj), what));
+  if (!out.empty()) a.read(H5::PredType::NATIVE_DOUBLE, out.data());
+  return out;
+}
+
 std::map<std::string, std::string> string_attrs(const H5::H5Object& obj) {
   return scan_attrs<std::string>(
       obj, [](H5T_class_t c) { return c == H5T_STRING; }, attr_kind::string, read_string);

@@ -89,7 +89,8 @@ std::vector<double> read_vector(const H5::DataSet& ds);  // a 1-D double dataset
 std::string string_attr(const H5::H5Object& obj, const std::string& name);
 double double_attr(const H5::H5Object& obj, const std::string& name);  // a float or an integer
 long long_attr(const H5::H5Object& obj, const std::string& name);
-std::vector<long> int_array_attr(const H5::H5Object& obj, const std::string& name);  // empty for a null dataspace
+std::vector<long> int_array_attr(const H5::H5Object& obj, const std::string& name);       // empty for a null dataspace
+std::vector<double> double_array_attr(const H5::H5Object& obj, const std::string& name);  // a number array
 // Every attribute of obj that holds one string, or one number (floats only, or integers
 // too), by name; attributes of other kinds are skipped, damaged ones refused.
 std::map<std::string, std::string> string_attrs(const H5::H5Object& obj);

@@ -148,6 +148,26 @@ constexpr field frame_rate_run_fields[] = {
     {"hz", f64},          {"method", str},         {"substeps", i64},    {"dt", f64},
     {"completed", i8},    {"diverged", i8},        {"err_pos_max", f64}, {"steps", i64},
     {"force_evals", f64}, {"cost_per_frame", f64}, {"note", str}};
+// A scan (study/scan.hpp): its grid points, every run, and the cheapest run at each
+// point and rate; the axis values are the 2-D dataset /scan/<name>/values beside them.
+constexpr field scan_point_fields[] = {{"point", i64},   {"trusted", i8},    {"truth_source", str},
+                                       {"horizon", f64}, {"pos_scale", f64}, {"note", str}};
+constexpr field scan_run_fields[] = {{"point", i64},
+                                     {"hz", f64},
+                                     {"method", str},
+                                     {"substeps", i64},
+                                     {"dt", f64},
+                                     {"completed", i8},
+                                     {"diverged", i8},
+                                     {"failed", i8},
+                                     {"skipped", i8},
+                                     {"err_pos_max", f64},
+                                     {"steps", i64},
+                                     {"force_evals", f64},
+                                     {"newton_iterations", f64},
+                                     {"note", str}};
+constexpr field scan_best_fields[] = {{"point", i64},    {"hz", f64},          {"method", str},
+                                      {"substeps", i64}, {"err_pos_max", f64}, {"force_evals_per_frame", f64}};
 
 constexpr field_group runs_groups[] = {{run_fields}, {run_timing_fields, true}};
 constexpr field_group substep_runs_groups[] = {{run_fields}, {run_timing_fields, true}, {substep_fields}};
@@ -163,6 +183,9 @@ constexpr field_group verdict_equal_error_groups[] = {{verdict_equal_error_field
 constexpr field_group frame_rate_groups[] = {{frame_rate_fields}};
 constexpr field_group frame_answer_groups[] = {{frame_answer_fields}};
 constexpr field_group frame_rate_run_groups[] = {{frame_rate_run_fields}};
+constexpr field_group scan_point_groups[] = {{scan_point_fields}};
+constexpr field_group scan_run_groups[] = {{scan_run_fields}};
+constexpr field_group scan_best_groups[] = {{scan_best_fields}};
 
 constexpr table all_tables[] = {
     {"runs", "/problems/<p>/methods/<m>/runs", runs_groups},
@@ -179,6 +202,9 @@ constexpr table all_tables[] = {
     {"verdict_frame_rate", "/verdict/frame_rate", frame_rate_groups},
     {"verdict_frame_answer", "/verdict/frame_answer", frame_answer_groups},
     {"frame_rate_runs", "/frame_rates/<p>/runs", frame_rate_run_groups},
+    {"scan_points", "/scan/<name>/points", scan_point_groups},
+    {"scan_runs", "/scan/<name>/runs", scan_run_groups},
+    {"scan_best", "/scan/<name>/best", scan_best_groups},
 };
 
 }  // namespace

@@ -209,6 +209,140 @@ void write_problem(H5::Group& parent, const problem_study& ps, bool timed) {
   if (timed) write_front(g, ps, true, timed);
 }
 
+// /scan/<name>: a scan's axes and options as attributes, the grid values (points x axes),
+// and its points, runs and cheapest runs as tables (study/scan.hpp; docs/study-format.md).
+void write_scans(H5::H5File& file, const std::vector<scan_result>& scans) {
+  if (scans.empty()) return;
+  H5::Group all = file.createGroup("scan");
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (const auto& sc : scans) {
+    const auto& o = sc.options;
+    H5::Group g = all.createGroup(o.name.empty() ? o.problem : o.name);
+    attr(g, "problem", o.problem);
+    attr(g, "unit", sc.unit);
+    attr(g, "tol", o.tol);
+    std::vector<std::string> axis_names;
+    std::vector<double> lo, hi;
+    std::vector<int> count, log;
+    for (const auto& a : o.axes) {
+      axis_names.push_back(a.param);
+      lo.push_back(a.lo);
+      hi.push_back(a.hi);
+      count.push_back(a.count);
+      log.push_back(a.log ? 1 : 0);
+    }
+    attr(g, "axes", fmt::format("{}", fmt::join(axis_names, ",")));  // parameter names have no commas
+    attr(g, "axis_lo", lo);
+    attr(g, "axis_hi", hi);
+    attr(g, "axis_count", count);
+    attr(g, "axis_log", log);
+    attr(g, "hz", o.hz);
+    attr(g, "substeps", std::vector<int>(o.substeps.begin(), o.substeps.end()));
+    std::vector<std::string> fixed_names;
+    std::vector<double> fixed_values;
+    for (const auto& [name, value] : o.fixed) {
+      fixed_names.push_back(name);
+      fixed_values.push_back(value);
+    }
+    attr(g, "fixed_params", fmt::format("{}", fmt::join(fixed_names, ",")));
+    attr(g, "fixed_values", fixed_values);
+    attr(g, "reference_rtol", o.ref_tol.rtol);
+    attr(g, "reference_atol", o.ref_tol.atol);
+    attr(g, "work_budget", o.limits.work_budget);
+    attr(g, "wall_seconds", sc.wall_seconds);
+    // The grid: one 1-D dataset per axis under values/, a value per point.
+    H5::Group values = g.createGroup("values");
+    for (std::size_t k = 0; k < o.axes.size(); ++k) {
+      std::vector<double> column;
+      for (const auto& p : sc.points) column.push_back(p.values[k]);
+      h5::dataset(values, o.axes[k].param, column);
+    }
+    {
+      std::vector<std::int64_t> point;
+      std::vector<std::int8_t> trusted;
+      std::vector<std::string> source, note;
+      std::vector<double> horizon, scale;
+      for (std::size_t i = 0; i < sc.points.size(); ++i) {
+        const auto& p = sc.points[i];
+        point.push_back(static_cast<std::int64_t>(i));
+        trusted.push_back(p.trusted ? 1 : 0);
+        source.push_back(p.truth_source);
+        horizon.push_back(p.horizon);
+        scale.push_back(p.pos_scale);
+        note.push_back(p.note);
+      }
+      h5::table t;
+      t.add("point", point);
+      t.add("trusted", trusted);
+      t.add("truth_source", source);
+      t.add("horizon", horizon);
+      t.add("pos_scale", scale);
+      t.add("note", note);
+      t.write(g, "points", schema::find("scan_points"));
+    }
+    {
+      std::vector<std::int64_t> point, substeps, steps;
+      std::vector<double> hz, dt, err, evals, newton;
+      std::vector<std::int8_t> completed, diverged, failed, skipped;
+      std::vector<std::string> method, note;
+      for (const auto& r : sc.runs) {
+        const auto& m = r.row.metrics;
+        point.push_back(static_cast<std::int64_t>(r.point));
+        hz.push_back(r.hz);
+        method.push_back(r.method);
+        substeps.push_back(r.substeps);
+        dt.push_back(r.row.param);
+        completed.push_back(m.completed() ? 1 : 0);
+        diverged.push_back(m.diverged ? 1 : 0);
+        failed.push_back(m.failed ? 1 : 0);
+        skipped.push_back(m.skipped ? 1 : 0);
+        err.push_back(m.completed() ? m.err_pos_max : nan);
+        steps.push_back(r.row.steps);
+        evals.push_back(static_cast<double>(r.row.work.force_evals));
+        newton.push_back(static_cast<double>(r.row.work.newton_iterations));
+        note.push_back(m.note);
+      }
+      h5::table t;
+      t.add("point", point);
+      t.add("hz", hz);
+      t.add("method", method);
+      t.add("substeps", substeps);
+      t.add("dt", dt);
+      t.add("completed", completed);
+      t.add("diverged", diverged);
+      t.add("failed", failed);
+      t.add("skipped", skipped);
+      t.add("err_pos_max", err);
+      t.add("steps", steps);
+      t.add("force_evals", evals);
+      t.add("newton_iterations", newton);
+      t.add("note", note);
+      t.write(g, "runs", schema::find("scan_runs"));
+    }
+    {
+      std::vector<std::int64_t> point, substeps;
+      std::vector<double> hz, err, cost;
+      std::vector<std::string> method;
+      for (const auto& b : sc.best) {
+        point.push_back(static_cast<std::int64_t>(b.point));
+        hz.push_back(b.hz);
+        method.push_back(b.method);
+        substeps.push_back(b.substeps);
+        err.push_back(b.err_pos_max);
+        cost.push_back(b.force_evals_per_frame);
+      }
+      h5::table t;
+      t.add("point", point);
+      t.add("hz", hz);
+      t.add("method", method);
+      t.add("substeps", substeps);
+      t.add("err_pos_max", err);
+      t.add("force_evals_per_frame", cost);
+      t.write(g, "best", schema::find("scan_best"));
+    }
+  }
+}
+
 std::string temp_path_for(const std::string& path) { return fmt::format("{}.tmp.{}", path, ::getpid()); }
 
 // The whole study file built in memory (HDF5's core driver without a backing store;
@@ -264,6 +398,7 @@ std::vector<unsigned char> study_image(const study& s, const std::string& name) 
   write_loop(file, s);           // /loop: the game-loop study (study/loop.hpp), when the study holds one
   write_energy(file, s.energy);  // /energy: the long-run energy study (study/energy.hpp)
   write_verdict(file, s);        // /verdict and /frame_rates: the answer (study/verdict.hpp)
+  write_scans(file, s.scans);    // /scan: parameter scans (study/scan.hpp)
   file.flush(H5F_SCOPE_GLOBAL);
   const ssize_t size = H5Fget_file_image(file.getId(), nullptr, 0);
   std::vector<unsigned char> image(size > 0 ? static_cast<std::size_t>(size) : 0);

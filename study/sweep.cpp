@@ -3,14 +3,11 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <exception>
 #include <mutex>
 #include <stdexcept>
-#include <thread>
 
 #include "core/drive.hpp"
 #include "study/machine.hpp"
@@ -267,26 +264,9 @@ study run_sweep(const sweep_options& opts) {
   };
   const auto names = opts.problems.empty() ? problem_names() : opts.problems;
   std::vector<problem_study> swept(names.size());
-  std::vector<std::exception_ptr> failures(names.size());
-  std::atomic<std::size_t> next{0};
-  const auto worker = [&] {
-    for (std::size_t i; (i = next++) < names.size();) {
-      try {
-        swept[i] = sweep_problem(names[i], opts, warn);
-      } catch (...) {
-        failures[i] = std::current_exception();
-        next = names.size();  // the others stop at their current problem
-      }
-      part_done();
-    }
-  };
-  {
-    std::vector<std::jthread> threads;
-    for (int t = 1; t < sweep_jobs(opts, names.size()); ++t) threads.emplace_back(worker);
-    worker();
-  }
-  for (const auto& failure : failures)
-    if (failure) std::rethrow_exception(failure);
+  parallel_indices(
+      names.size(), sweep_jobs(opts, names.size()),
+      [&](std::size_t i) { swept[i] = sweep_problem(names[i], opts, warn); }, part_done);
   for (auto& ps : swept) out.problems.push_back(std::move(ps));
   out.substeps = run_substeps(out, opts.substeps);
   out.frame_rates = run_frame_rates(out, opts.frame_rates);

@@ -16,7 +16,9 @@
 #include "core/method.hpp"
 #include "study/energy.hpp"
 #include "study/loop.hpp"
+#include "study/method_row.hpp"
 #include "study/registry.hpp"
+#include "study/scan.hpp"
 #include "study/stability.hpp"
 
 namespace stepbench {
@@ -81,25 +83,6 @@ int sweep_jobs(const sweep_options& opts, std::size_t problems);
 
 // The parts on_progress counts: the problems, then the frame-rate, loop and energy studies.
 std::size_t sweep_parts(const sweep_options& opts);
-
-// Wall time of one whole run, from the benchmark (absent unless timed).
-struct timing {
-  double time_ns = std::numeric_limits<double>::quiet_NaN();      // median over repetitions
-  double time_ns_min = std::numeric_limits<double>::quiet_NaN();  // fastest repetition
-  double time_ns_max = std::numeric_limits<double>::quiet_NaN();  // slowest repetition
-  long repetitions = 0;
-  bool cut = false;  // skipped by the per-case time budget
-};
-
-// One run of one method at one parameter: the single row shape of the study.
-struct method_row {
-  double param = 0.0;  // dt [s] or relative tolerance
-  long steps = 0;
-  long rejected_steps = 0;
-  work_counters work{};
-  run_metrics metrics;
-  timing time;
-};
 
 struct method_study {
   method_info info;
@@ -168,6 +151,7 @@ struct study {
   // The stability limits and regions of our integrators (study/stability.hpp): not of the
   // selected problems, so every study carries the same, computed by run_sweep.
   stability_data stability;
+  std::vector<scan_result> scans;  // parameter scans (study/scan.hpp), written under /scan
   double wall_seconds = 0.0;
   std::optional<timing_settings> timed;
 };

@@ -21,18 +21,6 @@ namespace {
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 constexpr const char* metric = "err_pos_max";
 
-// The truth at every stride-th sample of `t` (the frame ends of a slower rate).
-truth_table every_nth(const truth_table& t, std::size_t stride) {
-  truth_table out = t;
-  out.times.clear();
-  out.y.clear();
-  for (std::size_t j = stride - 1; j < t.times.size(); j += stride) {
-    out.times.push_back(t.times[j]);
-    out.y.push_back(t.y[j]);
-  }
-  return out;
-}
-
 bool contains(const std::vector<std::string>& v, std::string_view s) {
   return std::find(v.begin(), v.end(), s) != v.end();
 }
@@ -45,6 +33,17 @@ std::string with_substeps(const std::string& method, int n) {
 }
 
 }  // namespace
+
+truth_table every_nth(const truth_table& t, std::size_t stride) {
+  truth_table out = t;
+  out.times.clear();
+  out.y.clear();
+  for (std::size_t j = stride - 1; j < t.times.size(); j += stride) {
+    out.times.push_back(t.times[j]);
+    out.y.push_back(t.y[j]);
+  }
+  return out;
+}
 
 std::vector<double> verdict_targets() { return equal_error_targets(); }
 

@@ -28,6 +28,9 @@ namespace stepbench {
 
 // Runs the frame-rate study on every problem of `s` (their truths are rebuilt at the frame
 // ends of the fastest rate). A problem whose horizon holds no whole frame is left out.
+// The truth at every stride-th sample of `t` (the frame ends of a slower rate).
+truth_table every_nth(const truth_table& t, std::size_t stride);
+
 std::vector<frame_rate_study> run_frame_rates(const study& s, const frame_rate_options& opts);
 
 // The error targets of the verdict: 1e-2 .. 1e-12.

@@ -157,6 +157,26 @@ grep -q 'e+0[0-9] ns' "$work/out" && bad "loop prints powers of ten of ns: $(cat
 [ "$("$bin" list | grep -c 'aluminum_on_aluminum')" -eq 1 ] && ok || bad "list prints the friction table more than once"
 "$bin" stability | grep -q 'y_max theory (a)  y_max measured (b)' && ok || bad "stability's columns are not labelled"
 
+# scan: one line and exit 2 for a bad axis; the answer as JSON on stdout, progress on
+# stderr; advise --scan answers from the file; a file without a scan is exit 1.
+expect_error "outside the parameter's range: k_s must be a positive finite number" scan --problem stiff_spring --param stiff_spring.k_s=-1:1e7:5 --out "$work/scan.h5"
+expect_error "stiff_spring has no parameter 'kk'" scan --problem stiff_spring --param stiff_spring.kk=1:2:3 --out "$work/scan.h5"
+expect_error "frame rate 45 Hz does not divide the fastest, 60 Hz" scan --problem stiff_spring --param stiff_spring.k_s=1:2:3 --hz 60,45 --out "$work/scan.h5"
+[ ! -e "$work/scan.h5" ] && ok || bad "a refused scan wrote its file"
+"$bin" scan --problem stiff_spring --param stiff_spring.k_s=1e1:1e7:25:log --hz 60 --substeps 1,8 --json \
+  --out "$work/scan.h5" >"$work/out" 2>"$work/err" || bad "scan failed: $(cat "$work/err")"
+/usr/bin/python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["points"] == 25, d' "$work/out" && ok ||
+  bad "scan --json is not one JSON object: $(head -3 "$work/out")"
+grep -q '^wrote .*scan.h5 (/scan/stiff_spring: 25 points' "$work/err" && ok || bad "scan's summary: $(cat "$work/err")"
+"$bin" advise --scan "$work/scan.h5" --tol 1e-3 >"$work/out"
+rc=$?  # 3: with at most 8 substeps nothing holds 1 mm over the whole range
+[ "$rc" -eq 3 ] && grep -q '60 Hz: no method of the scan stays within 0.001 m over the whole range' "$work/out" && ok ||
+  bad "advise --scan at 1e-3 exited $rc: $(cat "$work/out")"
+grep -q '60 Hz  rk4  *diverges for k_s >= 5.62e+04 N/m' "$work/out" && ok || bad "advise --scan: $(cat "$work/out")"
+"$bin" advise --scan "$work/none.h5" --tol 1e-3 >/dev/null 2>"$work/err"
+[ $? -eq 1 ] && grep -q "cannot read the scan in '.*none.h5': no such file" "$work/err" && ok ||
+  bad "advise --scan of a missing file: $(cat "$work/err")"
+
 # stepbench_bench, beside stepbench: --help lists our flags, one line each, above Google
 # Benchmark's.
 bench=$(dirname "$bin")/stepbench_bench

@@ -1,0 +1,154 @@
+// `stepbench scan`: a problem over a grid of its parameters, at frame rates and substeps
+// (study/scan.hpp), into a study file under /scan/<name>, then the range answer.
+#include "study/scan.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "cli/args.hpp"
+#include "cli/commands.hpp"
+#include "study/study_file.hpp"
+
+namespace stepbench::cli {
+namespace {
+
+struct scan_args {
+  std::string problem, hz_text, dt_text, substeps_text, tol_text = "1e-3", name, out = "results/scan.h5";
+  std::vector<std::string> params, sets, methods;
+  int jobs = 0;
+  bool json = false, quiet = false;
+};
+
+std::vector<double> number_list(const std::string& text, std::string_view what) {
+  std::vector<double> out;
+  for (std::size_t start = 0; start <= text.size();) {
+    const auto comma = std::min(text.find(',', start), text.size());
+    out.push_back(parse_number(std::string_view(text).substr(start, comma - start), what));
+    start = comma + 1;
+  }
+  return out;
+}
+
+}  // namespace
+
+nlohmann::json scan_answer_json(const scan_answer& a) {
+  nlohmann::json out = {{"problem", a.problem},
+                        {"unit", a.unit},
+                        {"range", a.range},
+                        {"tol", a.tol},
+                        {"points", a.points},
+                        {"untrusted_points", a.untrusted},
+                        {"choices", nlohmann::json::array()},
+                        {"one_step_a_frame", nlohmann::json::array()}};
+  for (const auto& c : a.choices)
+    out["choices"].push_back({{"hz", c.hz},
+                              {"method", c.method.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.method)},
+                              {"substeps", c.substeps},
+                              {"worst_err_pos_max", c.worst_err},
+                              {"max_force_evals_per_frame", c.max_force_evals_per_frame}});
+  for (const auto& b : a.breaks)
+    out["one_step_a_frame"].push_back({{"hz", b.hz},
+                                       {"method", b.method},
+                                       {"unstable_points", b.unstable},
+                                       {"points", b.points},
+                                       {"where", b.where}});
+  return out;
+}
+
+namespace {
+
+int run_scan_command(const scan_args& a) {
+  scan_options o;
+  o.problem = a.problem;
+  o.name = a.name;
+  make_problem(a.problem);  // an unknown problem is named before the axes are read
+  for (const auto& p : a.params) o.axes.push_back(parse_scan_axis(p, a.problem));
+  if (!a.hz_text.empty() && !a.dt_text.empty()) throw std::invalid_argument("give --hz or --dt, not both");
+  if (!a.hz_text.empty()) o.hz = number_list(a.hz_text, "--hz");
+  if (!a.dt_text.empty()) {
+    o.hz.clear();
+    for (double dt : number_list(a.dt_text, "--dt")) {
+      if (!(dt > 0.0)) throw std::invalid_argument(fmt::format("--dt {:g} is not positive", dt));
+      o.hz.push_back(1.0 / dt);  // a frame of dt: the runs take 1, 2, 4 ... substeps of it
+    }
+  }
+  if (!a.substeps_text.empty()) {
+    o.substeps.clear();
+    for (double n : number_list(a.substeps_text, "--substeps")) {
+      if (!(n >= 1 && n == std::floor(n) && n <= (1 << 20)))
+        throw std::invalid_argument(fmt::format("--substeps {:g} is not a whole number from 1 to 2^20", n));
+      o.substeps.push_back(static_cast<int>(n));
+    }
+  }
+  o.tol = parse_number(a.tol_text, "--tol");
+  o.methods = a.methods;
+  o.jobs = a.jobs;
+  parameter_overrides sets;
+  for (const auto& s : a.sets) add_override(sets, s, std::vector<std::string>{a.problem});
+  if (auto it = sets.find(a.problem); it != sets.end()) o.fixed = it->second;
+  validate(o);
+  check_writable(a.out);
+  // Progress on stderr: a line every 5 s (the scan's answer is what stdout carries).
+  const auto start = std::chrono::steady_clock::now();
+  auto last = start;
+  o.on_progress = [&](std::size_t done, std::size_t total) {
+    const auto now = std::chrono::steady_clock::now();
+    if (a.quiet || (done < total && now - last < std::chrono::seconds(5))) return;
+    last = now;
+    const double elapsed = std::chrono::duration<double>(now - start).count();
+    fmt::print(stderr, "scan: {} of {} points, {:.0f} s elapsed{}\n", done, total, elapsed,
+               done < total ? fmt::format(", about {:.0f} s left", elapsed / done * (total - done)) : "");
+  };
+  study s;
+  s.scans.push_back(run_scan(o));
+  s.wall_seconds = s.scans.back().wall_seconds;
+  write_study(s, a.out);
+  const scan_answer answer = answer_scan(s.scans.back(), o.tol);
+  if (a.json)
+    std::cout << scan_answer_json(answer).dump(2) << "\n";
+  else
+    fmt::print("{}", format_scan_answer(answer));
+  if (!a.quiet)
+    fmt::print(stderr,
+               "wrote {} (/scan/{}: {} points, {} runs) in {:.2f} s; `stepbench advise --scan {} --tol X` "
+               "answers at another tolerance\n",
+               a.out, o.name.empty() ? o.problem : o.name, s.scans.back().points.size(), s.scans.back().runs.size(),
+               s.wall_seconds, a.out);
+  return 0;
+}
+
+}  // namespace
+
+command add_scan(CLI::App& app) {
+  auto a = std::make_shared<scan_args>();
+  auto* sub = app.add_subcommand(
+      "scan",
+      "a problem over a grid of its parameters, frame rates and substeps: where each method breaks, and the "
+      "cheapest that holds over the whole range");
+  sub->add_option("--problem", a->problem, "the problem to scan")->required();
+  sub->add_option("--param", a->params, "an axis, problem.name=lo:hi:count[:log] (repeatable)")->required();
+  sub->add_option("--hz", a->hz_text, "frame rates, comma-separated; each divides the fastest (30,60,120,240)");
+  sub->add_option("--dt", a->dt_text, "frame timesteps instead of rates, comma-separated");
+  sub->add_option("--substeps", a->substeps_text, "substeps a frame, comma-separated (1,2,4,8,16,32,64)");
+  sub->add_option("--integrator,--method", a->methods,
+                  "fixed-step methods to run (repeatable; default: our fixed-step methods)");
+  sub->add_option("--tol", a->tol_text, "the error tolerance in the problem's unit, err_pos_max")
+      ->capture_default_str();
+  sub->add_option("--set", a->sets, "fix another parameter, problem.name=value (repeatable)");
+  sub->add_option("--name", a->name, "the scan's group under /scan (default: the problem's name)");
+  sub->add_option("--jobs", a->jobs, "threads over the grid points (0: one a core)")->check(CLI::NonNegativeNumber);
+  sub->add_option("--out", a->out, "study file to write")->capture_default_str();
+  sub->add_flag("--json", a->json, "the answer as JSON on stdout");
+  sub->add_flag("--quiet", a->quiet, "no progress or summary on stderr");
+  sub->footer(
+      "exit codes: 0 written whole (a method that diverges at a point is a finding, recorded there); 1 a file "
+      "error; 2 bad usage (an axis outside the parameter's range, an unknown name)\n");
+  return {sub, [a] { return run_scan_command(*a); }};
+}
+
+}  // namespace stepbench::cli

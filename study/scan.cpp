@@ -1,0 +1,482 @@
+#include "study/scan.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <stdexcept>
+
+#include "core/measure.hpp"
+#include "study/h5.hpp"
+#include "study/machine.hpp"
+#include "study/registry.hpp"
+#include "study/verdict.hpp"
+
+namespace stepbench {
+namespace {
+
+double number(std::string_view text, std::string_view what, std::string_view axis) {
+  double v = 0.0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(v))
+    throw std::invalid_argument(fmt::format("--param {}: {} '{}' is not a finite number", axis, what, text));
+  return v;
+}
+
+std::vector<std::string_view> split(std::string_view text, char sep) {
+  std::vector<std::string_view> out;
+  for (std::size_t start = 0;;) {
+    const auto at = text.find(sep, start);
+    out.push_back(text.substr(start, at == std::string_view::npos ? std::string_view::npos : at - start));
+    if (at == std::string_view::npos) return out;
+    start = at + 1;
+  }
+}
+
+// The frame-rate study's frames: whole frames of the slowest rate within the problem's
+// horizon, the truth at the fastest rate's frame ends (every rate divides the fastest).
+struct frames {
+  double horizon = 0.0;
+  std::vector<double> times;
+};
+
+frames frames_of(double problem_horizon, const std::vector<double>& hz) {
+  const double slowest = *std::min_element(hz.begin(), hz.end());
+  const double fastest = *std::max_element(hz.begin(), hz.end());
+  frames f;
+  const long slow_frames = std::max(1L, static_cast<long>(std::floor(problem_horizon * slowest * (1.0 + 1e-12))));
+  f.horizon = static_cast<double>(slow_frames) / slowest;
+  const long fast_frames = std::lround(f.horizon * fastest);
+  for (long j = 1; j <= fast_frames; ++j) f.times.push_back(static_cast<double>(j) / fastest);
+  return f;
+}
+
+}  // namespace
+
+std::vector<double> scan_axis::values() const {
+  // Log axes in powers of ten, so that whole decades are exact (glibc's pow is exact
+  // for 10^k); both ends are the values given.
+  std::vector<double> out;
+  for (int i = 0; i < count; ++i) {
+    const double s = count == 1 ? 0.0 : static_cast<double>(i) / (count - 1);
+    out.push_back(i == 0           ? lo
+                  : i == count - 1 ? hi
+                  : log            ? std::pow(10.0, std::log10(lo) + s * (std::log10(hi) - std::log10(lo)))
+                                   : lo + s * (hi - lo));
+  }
+  return out;
+}
+
+scan_axis parse_scan_axis(std::string_view text, const std::string& problem) {
+  const auto eq = text.find('=');
+  const auto dot = text.find('.');
+  if (eq == std::string_view::npos || dot == std::string_view::npos || dot > eq)
+    throw std::invalid_argument(fmt::format("malformed --param '{}': expected problem.name=lo:hi:count[:log]", text));
+  const std::string_view target = text.substr(0, dot), name = text.substr(dot + 1, eq - dot - 1);
+  if (target != problem)
+    throw std::invalid_argument(fmt::format("--param {}: the scan is of {}, not {}", text, problem, target));
+  const auto parts = split(text.substr(eq + 1), ':');
+  if (parts.size() < 3 || parts.size() > 4 || (parts.size() == 4 && parts[3] != "log"))
+    throw std::invalid_argument(fmt::format("malformed --param '{}': expected problem.name=lo:hi:count[:log]", text));
+  scan_axis a;
+  a.param = std::string(name);
+  a.lo = number(parts[0], "lo", text);
+  a.hi = number(parts[1], "hi", text);
+  const double count = number(parts[2], "count", text);
+  if (!(count >= 1 && count <= 1e5 && count == std::floor(count)))
+    throw std::invalid_argument(fmt::format("--param {}: count must be a whole number from 1 to 100000", text));
+  a.count = static_cast<int>(count);
+  a.log = parts.size() == 4;
+  if (a.count > 1 && !(a.lo < a.hi)) throw std::invalid_argument(fmt::format("--param {}: lo must be below hi", text));
+  if (a.log && !(a.lo > 0.0)) throw std::invalid_argument(fmt::format("--param {}: a log axis needs lo > 0", text));
+  const auto params = make_problem(problem)->params();
+  const auto it = std::find_if(params.begin(), params.end(), [&](const param_value& p) { return p.name == name; });
+  if (it == params.end()) {
+    std::string known;
+    for (const auto& p : params) known += (known.empty() ? "" : ", ") + p.name;
+    throw std::invalid_argument(
+        fmt::format("--param {}: {} has no parameter '{}' (it has {})", text, problem, name, known));
+  }
+  for (double v : {a.lo, a.hi})
+    if (auto why = it->check(v); !why.empty())
+      throw std::invalid_argument(fmt::format("--param {}: {} is outside the parameter's range: {}", text, v, why));
+  if (it->allowed.whole)
+    for (double v : a.values())
+      if (v != std::floor(v))
+        throw std::invalid_argument(
+            fmt::format("--param {}: {} takes whole numbers, and the axis has {:g}", text, a.param, v));
+  return a;
+}
+
+std::vector<std::vector<double>> scan_grid(const std::vector<scan_axis>& axes) {
+  std::vector<std::vector<double>> out{{}};
+  for (const auto& axis : axes) {
+    std::vector<std::vector<double>> next;
+    for (const auto& prefix : out)
+      for (double v : axis.values()) {
+        next.push_back(prefix);
+        next.back().push_back(v);
+      }
+    out = std::move(next);
+  }
+  return out;
+}
+
+void validate(const scan_options& opts) {
+  auto problem = make_problem(opts.problem);  // throws, naming an unknown problem
+  if (opts.axes.empty()) throw std::invalid_argument("scan: give at least one --param axis");
+  for (std::size_t i = 0; i < opts.axes.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (opts.axes[i].param == opts.axes[j].param)
+        throw std::invalid_argument(fmt::format("scan: parameter {} is given two axes", opts.axes[i].param));
+  double points = 1.0;
+  for (const auto& a : opts.axes) points *= a.count;
+  if (points > 1e6) throw std::invalid_argument(fmt::format("scan: {:.3g} grid points; the limit is 10^6", points));
+  if (opts.hz.empty()) throw std::invalid_argument("scan: no frame rate");
+  const double fastest = *std::max_element(opts.hz.begin(), opts.hz.end());
+  for (double hz : opts.hz)
+    if (!(hz > 0.0 && std::isfinite(hz)) || std::abs(fastest / hz - std::round(fastest / hz)) > 1e-9)
+      throw std::invalid_argument(
+          fmt::format("scan: frame rate {:g} Hz does not divide the fastest, {:g} Hz", hz, fastest));
+  if (opts.substeps.empty()) throw std::invalid_argument("scan: no substep count");
+  for (int n : opts.substeps)
+    if (n < 1 || n > 1 << 20) throw std::invalid_argument(fmt::format("scan: substeps {} is not in 1 .. 2^20", n));
+  if (!(opts.tol > 0.0 && std::isfinite(opts.tol)))
+    throw std::invalid_argument("scan: the tolerance must be a positive number");
+  const auto methods = problem->methods();
+  for (const auto& m : opts.methods) {
+    const auto it = std::find_if(methods.begin(), methods.end(), [&](const method_info& i) { return i.name == m; });
+    if (it == methods.end()) throw std::invalid_argument(fmt::format("scan: {} does not run on {}", m, opts.problem));
+    if (it->kind != method_kind::fixed_step)
+      throw std::invalid_argument(fmt::format("scan: {} is adaptive; a scan runs fixed-step methods", m));
+  }
+  for (const auto& [name, value] : opts.fixed) {
+    problem->set(name, value);  // throws for an unknown parameter
+    for (const auto& a : opts.axes)
+      if (a.param == name) throw std::invalid_argument(fmt::format("scan: {} is both set and scanned", name));
+  }
+}
+
+scan_result run_scan(const scan_options& opts) {
+  validate(opts);
+  const auto start = std::chrono::steady_clock::now();
+  scan_result out;
+  out.options = opts;
+  auto proto = make_problem(opts.problem);
+  out.unit = std::string(proto->position_unit());
+  std::vector<method_info> methods;
+  for (const auto& m : proto->methods())
+    if (m.kind == method_kind::fixed_step &&
+        (opts.methods.empty() ? m.origin == method_origin::ours
+                              : std::find(opts.methods.begin(), opts.methods.end(), m.name) != opts.methods.end()))
+      methods.push_back(m);
+  const auto grid = scan_grid(opts.axes);
+  const double fastest = *std::max_element(opts.hz.begin(), opts.hz.end());
+
+  // Each point on its own: its problem, truth and runs, into its slot (the result does
+  // not depend on the threads), then concatenated in grid order.
+  struct point_work {
+    scan_point point;
+    std::vector<scan_run> runs;
+  };
+  std::vector<point_work> work(grid.size());
+  const auto run_point = [&](std::size_t i) {
+    auto& w = work[i];
+    w.point.values = grid[i];
+    auto problem = make_problem(opts.problem);
+    for (const auto& [name, value] : opts.fixed) problem->set(name, value);
+    for (std::size_t a = 0; a < opts.axes.size(); ++a) problem->set(opts.axes[a].param, grid[i][a]);
+    if (auto why = problem->validate(); !why.empty()) {
+      w.point.trusted = false;
+      w.point.truth_source = "none";
+      w.point.note = "not run: " + why;
+      return;
+    }
+    const frames f = frames_of(problem->horizon(), opts.hz);
+    w.point.horizon = f.horizon;
+    const truth_table fine = build_truth(*problem, f.times, {.tol = opts.ref_tol});
+    w.point.truth_source = fine.source;
+    w.point.trusted = fine.trusted;
+    w.point.note = fine.note;
+    w.point.pos_scale = fine.pos_scale;
+    for (double hz : opts.hz) {
+      const truth_table truth = every_nth(fine, static_cast<std::size_t>(std::lround(fastest / hz)));
+      for (const auto& m : methods)
+        for (int n : opts.substeps) {
+          const double dt = 1.0 / (hz * n);
+          const run_result run = problem->run(m.name, dt, f.horizon, truth.times, opts.limits);
+          scan_run r{
+              i, hz, m.name, n, {dt, run.steps, run.rejected_steps, run.work, measure(*problem, run, truth), {}}};
+          // Past the work budget every finer count is too; past round-off nothing is learnt.
+          const bool done = r.row.metrics.skipped;
+          w.runs.push_back(std::move(r));
+          if (done) break;
+        }
+    }
+  };
+  std::size_t done = 0;
+  parallel_indices(grid.size(), opts.jobs, run_point, [&] {
+    ++done;
+    if (opts.on_progress) opts.on_progress(done, grid.size());
+  });
+
+  for (auto& w : work) {
+    out.points.push_back(std::move(w.point));
+    for (auto& r : w.runs) out.runs.push_back(std::move(r));
+  }
+  // The cheapest run meeting the tolerance at each point and rate: fewest force
+  // evaluations (the same frames at one rate, so the total compares), then fewer substeps.
+  for (std::size_t i = 0; i < out.points.size(); ++i)
+    for (double hz : opts.hz) {
+      scan_best b{i, hz, "", 0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
+      const scan_run* pick = nullptr;
+      for (const auto& r : out.runs) {
+        if (r.point != i || r.hz != hz || !r.row.metrics.completed() || !(r.row.metrics.err_pos_max <= opts.tol))
+          continue;
+        if (!pick || r.row.work.force_evals < pick->row.work.force_evals ||
+            (r.row.work.force_evals == pick->row.work.force_evals && r.substeps < pick->substeps))
+          pick = &r;
+      }
+      if (pick) {
+        const double frames_run = out.points[i].horizon * hz;
+        b.method = pick->method;
+        b.substeps = pick->substeps;
+        b.err_pos_max = pick->row.metrics.err_pos_max;
+        b.force_evals_per_frame = static_cast<double>(pick->row.work.force_evals) / frames_run;
+      }
+      out.best.push_back(b);
+    }
+  out.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+}  // namespace stepbench
+
+namespace stepbench {
+namespace {
+
+std::string param_unit(const std::string& problem, const std::string& param) {
+  try {
+    for (const auto& p : make_problem(problem)->params())
+      if (p.name == param) return p.unit == "1" ? "" : " " + p.unit;
+  } catch (const std::exception&) {
+  }
+  return "";
+}
+
+std::string range_text(const scan_result& s) {
+  std::vector<std::string> parts;
+  for (const auto& a : s.options.axes)
+    parts.push_back(fmt::format("{} {:g} .. {:g}{} ({} points{})", a.param, a.lo, a.hi,
+                                param_unit(s.options.problem, a.param), a.count, a.log ? ", log" : ""));
+  return fmt::format("{}", fmt::join(parts, " x "));
+}
+
+}  // namespace
+
+scan_answer answer_scan(const scan_result& s, double tol) {
+  scan_answer a;
+  a.problem = s.options.problem;
+  a.unit = s.unit;
+  a.tol = tol;
+  a.range = range_text(s);
+  a.points = s.points.size();
+  for (const auto& p : s.points) a.untrusted += p.trusted ? 0 : 1;
+  // Runs by (rate, method, substeps), over the trusted points.
+  struct combo {
+    double hz;
+    std::string method;
+    int substeps;
+    std::size_t runs = 0, within = 0;
+    double worst = 0.0, cost = 0.0;
+    std::vector<std::size_t> unstable;  // point indices
+  };
+  std::vector<combo> combos;
+  const auto find_combo = [&](double hz, const std::string& m, int n) -> combo& {
+    for (auto& c : combos)
+      if (c.hz == hz && c.method == m && c.substeps == n) return c;
+    combos.push_back({hz, m, n, 0, 0, 0.0, 0.0, {}});
+    return combos.back();
+  };
+  for (const auto& r : s.runs) {
+    const auto& p = s.points[r.point];
+    if (!p.trusted) continue;
+    combo& c = find_combo(r.hz, r.method, r.substeps);
+    ++c.runs;
+    const auto& m = r.row.metrics;
+    if (m.completed() && m.err_pos_max <= tol) ++c.within;
+    c.worst = m.completed() ? std::max(c.worst, m.err_pos_max) : std::numeric_limits<double>::infinity();
+    if (m.diverged || m.failed) c.unstable.push_back(r.point);
+    c.cost = std::max(c.cost, static_cast<double>(r.row.work.force_evals) / (p.horizon * r.hz));
+  }
+  const std::size_t trusted = a.points - a.untrusted;
+  for (double hz : s.options.hz) {
+    scan_choice best{hz, "", 0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
+    for (const auto& c : combos) {
+      if (c.hz != hz || c.runs != trusted || c.within != trusted || trusted == 0) continue;
+      if (best.method.empty() || c.cost < best.max_force_evals_per_frame ||
+          (c.cost == best.max_force_evals_per_frame && c.substeps < best.substeps))
+        best = {hz, c.method, c.substeps, c.worst, c.cost};
+    }
+    a.choices.push_back(best);
+    for (const auto& c : combos) {
+      if (c.hz != hz || c.substeps != 1) continue;
+      scan_break b{hz, c.method, c.unstable.size(), c.runs, ""};
+      if (!c.unstable.empty() && s.options.axes.size() == 1) {
+        // One axis: the unstable values as ranges of consecutive grid points.
+        const auto& axis = s.options.axes[0];
+        const std::string unit = param_unit(s.options.problem, axis.param);
+        std::vector<std::string> spans;
+        for (std::size_t k = 0; k < c.unstable.size();) {
+          std::size_t e = k;
+          while (e + 1 < c.unstable.size() && c.unstable[e + 1] == c.unstable[e] + 1) ++e;
+          const double lo = s.points[c.unstable[k]].values[0], hi = s.points[c.unstable[e]].values[0];
+          const bool to_end = c.unstable[e] + 1 == s.points.size(), from_start = c.unstable[k] == 0;
+          spans.push_back(to_end && !from_start   ? fmt::format("{} >= {:.3g}{}", axis.param, lo, unit)
+                          : from_start && !to_end ? fmt::format("{} <= {:.3g}{}", axis.param, hi, unit)
+                          : lo == hi              ? fmt::format("{} = {:.3g}{}", axis.param, lo, unit)
+                                                  : fmt::format("{} {:.3g} .. {:.3g}{}", axis.param, lo, hi, unit));
+          k = e + 1;
+        }
+        b.where = fmt::format("diverges for {}", fmt::join(spans, ", "));
+      } else if (!c.unstable.empty()) {
+        std::vector<std::string> at;
+        for (std::size_t k = 0; k < s.options.axes.size(); ++k)
+          at.push_back(fmt::format("{} = {:.3g}", s.options.axes[k].param, s.points[c.unstable.front()].values[k]));
+        b.where =
+            fmt::format("diverges at {} of {} points, first at {}", c.unstable.size(), c.runs, fmt::join(at, ", "));
+      } else {
+        b.where = "stable everywhere";
+      }
+      a.breaks.push_back(b);
+    }
+  }
+  return a;
+}
+
+std::string format_scan_answer(const scan_answer& a) {
+  std::string out = fmt::format("{} over {}, within {:g} {} (err_pos_max):\n", a.problem, a.range, a.tol, a.unit);
+  for (const auto& c : a.choices) {
+    if (c.method.empty())
+      out += fmt::format("  {:g} Hz: no method of the scan stays within {:g} {} over the whole range\n", c.hz, a.tol,
+                         a.unit);
+    else
+      out += fmt::format(
+          "  {:g} Hz: {} with {} stays stable and within {:g} {} everywhere (worst {:.3g} {}, "
+          "{:.4g} force evaluations a frame at most)\n",
+          c.hz, c.method, c.substeps == 1 ? std::string("one step a frame") : fmt::format("{} substeps", c.substeps),
+          a.tol, a.unit, c.worst_err, a.unit, c.max_force_evals_per_frame);
+  }
+  out += "At one step a frame:\n";
+  for (const auto& b : a.breaks) out += fmt::format("  {:g} Hz  {:<22} {}\n", b.hz, b.method, b.where);
+  if (a.untrusted > 0)
+    out += fmt::format("{} of {} points have no trusted truth and are left out (see the scan's points table)\n",
+                       a.untrusted, a.points);
+  return out;
+}
+
+scan_result read_scan(const std::string& path, const std::string& name) {
+  scan_result s;
+  try {
+    if (!std::filesystem::exists(path)) throw std::runtime_error("no such file");
+    if (!H5::H5File::isHdf5(path)) throw std::runtime_error("not an HDF5 file");
+    const H5::H5File file(path, H5F_ACC_RDONLY);
+    if (!h5::is_group(file, "scan")) throw std::runtime_error("it holds no scan (/scan is absent)");
+    const H5::Group all = file.openGroup("scan");
+    const auto names = h5::children(all);
+    std::string which = name;
+    if (which.empty()) {
+      if (names.size() != 1)
+        throw std::invalid_argument(
+            fmt::format("'{}' holds {} scans; name one with --name ({})", path, names.size(), fmt::join(names, ", ")));
+      which = names.front();
+    }
+    if (!h5::is_group(all, which))
+      throw std::invalid_argument(
+          fmt::format("'{}' has no scan '{}' (it has: {})", path, which, fmt::join(names, ", ")));
+    const H5::Group g = all.openGroup(which);
+    auto& o = s.options;
+    o.name = which;
+    o.problem = h5::string_attr(g, "problem");
+    s.unit = h5::string_attr(g, "unit");
+    o.tol = h5::double_attr(g, "tol");
+    const auto lo = h5::double_array_attr(g, "axis_lo"), hi = h5::double_array_attr(g, "axis_hi");
+    const auto count = h5::int_array_attr(g, "axis_count"), log = h5::int_array_attr(g, "axis_log");
+    const std::string axes = h5::string_attr(g, "axes");
+    std::vector<std::string> axis_names;
+    for (std::size_t start = 0; start <= axes.size();) {
+      const auto comma = std::min(axes.find(',', start), axes.size());
+      axis_names.push_back(axes.substr(start, comma - start));
+      start = comma + 1;
+    }
+    if (axis_names.size() != lo.size() || lo.size() != hi.size() || hi.size() != count.size() ||
+        count.size() != log.size())
+      throw std::runtime_error(fmt::format("scan '{}': its axis attributes differ in length", which));
+    for (std::size_t k = 0; k < axis_names.size(); ++k)
+      o.axes.push_back({axis_names[k], lo[k], hi[k], static_cast<int>(count[k]), log[k] != 0});
+    o.hz = h5::double_array_attr(g, "hz");
+    for (long n : h5::int_array_attr(g, "substeps")) o.substeps.push_back(static_cast<int>(n));
+    const H5::Group values = g.openGroup("values");
+    std::vector<std::vector<double>> columns;
+    for (const auto& a : o.axes) columns.push_back(h5::read_vector(values.openDataSet(a.param)));
+    const h5::table_data points = h5::read_table(g.openDataSet("points"));
+    const auto& trusted = points.ints("trusted");
+    const auto& source = points.strings("truth_source");
+    const auto& note = points.strings("note");
+    const auto horizon = points.doubles("horizon"), scale = points.doubles("pos_scale");
+    for (std::size_t i = 0; i < points.rows(); ++i) {
+      scan_point p;
+      for (const auto& c : columns) {
+        if (c.size() != points.rows())
+          throw std::runtime_error(fmt::format("scan '{}': values/ and points differ in length", which));
+        p.values.push_back(c[i]);
+      }
+      p.trusted = trusted[i] != 0;
+      p.truth_source = source[i];
+      p.note = note[i];
+      p.horizon = horizon[i];
+      p.pos_scale = scale[i];
+      s.points.push_back(std::move(p));
+    }
+    const h5::table_data runs = h5::read_table(g.openDataSet("runs"));
+    const auto& point = runs.ints("point");
+    const auto hz = runs.doubles("hz"), dt = runs.doubles("dt"), err = runs.doubles("err_pos_max"),
+               evals = runs.doubles("force_evals"), newton = runs.doubles("newton_iterations");
+    const auto& method = runs.strings("method");
+    const auto &substeps = runs.ints("substeps"), &steps = runs.ints("steps");
+    const auto &diverged = runs.ints("diverged"), &failed = runs.ints("failed"), &skipped = runs.ints("skipped");
+    const auto& run_note = runs.strings("note");
+    for (std::size_t i = 0; i < runs.rows(); ++i) {
+      if (point[i] < 0 || static_cast<std::size_t>(point[i]) >= s.points.size())
+        throw std::runtime_error(
+            fmt::format("scan '{}': run {} names point {}, beyond its {} points", which, i, point[i], s.points.size()));
+      scan_run r;
+      r.point = static_cast<std::size_t>(point[i]);
+      r.hz = hz[i];
+      r.method = method[i];
+      r.substeps = static_cast<int>(substeps[i]);
+      r.row.param = dt[i];
+      r.row.steps = steps[i];
+      r.row.work.force_evals = static_cast<long>(evals[i]);
+      r.row.work.newton_iterations = static_cast<long>(newton[i]);
+      r.row.metrics.err_pos_max = err[i];
+      r.row.metrics.diverged = diverged[i] != 0;
+      r.row.metrics.failed = failed[i] != 0;
+      r.row.metrics.skipped = skipped[i] != 0;
+      r.row.metrics.note = run_note[i];
+      s.runs.push_back(std::move(r));
+    }
+  } catch (const std::invalid_argument&) {
+    throw;
+  } catch (const H5::Exception& e) {
+    throw std::runtime_error(fmt::format("cannot read the scan in '{}': {}", path, e.getDetailMsg()));
+  } catch (const std::exception& e) {
+    throw std::runtime_error(fmt::format("cannot read the scan in '{}': {}", path, e.what()));
+  }
+  return s;
+}
+
+}  // namespace stepbench

@@ -1,0 +1,140 @@
+#pragma once
+// A scene's whole range (issue 20): `stepbench scan` runs the fixed-step methods over a
+// grid of a problem's declared parameters and, at each grid point, over frame rates and
+// substeps, as the frame-rate study does at the default point (study/verdict.hpp): whole
+// frames of the slowest rate against the truth at the frame ends (the closed form, else
+// the references, which may fail at a point: recorded there, the scan goes on).
+//
+// Per grid point, rate, method and substep count: completed or diverged (or failed),
+// err_pos_max, the counted cost (force evaluations, Newton iterations); per grid point
+// and rate, the cheapest method and substep count whose error meets the tolerance. The
+// answer to "which method is cheapest, stays stable and within my tolerance over my
+// whole range, and where does each break" is read from these (`advise --scan`).
+#include <functional>
+#include <map>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/method.hpp"
+#include "references/reference.hpp"
+#include "study/method_row.hpp"
+
+namespace stepbench {
+
+// One axis of the grid: `problem.param=lo:hi:count[:log]`.
+struct scan_axis {
+  std::string param;
+  double lo = 0.0, hi = 0.0;
+  int count = 1;
+  bool log = false;
+  std::vector<double> values() const;  // lo .. hi, count points, evenly (in log when `log`)
+};
+
+// Parses `P.name=lo:hi:count[:log]` for problem P; throws std::invalid_argument with a
+// one-line reason (another problem, an unknown parameter, a bound outside the parameter's
+// declared range, count < 1 or above 10^5, log with a bound <= 0).
+scan_axis parse_scan_axis(std::string_view text, const std::string& problem);
+
+struct scan_options {
+  std::string problem;
+  std::string name;  // the group under /scan ("" : the problem's name)
+  std::vector<scan_axis> axes;
+  std::vector<double> hz{30, 60, 120, 240};  // each divides the fastest (--dt X is hz 1/X)
+  std::vector<int> substeps{1, 2, 4, 8, 16, 32, 64};
+  std::vector<std::string> methods;     // empty: our fixed-step methods on the problem
+  double tol = 1e-3;                    // in the problem's position unit
+  std::map<std::string, double> fixed;  // other parameters of the problem (--set)
+  reference_tolerances ref_tol{};
+  run_limits limits{};
+  int jobs = 0;  // threads over the grid points (0: one a core)
+  // Progress: called after each grid point with the points done and the total.
+  std::function<void(std::size_t done, std::size_t total)> on_progress;
+};
+
+// Checks the options; throws std::invalid_argument with a one-line reason.
+void validate(const scan_options& opts);
+
+struct scan_run {
+  std::size_t point = 0;  // index into scan_result::points
+  double hz = 0.0;
+  std::string method;
+  int substeps = 1;
+  method_row row;  // param is dt
+};
+
+struct scan_point {
+  std::vector<double> values;  // one per axis
+  std::string truth_source;    // closed_form, a reference, or none
+  bool trusted = true;
+  std::string note;        // why the truth is not trusted, or why the point was not run
+  double horizon = 0.0;    // whole frames of the slowest rate
+  double pos_scale = 1.0;  // the motion's amplitude
+};
+
+// The cheapest run at a point and rate that completed with err_pos_max <= tol, by force
+// evaluations (our methods' counted cost; ties to the fewer substeps, then the registry order).
+struct scan_best {
+  std::size_t point = 0;
+  double hz = 0.0;
+  std::string method;  // "" when none meets the tolerance
+  int substeps = 0;
+  double err_pos_max = 0.0;
+  double force_evals_per_frame = 0.0;
+};
+
+struct scan_result {
+  scan_options options;
+  std::string unit;  // the problem's position unit
+  std::vector<scan_point> points;
+  std::vector<scan_run> runs;
+  std::vector<scan_best> best;
+  double wall_seconds = 0.0;
+};
+
+scan_result run_scan(const scan_options& opts);
+
+// The grid points in order: the first axis varies slowest.
+std::vector<std::vector<double>> scan_grid(const std::vector<scan_axis>& axes);
+
+}  // namespace stepbench
+
+namespace stepbench {
+
+// The range question answered from a scan at a tolerance (which may differ from the
+// scan's own): at each rate, the cheapest method and substep count that completes within
+// `tol` at every trusted grid point (cost: its largest force evaluations a frame over the
+// points), and where each method breaks at one step a frame.
+struct scan_choice {
+  double hz = 0.0;
+  std::string method;  // "" when no method and substep count holds over the whole range
+  int substeps = 0;
+  double worst_err = 0.0;
+  double max_force_evals_per_frame = 0.0;
+};
+
+struct scan_break {
+  double hz = 0.0;
+  std::string method;
+  std::size_t unstable = 0;  // points where one step a frame diverged or failed
+  std::size_t points = 0;    // trusted points run
+  std::string where;         // "diverges for k_s >= 3.16e4 N/m" (one axis), or the first point
+};
+
+struct scan_answer {
+  std::string problem, unit, range;  // range: "k_s 10 .. 1e7 (25 points, log)"
+  double tol = 0.0;
+  std::size_t points = 0, untrusted = 0;
+  std::vector<scan_choice> choices;
+  std::vector<scan_break> breaks;
+};
+
+scan_answer answer_scan(const scan_result& scan, double tol);
+std::string format_scan_answer(const scan_answer& a);
+
+// Reads /scan/<name> of a study file (name "" : the only scan in it); throws
+// std::runtime_error naming the file and what is wrong, std::invalid_argument for a
+// name it does not hold (listing those it does).
+scan_result read_scan(const std::string& path, const std::string& name);
+
+}  // namespace stepbench

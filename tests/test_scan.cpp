@@ -1,0 +1,127 @@
+// `stepbench scan` (study/scan.hpp): its axes and their refusals, the grid, and the map
+// against the theory: on the stiff spring (k_s 1e1 .. 1e7 N/m, log) at one step a 60 Hz
+// frame, each explicit method's stable/unstable boundary lies within one grid cell of
+// its oscillator stability limit, w dt = 2 sqrt(2) for RK4 and 2 for semi-implicit Euler
+// (Hairer & Wanner, "Solving ODEs II", sec. IV.2; the study computes the same limits
+// from the compiled steps, study/stability.hpp).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+
+#include "study/scan.hpp"
+#include "study/study_file.hpp"
+#include "study/sweep.hpp"
+
+using namespace stepbench;
+
+namespace {
+
+void expect_refused(const std::string& text, const std::string& problem, const std::string& fragment) {
+  try {
+    parse_scan_axis(text, problem);
+    ADD_FAILURE() << text << " was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << "one line: " << e.what();
+  }
+}
+
+}  // namespace
+
+TEST(scan, axes_parse_and_refuse) {
+  const scan_axis a = parse_scan_axis("stiff_spring.k_s=1e1:1e7:25:log", "stiff_spring");
+  EXPECT_EQ(a.param, "k_s");
+  EXPECT_TRUE(a.log);
+  const auto v = a.values();
+  ASSERT_EQ(v.size(), 25u);
+  EXPECT_EQ(v.front(), 10.0);
+  EXPECT_EQ(v.back(), 1e7);
+  EXPECT_NEAR(v[4], 100.0, 1e-9);  // four steps of 10^(1/4): one decade
+  const auto lin = parse_scan_axis("pendulum.theta0_deg=1:179.9:3", "pendulum").values();
+  EXPECT_EQ(lin, (std::vector<double>{1.0, 90.45, 179.9}));
+  expect_refused("stiff_spring.k_s=-1:10:5", "stiff_spring", "outside the parameter's range");
+  expect_refused("pendulum.theta0_deg=1:180:5", "pendulum", "outside the parameter's range");
+  expect_refused("stiff_spring.stiffness=1:10:5", "stiff_spring", "has no parameter 'stiffness'");
+  expect_refused("pendulum.theta0_deg=1:10:5", "stiff_spring", "not pendulum");
+  expect_refused("stiff_spring.k_s=1:10:0", "stiff_spring", "count");
+  expect_refused("stiff_spring.k_s=1:10", "stiff_spring", "malformed");
+  expect_refused("stiff_spring.k_s=10:1:5", "stiff_spring", "lo must be below hi");
+  expect_refused("stiff_spring.k_d=0:10:5:log", "stiff_spring", "log axis needs lo > 0");
+  expect_refused("spring_chain.masses=2:10:4", "spring_chain", "whole numbers");
+}
+
+TEST(scan, grid_varies_the_first_axis_slowest) {
+  const auto grid = scan_grid({{"a", 1, 2, 2, false}, {"b", 10, 30, 3, false}});
+  ASSERT_EQ(grid.size(), 6u);
+  EXPECT_EQ(grid[0], (std::vector<double>{1, 10}));
+  EXPECT_EQ(grid[2], (std::vector<double>{1, 30}));
+  EXPECT_EQ(grid[3], (std::vector<double>{2, 10}));
+}
+
+TEST(scan, stiff_spring_boundary_follows_the_stability_limit) {
+  scan_options o;
+  o.problem = "stiff_spring";
+  o.axes = {parse_scan_axis("stiff_spring.k_s=1e1:1e7:25:log", "stiff_spring")};
+  o.hz = {60};
+  o.substeps = {1};
+  o.methods = {"rk4", "semi_implicit_euler", "implicit_euler"};
+  const scan_result s = run_scan(o);
+  ASSERT_EQ(s.points.size(), 25u);
+  const double dt = 1.0 / 60.0, cell = std::sqrt(std::pow(10.0, 0.25));  // one cell in w = sqrt(k_s / m)
+  for (const auto& [method, limit] : {std::pair{"rk4", 2.0 * std::numbers::sqrt2}, {"semi_implicit_euler", 2.0}}) {
+    double last_stable = 0.0, first_unstable = 0.0;
+    for (const auto& r : s.runs) {
+      if (r.method != method) continue;
+      const double w_dt = std::sqrt(s.points[r.point].values[0]) * dt;
+      if (r.row.metrics.completed() && first_unstable == 0.0) last_stable = w_dt;
+      if (r.row.metrics.diverged && first_unstable == 0.0) first_unstable = w_dt;
+      // Unstable once, unstable above: the map has one boundary.
+      if (first_unstable > 0.0) {
+        EXPECT_TRUE(r.row.metrics.diverged) << method << " at w dt " << w_dt;
+      }
+    }
+    ASSERT_GT(last_stable, 0.0) << method;
+    ASSERT_GT(first_unstable, 0.0) << method;
+    EXPECT_NEAR(first_unstable / last_stable, cell, 1e-9) << method << ": the boundary lies between neighbours";
+    EXPECT_LE(last_stable, limit * cell) << method;
+    EXPECT_GE(first_unstable, limit / cell) << method;
+  }
+  // Implicit Euler is stable at every stiffness; the answer says so, and names RK4's break.
+  const scan_answer a = answer_scan(s, 1.0);  // 1 m: any stable run meets it
+  for (const auto& b : a.breaks) {
+    if (b.method == "implicit_euler") {
+      EXPECT_EQ(b.where, "stable everywhere");
+    } else if (b.method == "rk4") {
+      EXPECT_NE(b.where.find("diverges for k_s >= "), std::string::npos) << b.where;
+    }
+  }
+  ASSERT_EQ(a.choices.size(), 1u);
+  EXPECT_EQ(a.choices[0].method, "implicit_euler");
+}
+
+TEST(scan, written_and_read_back) {
+  scan_options o;
+  o.problem = "pendulum";
+  o.axes = {parse_scan_axis("pendulum.theta0_deg=10:170:3", "pendulum")};
+  o.hz = {30, 60};
+  o.substeps = {1, 4};
+  o.methods = {"rk4", "velocity_verlet"};
+  study s;
+  s.scans.push_back(run_scan(o));
+  const auto path = (std::filesystem::temp_directory_path() / "stepbench_test_scan.h5").string();
+  write_study(s, path);
+  const scan_result back = read_scan(path, "");
+  std::filesystem::remove(path);
+  ASSERT_EQ(back.points.size(), 3u);
+  ASSERT_EQ(back.runs.size(), s.scans[0].runs.size());
+  for (std::size_t i = 0; i < back.runs.size(); ++i) {
+    const auto &x = back.runs[i].row.metrics, &y = s.scans[0].runs[i].row.metrics;
+    EXPECT_TRUE(x.err_pos_max == y.err_pos_max || (std::isnan(x.err_pos_max) && std::isnan(y.err_pos_max)));
+    EXPECT_EQ(back.runs[i].row.work.force_evals, s.scans[0].runs[i].row.work.force_evals);
+  }
+  // The pendulum has a closed form: every point is trusted, and its answer is the same read back.
+  for (const auto& p : back.points) EXPECT_EQ(p.truth_source, "closed_form");
+  EXPECT_EQ(format_scan_answer(answer_scan(back, 1e-3)), format_scan_answer(answer_scan(s.scans[0], 1e-3)));
+}

@@ -124,6 +124,7 @@ int main(int argc, char** argv) {
     sweep_options sopts;
     if (opts.quick) {
       sopts.levels = sopts.max_levels = 8;
+      sopts.scans = default_scans(true);
       sopts.tolerances = tolerance_ladder(true);
     }
     sopts.overrides = opts.overrides;

@@ -30,6 +30,7 @@ int run_sweep_command(sweep_args a) {
   for (const auto& s : a.sets) add_override(a.opts.overrides, s, a.opts.problems);
   if (a.quick) {
     a.opts.levels = a.opts.max_levels = 8;
+    a.opts.scans = default_scans(true);
     a.opts.tolerances = tolerance_ladder(true);
   }
   a.opts.progress = !a.quiet;

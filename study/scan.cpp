@@ -66,6 +66,7 @@ std::vector<double> scan_axis::values() const {
                   : i == count - 1 ? hi
                   : log            ? std::pow(10.0, std::log10(lo) + s * (std::log10(hi) - std::log10(lo)))
                                    : lo + s * (hi - lo));
+    if (whole) out.back() = std::round(out.back());
   }
   return out;
 }
@@ -103,11 +104,16 @@ scan_axis parse_scan_axis(std::string_view text, const std::string& problem) {
   for (double v : {a.lo, a.hi})
     if (auto why = it->check(v); !why.empty())
       throw std::invalid_argument(fmt::format("--param {}: {} is outside the parameter's range: {}", text, v, why));
-  if (it->allowed.whole)
-    for (double v : a.values())
-      if (v != std::floor(v))
-        throw std::invalid_argument(
-            fmt::format("--param {}: {} takes whole numbers, and the axis has {:g}", text, a.param, v));
+  if (it->allowed.whole) {
+    if (a.lo != std::floor(a.lo) || a.hi != std::floor(a.hi))
+      throw std::invalid_argument(fmt::format("--param {}: {} takes whole numbers", text, a.param));
+    a.whole = true;  // the points between are rounded
+    const auto v = a.values();
+    for (std::size_t i = 1; i < v.size(); ++i)
+      if (v[i] == v[i - 1])
+        throw std::invalid_argument(fmt::format(
+            "--param {}: {} takes whole numbers, and the axis repeats {:g}: use fewer points", text, a.param, v[i]));
+  }
   return a;
 }
 
@@ -158,6 +164,22 @@ void validate(const scan_options& opts) {
     for (const auto& a : opts.axes)
       if (a.param == name) throw std::invalid_argument(fmt::format("scan: {} is both set and scanned", name));
   }
+}
+
+std::vector<scan_options> default_scans(bool quick) {
+  scan_options spring;
+  spring.problem = "stiff_spring";
+  spring.axes = {
+      parse_scan_axis(quick ? "stiff_spring.k_s=1e1:1e7:13:log" : "stiff_spring.k_s=1e1:1e7:25:log", "stiff_spring")};
+  if (quick) {
+    spring.hz = {60};
+    spring.substeps = {1, 4, 16};
+    return {spring};
+  }
+  scan_options pendulum;
+  pendulum.problem = "pendulum";
+  pendulum.axes = {parse_scan_axis("pendulum.theta0_deg=1:179.9:12", "pendulum")};
+  return {spring, pendulum};
 }
 
 scan_result run_scan(const scan_options& opts) {
@@ -416,7 +438,7 @@ scan_result read_scan(const std::string& path, const std::string& name) {
         count.size() != log.size())
       throw std::runtime_error(fmt::format("scan '{}': its axis attributes differ in length", which));
     for (std::size_t k = 0; k < axis_names.size(); ++k)
-      o.axes.push_back({axis_names[k], lo[k], hi[k], static_cast<int>(count[k]), log[k] != 0});
+      o.axes.push_back({axis_names[k], lo[k], hi[k], static_cast<int>(count[k]), log[k] != 0, false});
     o.hz = h5::double_array_attr(g, "hz");
     for (long n : h5::int_array_attr(g, "substeps")) o.substeps.push_back(static_cast<int>(n));
     const H5::Group values = g.openGroup("values");

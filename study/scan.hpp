@@ -28,6 +28,7 @@ struct scan_axis {
   double lo = 0.0, hi = 0.0;
   int count = 1;
   bool log = false;
+  bool whole = false;                  // the parameter takes whole numbers: values are rounded
   std::vector<double> values() const;  // lo .. hi, count points, evenly (in log when `log`)
 };
 
@@ -54,6 +55,11 @@ struct scan_options {
 
 // Checks the options; throws std::invalid_argument with a one-line reason.
 void validate(const scan_options& opts);
+
+// The scans of the full study: stiff_spring over k_s 1e1 .. 1e7 N/m (25 points, log) and
+// the pendulum over its release angle 1 .. 179.9 deg (12 points), each at 30 .. 240 Hz
+// with 1 .. 64 substeps; `quick`: the stiff spring's 13 points at 60 Hz only (the CI study).
+std::vector<scan_options> default_scans(bool quick = false);
 
 struct scan_run {
   std::size_t point = 0;  // index into scan_result::points

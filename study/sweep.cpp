@@ -78,6 +78,7 @@ void validate(const sweep_options& opts) {
   }
   const auto names = opts.problems.empty() ? problem_names() : opts.problems;
   for (const auto& name : names) configured_problem(name, opts);
+  for (const auto& sc : opts.scans) validate(sc);
   // A method named explicitly must run on at least one selected problem.
   for (const auto& m : opts.methods) {
     bool runs = false;
@@ -206,7 +207,7 @@ method_study run_method(const problem_study& ps, const method_info& m, const swe
 }
 
 std::size_t sweep_parts(const sweep_options& opts) {
-  return (opts.problems.empty() ? problem_names().size() : opts.problems.size()) + 3;
+  return (opts.problems.empty() ? problem_names().size() : opts.problems.size()) + 4;
 }
 
 namespace {
@@ -283,6 +284,29 @@ study run_sweep(const sweep_options& opts) {
   if (energy.methods.empty()) energy.methods = opts.methods;
   if (energy.scenes.empty()) energy.enabled = false;
   out.energy = run_energy_study(energy, opts.overrides);
+  part_done();
+  // The parameter scans of the selected problems, with the sweep's methods where named.
+  for (scan_options sc : opts.scans) {
+    if (!opts.problems.empty() && !contains(opts.problems, sc.problem)) continue;
+    if (!opts.methods.empty()) {
+      sc.methods.clear();
+      for (const auto& m : make_problem(sc.problem)->methods())
+        if (m.kind == method_kind::fixed_step && contains(opts.methods, m.name)) sc.methods.push_back(m.name);
+      if (sc.methods.empty()) continue;
+    }
+    sc.ref_tol = opts.tol;
+    sc.limits = opts.limits;
+    sc.jobs = opts.jobs;
+    if (auto it = opts.overrides.find(sc.problem); it != opts.overrides.end())
+      for (const auto& [name, value] : it->second)
+        if (std::none_of(sc.axes.begin(), sc.axes.end(), [&](const scan_axis& a) { return a.param == name; }))
+          sc.fixed[name] = value;
+    const auto t0 = std::chrono::steady_clock::now();
+    out.scans.push_back(run_scan(sc));
+    if (opts.progress)
+      warn(fmt::format("scan    {:<22} {} points in {:.2f} s", sc.problem, out.scans.back().points.size(),
+                       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
+  }
   part_done();
   out.stability = compute_stability();
   out.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

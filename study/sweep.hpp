@@ -63,13 +63,14 @@ struct sweep_options {
   int sample_count = 32;  // fixed sample times j T / sample_count; must divide base_steps
   std::vector<double> tolerances = tolerance_ladder();
   reference_tolerances tol{};
-  run_limits limits{};               // the work budget of one run (core/method.hpp)
-  substep_options substeps{};        // the small-steps comparison (study/substeps.hpp)
-  loop_options loop{};               // the game-loop study (study/loop.hpp)
-  energy_options energy{};           // the long-run energy study (study/energy.hpp)
-  frame_rate_options frame_rates{};  // the game programmer's frame-rate table (study/verdict.hpp)
-  bool progress = false;             // one line per problem on stderr
-  int jobs = 0;                      // threads the problems are swept on (0: one a core)
+  run_limits limits{};                                // the work budget of one run (core/method.hpp)
+  substep_options substeps{};                         // the small-steps comparison (study/substeps.hpp)
+  loop_options loop{};                                // the game-loop study (study/loop.hpp)
+  energy_options energy{};                            // the long-run energy study (study/energy.hpp)
+  frame_rate_options frame_rates{};                   // the game programmer's frame-rate table (study/verdict.hpp)
+  std::vector<scan_options> scans = default_scans();  // parameter scans (study/scan.hpp), under /scan
+  bool progress = false;                              // one line per problem on stderr
+  int jobs = 0;                                       // threads the problems are swept on (0: one a core)
   // A caller's live progress: called after each problem and each later study (frame
   // rates, loop, energy) with the parts done and the total (sweep_parts); and where the
   // sweep's warnings go (a reference that disagrees), so that they do not land on a
@@ -81,7 +82,8 @@ struct sweep_options {
 // The threads run_sweep uses for `problems` problems (opts.jobs, 0: one a core).
 int sweep_jobs(const sweep_options& opts, std::size_t problems);
 
-// The parts on_progress counts: the problems, then the frame-rate, loop and energy studies.
+// The parts on_progress counts: the problems, then the frame-rate, loop and energy studies
+// and the scans.
 std::size_t sweep_parts(const sweep_options& opts);
 
 struct method_study {

@@ -49,11 +49,15 @@ TEST(scan, axes_parse_and_refuse) {
   expect_refused("stiff_spring.k_s=1:10", "stiff_spring", "malformed");
   expect_refused("stiff_spring.k_s=10:1:5", "stiff_spring", "lo must be below hi");
   expect_refused("stiff_spring.k_d=0:10:5:log", "stiff_spring", "log axis needs lo > 0");
-  expect_refused("spring_chain.masses=2:10:4", "spring_chain", "whole numbers");
+  expect_refused("spring_chain.masses=2.5:10:4", "spring_chain", "must be a whole number");
+  expect_refused("spring_chain.masses=2:4:5", "spring_chain", "repeats");
+  // A whole-numbered parameter on a log axis: rounded, so 8 .. 4096 in 10 points doubles.
+  const auto masses = parse_scan_axis("spring_chain.masses=8:4096:10:log", "spring_chain").values();
+  for (std::size_t i = 0; i < masses.size(); ++i) EXPECT_EQ(masses[i], 8.0 * std::ldexp(1.0, static_cast<int>(i)));
 }
 
 TEST(scan, grid_varies_the_first_axis_slowest) {
-  const auto grid = scan_grid({{"a", 1, 2, 2, false}, {"b", 10, 30, 3, false}});
+  const auto grid = scan_grid({{"a", 1, 2, 2, false, false}, {"b", 10, 30, 3, false, false}});
   ASSERT_EQ(grid.size(), 6u);
   EXPECT_EQ(grid[0], (std::vector<double>{1, 10}));
   EXPECT_EQ(grid[2], (std::vector<double>{1, 30}));

@@ -905,8 +905,17 @@ def test_advise_never_answers_the_baseline(stepbench, timed_study):
     assert out["met"] is True and out["choice"]["method"] != "baseline_rk4" and out["choice"]["origin"] != "baseline"
     assert "baseline_rk4" in [r["method"] for r in out["runners_up"]]
     text_out = advise(stepbench, study, "--problem", "pendulum", "--tol", "1e-6").stdout
-    assert not text_out.splitlines()[1].startswith("use baseline_rk4")
-    assert "baseline_rk4 (baseline, for scale)" in text_out
+    assert not text_out.splitlines()[1].startswith("use baseline")
+    # The text shows the first five runners-up; where the baselines rank among them is a
+    # matter of measured time (baseline_rk4 and dop853 are within 1 %), so the check is
+    # that every baseline shown is labelled, and that those shown are the JSON's.
+    lines = text_out.splitlines()
+    section = lines[lines.index("runners-up:") + 1:]
+    section = section[:next((i for i, line in enumerate(section) if not line.startswith("  ")), len(section))]
+    shown = [line for line in section if "baseline_" in line]
+    top = [r["method"] for r in out["runners_up"]][:5]
+    assert len(shown) == sum(m.startswith("baseline_") for m in top), (shown, top)
+    assert all("(baseline, for scale)" in line for line in shown), shown
 
 
 def test_advise_cut_rows_are_too_slow(stepbench, bench, tmp_path):

@@ -11,6 +11,7 @@ import numpy as np
 from . import figures, render, tables
 from . import energy_runs as energy_section
 from . import loop as loop_section
+from . import scan as scan_section
 from . import substeps as substeps_section
 from . import verdict as verdict_section
 from .formatting import fmt_num
@@ -38,10 +39,10 @@ def _value(v):
     return str(v)
 
 
-def _figure_jobs(study, figdir, whole):
+def _figure_jobs(study, figdir, whole, scans=None):
     """(kind, argument, path) for every figure; they are independent, so they can be
     drawn in parallel processes. `whole`: the study-wide figures too (not for a report
-    of one problem)."""
+    of one problem); `scans`: the study's /scan (scan.load), None when it has none."""
     jobs = []
     for p in study.problems:
         jobs += [("wp", p.name, os.path.join(figdir, f"work_precision_{p.name}.png")),
@@ -57,17 +58,20 @@ def _figure_jobs(study, figdir, whole):
         jobs.append(("substeps", None, os.path.join(figdir, substeps_section.FIGURE)))
     if study.loop is not None:
         jobs.append(("loop", None, os.path.join(figdir, "loop_shown_error.png")))
+    for k, s in enumerate(scans or ()):
+        for which, name in scan_section.figure_names(s).items():
+            jobs.append((f"scan_{which}", k, os.path.join(figdir, name)))
     # The slowest first, so that the workers finish together.
     slow = {"loop": 0, "substeps": 1, "energy_runs": 2, "stability": 3}
     return sorted(jobs, key=lambda j: slow.get(j[0], 9))
 
 
-_STUDY = _NAMES = None
+_STUDY = _NAMES = _SCANS = None
 
 
-def _init_worker(study, names):
-    global _STUDY, _NAMES
-    _STUDY, _NAMES = study, names
+def _init_worker(study, names, scans=None):
+    global _STUDY, _NAMES, _SCANS
+    _STUDY, _NAMES, _SCANS = study, names, scans
 
 
 def _draw(job):
@@ -90,15 +94,17 @@ def _draw(job):
         energy_section.figure(study.energy_runs, styles, path)
     elif kind == "substeps":
         substeps_section.figure(study.substeps, styles, path)
+    elif kind.startswith("scan_"):
+        scan_section.draw(_SCANS[arg], kind[len("scan_"):], study, styles, path)
     return path
 
 
-def draw_figures(study, figdir, workers, names, whole=True):
-    jobs = _figure_jobs(study, figdir, whole)
+def draw_figures(study, figdir, workers, names, whole=True, scans=None):
+    jobs = _figure_jobs(study, figdir, whole, scans)
     if workers <= 1:
-        _init_worker(study, names)
+        _init_worker(study, names, scans)
         return [p for p in map(_draw, jobs) if p]
-    with ProcessPoolExecutor(max_workers=workers, initializer=_init_worker, initargs=(study, names)) as ex:
+    with ProcessPoolExecutor(max_workers=workers, initializer=_init_worker, initargs=(study, names, scans)) as ex:
         return [p for p in ex.map(_draw, jobs) if p]
 
 
@@ -127,10 +133,13 @@ def build(study, outdir, workers=2, problem=None, self_contained=False):
     whole = problem is None
     if not whole:
         study = one_problem(study, problem)
+    # The parameter scans (/scan), read beside the study (study.py does not hold them);
+    # in the report of the whole study only, as the other study-wide sections.
+    scans = scan_section.load(study.path) if whole else None
     figdir = os.path.join(outdir, "fig")
     os.makedirs(figdir, exist_ok=True)
-    made = set(os.path.basename(p) for p in draw_figures(study, figdir, workers, names, whole))
-    doc = document(study, made, whole)
+    made = set(os.path.basename(p) for p in draw_figures(study, figdir, workers, names, whole, scans))
+    doc = document(study, made, whole, scans)
     with open(os.path.join(outdir, "REPORT.md"), "w") as f:
         f.write(render.markdown(doc))
     with open(os.path.join(outdir, "index.html"), "w") as f:
@@ -148,7 +157,7 @@ def headline(study):
             f"{a['git_commit']}; build and machine in the appendix.")
 
 
-def document(study, figs, whole=True):
+def document(study, figs, whole=True, scans=None):
     doc = render.Doc(TITLE)
     doc.p(headline(study))
     if study.verdict is not None:
@@ -168,6 +177,7 @@ def document(study, figs, whole=True):
         substeps_section.section(doc, study, figs)
         _energy(doc, study, figs)
         loop_section.section(doc, study, figs)
+        scan_section.section(doc, study, figs, scans)  # nothing for a study without /scan
     _how_made(doc, study)
     _metadata(doc, study)
     return doc

@@ -30,6 +30,7 @@ command add_loop(CLI::App& app);
 command add_energy(CLI::App& app);
 command add_schema(CLI::App& app);
 command add_scan(CLI::App& app);
+command add_merge(CLI::App& app);
 
 // The range answer of a scan as JSON (`scan --json`, `advise --scan --json`).
 nlohmann::json scan_answer_json(const scan_answer& a);

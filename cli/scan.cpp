@@ -21,6 +21,7 @@ struct scan_args {
   std::string problem, hz_text, dt_text, substeps_text, tol_text = "1e-3", name, out = "results/scan.h5";
   std::vector<std::string> params, sets, methods;
   int jobs = 0;
+  std::string shard;  // K/N
   bool json = false, quiet = false;
 };
 
@@ -86,6 +87,16 @@ int run_scan_command(const scan_args& a) {
     }
   }
   o.tol = parse_number(a.tol_text, "--tol");
+  if (!a.shard.empty()) {
+    const auto slash = a.shard.find('/');
+    if (slash == std::string::npos) throw std::invalid_argument(fmt::format("--shard {}: expected K/N", a.shard));
+    const double k = parse_number(std::string_view(a.shard).substr(0, slash), "--shard K");
+    const double n = parse_number(std::string_view(a.shard).substr(slash + 1), "--shard N");
+    if (!(n >= 1 && n <= 1e6 && n == std::floor(n) && k >= 1 && k <= n && k == std::floor(k)))
+      throw std::invalid_argument(fmt::format("--shard {}: K and N must be whole numbers with 1 <= K <= N", a.shard));
+    o.shard_index = static_cast<int>(k) - 1;
+    o.shard_count = static_cast<int>(n);
+  }
   o.methods = a.methods;
   o.jobs = a.jobs;
   parameter_overrides sets;
@@ -142,6 +153,8 @@ command add_scan(CLI::App& app) {
   sub->add_option("--set", a->sets, "fix another parameter, problem.name=value (repeatable)");
   sub->add_option("--name", a->name, "the scan's group under /scan (default: the problem's name)");
   sub->add_option("--jobs", a->jobs, "threads over the grid points (0: one a core)")->check(CLI::NonNegativeNumber);
+  sub->add_option("--shard", a->shard,
+                  "K/N: run shard K of N, a deterministic share of the grid points (`stepbench merge` joins them)");
   sub->add_option("--out", a->out, "study file to write")->capture_default_str();
   sub->add_flag("--json", a->json, "the answer as JSON on stdout");
   sub->add_flag("--quiet", a->quiet, "no progress or summary on stderr");

@@ -150,6 +150,9 @@ void validate(const scan_options& opts) {
   if (opts.substeps.empty()) throw std::invalid_argument("scan: no substep count");
   for (int n : opts.substeps)
     if (n < 1 || n > 1 << 20) throw std::invalid_argument(fmt::format("scan: substeps {} is not in 1 .. 2^20", n));
+  if (opts.shard_count < 1 || opts.shard_index < 0 || opts.shard_index >= opts.shard_count)
+    throw std::invalid_argument(
+        fmt::format("scan: shard {} of {} does not exist", opts.shard_index + 1, opts.shard_count));
   if (!(opts.tol > 0.0 && std::isfinite(opts.tol)))
     throw std::invalid_argument("scan: the tolerance must be a positive number");
   const auto methods = problem->methods();
@@ -164,6 +167,137 @@ void validate(const scan_options& opts) {
     for (const auto& a : opts.axes)
       if (a.param == name) throw std::invalid_argument(fmt::format("scan: {} is both set and scanned", name));
   }
+}
+
+namespace {
+
+// The cheapest run meeting the tolerance at each point and rate: fewest force
+// evaluations (the same frames at one rate, so the total compares), then fewer substeps.
+void compute_best(scan_result& s) {
+  const auto& hz = s.options.hz;
+  std::vector<const scan_run*> pick(s.points.size() * hz.size(), nullptr);
+  for (const auto& r : s.runs) {
+    const auto rate = static_cast<std::size_t>(std::find(hz.begin(), hz.end(), r.hz) - hz.begin());
+    if (rate == hz.size() || !r.row.metrics.completed() || !(r.row.metrics.err_pos_max <= s.options.tol)) continue;
+    const scan_run*& p = pick[r.point * hz.size() + rate];
+    if (!p || r.row.work.force_evals < p->row.work.force_evals ||
+        (r.row.work.force_evals == p->row.work.force_evals && r.substeps < p->substeps))
+      p = &r;
+  }
+  s.best.clear();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t i = 0; i < s.points.size(); ++i)
+    for (std::size_t k = 0; k < hz.size(); ++k) {
+      scan_best b{i, hz[k], "", 0, nan, nan};
+      if (const scan_run* p = pick[i * hz.size() + k]) {
+        b.method = p->method;
+        b.substeps = p->substeps;
+        b.err_pos_max = p->row.metrics.err_pos_max;
+        b.force_evals_per_frame = static_cast<double>(p->row.work.force_evals) / (s.points[i].horizon * hz[k]);
+      }
+      s.best.push_back(b);
+    }
+}
+
+}  // namespace
+
+std::vector<std::size_t> scan_shard(const scan_options& opts, int k, int n) {
+  if (n < 1 || k < 0 || k >= n) throw std::invalid_argument(fmt::format("shard {} of {} does not exist", k + 1, n));
+  const auto grid = scan_grid(opts.axes);
+  std::vector<std::size_t> all(grid.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+  if (n == 1) return all;
+  std::vector<double> size(grid.size(), 1.0);
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    auto p = make_problem(opts.problem);
+    for (const auto& [name, value] : opts.fixed) p->set(name, value);
+    for (std::size_t a = 0; a < opts.axes.size(); ++a) p->set(opts.axes[a].param, grid[i][a]);
+    size[i] = p->validate().empty() ? static_cast<double>(p->dim()) : 1.0;
+  }
+  std::stable_sort(all.begin(), all.end(), [&](std::size_t a, std::size_t b) { return size[a] > size[b]; });
+  std::vector<double> load(static_cast<std::size_t>(n), 0.0);
+  std::vector<std::size_t> out;
+  for (std::size_t i : all) {
+    const auto least = static_cast<std::size_t>(std::min_element(load.begin(), load.end()) - load.begin());
+    load[least] += size[i];
+    if (least == static_cast<std::size_t>(k)) out.push_back(i);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+scan_result merge_scans(const std::vector<scan_result>& shards, bool partial, std::vector<std::size_t>& missing) {
+  if (shards.empty()) throw std::invalid_argument("merge: no shard");
+  const auto& first = shards.front();
+  const auto same_axes = [](const std::vector<scan_axis>& a, const std::vector<scan_axis>& b) {
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i)
+      if (a[i].param != b[i].param || a[i].lo != b[i].lo || a[i].hi != b[i].hi || a[i].count != b[i].count ||
+          a[i].log != b[i].log)
+        return false;
+    return true;
+  };
+  for (const auto& s : shards) {
+    const auto& o = s.options;
+    const auto& f = first.options;
+    const char* differs = o.problem != f.problem               ? "problem"
+                          : !same_axes(o.axes, f.axes)         ? "axes"
+                          : o.hz != f.hz                       ? "frame rates"
+                          : o.substeps != f.substeps           ? "substeps"
+                          : o.tol != f.tol                     ? "tolerance"
+                          : o.fixed != f.fixed                 ? "fixed parameters"
+                          : s.grid_points != first.grid_points ? "grid"
+                                                               : nullptr;
+    if (differs)
+      throw std::invalid_argument(fmt::format("merge: scan '{}': the shards differ in their {}", f.name, differs));
+  }
+  // Every point once: the first shard holding it, refusing a second.
+  std::vector<std::pair<const scan_result*, std::size_t>> owner(first.grid_points, {nullptr, 0});
+  for (const auto& s : shards)
+    for (std::size_t i = 0; i < s.points.size(); ++i) {
+      const std::size_t g = s.points[i].index;
+      if (g >= owner.size())
+        throw std::invalid_argument(
+            fmt::format("merge: scan '{}' has point {} beyond its grid of {}", first.options.name, g, owner.size()));
+      if (owner[g].first)
+        throw std::invalid_argument(fmt::format("merge: scan '{}': grid point {} is in two shards (overlapping shards)",
+                                                first.options.name, g));
+      owner[g] = {&s, i};
+    }
+  missing.clear();
+  for (std::size_t g = 0; g < owner.size(); ++g)
+    if (!owner[g].first) missing.push_back(g);
+  if (!missing.empty() && !partial)
+    throw std::invalid_argument(
+        fmt::format("merge: scan '{}': {} of {} grid points are in no shard (first: {}); "
+                    "--partial merges what there is",
+                    first.options.name, missing.size(), owner.size(), missing.front()));
+  // Each shard's runs by its local point, to carry them over in grid order.
+  scan_result out;
+  out.options = first.options;
+  out.options.shard_index = 0;
+  out.options.shard_count = 1;
+  out.unit = first.unit;
+  out.grid_points = first.grid_points;
+  std::map<const scan_result*, std::vector<std::vector<const scan_run*>>> runs_of;
+  for (const auto& s : shards) {
+    auto& by_point = runs_of[&s];
+    by_point.resize(s.points.size());
+    for (const auto& r : s.runs) by_point.at(r.point).push_back(&r);
+  }
+  for (std::size_t g = 0; g < owner.size(); ++g) {
+    const auto [s, i] = owner[g];
+    if (!s) continue;
+    const std::size_t local = out.points.size();
+    out.points.push_back(s->points[i]);
+    for (const scan_run* r : runs_of[s][i]) {
+      out.runs.push_back(*r);
+      out.runs.back().point = local;
+    }
+  }
+  for (const auto& s : shards) out.wall_seconds += s.wall_seconds;
+  compute_best(out);
+  return out;
 }
 
 std::vector<scan_options> default_scans(bool quick) {
@@ -196,6 +330,8 @@ scan_result run_scan(const scan_options& opts) {
                               : std::find(opts.methods.begin(), opts.methods.end(), m.name) != opts.methods.end()))
       methods.push_back(m);
   const auto grid = scan_grid(opts.axes);
+  const auto mine = scan_shard(opts, opts.shard_index, opts.shard_count);
+  out.grid_points = grid.size();
   const double fastest = *std::max_element(opts.hz.begin(), opts.hz.end());
 
   // Each point on its own: its problem, truth and runs, into its slot (the result does
@@ -204,9 +340,11 @@ scan_result run_scan(const scan_options& opts) {
     scan_point point;
     std::vector<scan_run> runs;
   };
-  std::vector<point_work> work(grid.size());
-  const auto run_point = [&](std::size_t i) {
-    auto& w = work[i];
+  std::vector<point_work> work(mine.size());
+  const auto run_point = [&](std::size_t local) {
+    const std::size_t i = mine[local];
+    auto& w = work[local];
+    w.point.index = i;
     w.point.values = grid[i];
     auto problem = make_problem(opts.problem);
     for (const auto& [name, value] : opts.fixed) problem->set(name, value);
@@ -219,7 +357,10 @@ scan_result run_scan(const scan_options& opts) {
     }
     const frames f = frames_of(problem->horizon(), opts.hz);
     w.point.horizon = f.horizon;
-    const truth_table fine = build_truth(*problem, f.times, {.tol = opts.ref_tol});
+    // A closed form is the truth; the references are run only without one (checking
+    // them against it at every grid point would be most of a scan's time).
+    const truth_table fine =
+        build_truth(*problem, f.times, {.run_references = !problem->has_closed_form(), .tol = opts.ref_tol});
     w.point.truth_source = fine.source;
     w.point.trusted = fine.trusted;
     w.point.note = fine.note;
@@ -231,8 +372,8 @@ scan_result run_scan(const scan_options& opts) {
           const double dt = 1.0 / (hz * n);
           const run_result run = problem->run(m.name, dt, f.horizon, truth.times, opts.limits);
           scan_run r{
-              i, hz, m.name, n, {dt, run.steps, run.rejected_steps, run.work, measure(*problem, run, truth), {}}};
-          // Past the work budget every finer count is too; past round-off nothing is learnt.
+              local, hz, m.name, n, {dt, run.steps, run.rejected_steps, run.work, measure(*problem, run, truth), {}}};
+          // Past the work budget every finer count is too.
           const bool done = r.row.metrics.skipped;
           w.runs.push_back(std::move(r));
           if (done) break;
@@ -240,37 +381,16 @@ scan_result run_scan(const scan_options& opts) {
     }
   };
   std::size_t done = 0;
-  parallel_indices(grid.size(), opts.jobs, run_point, [&] {
+  parallel_indices(mine.size(), opts.jobs, run_point, [&] {
     ++done;
-    if (opts.on_progress) opts.on_progress(done, grid.size());
+    if (opts.on_progress) opts.on_progress(done, mine.size());
   });
 
   for (auto& w : work) {
     out.points.push_back(std::move(w.point));
     for (auto& r : w.runs) out.runs.push_back(std::move(r));
   }
-  // The cheapest run meeting the tolerance at each point and rate: fewest force
-  // evaluations (the same frames at one rate, so the total compares), then fewer substeps.
-  for (std::size_t i = 0; i < out.points.size(); ++i)
-    for (double hz : opts.hz) {
-      scan_best b{i, hz, "", 0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
-      const scan_run* pick = nullptr;
-      for (const auto& r : out.runs) {
-        if (r.point != i || r.hz != hz || !r.row.metrics.completed() || !(r.row.metrics.err_pos_max <= opts.tol))
-          continue;
-        if (!pick || r.row.work.force_evals < pick->row.work.force_evals ||
-            (r.row.work.force_evals == pick->row.work.force_evals && r.substeps < pick->substeps))
-          pick = &r;
-      }
-      if (pick) {
-        const double frames_run = out.points[i].horizon * hz;
-        b.method = pick->method;
-        b.substeps = pick->substeps;
-        b.err_pos_max = pick->row.metrics.err_pos_max;
-        b.force_evals_per_frame = static_cast<double>(pick->row.work.force_evals) / frames_run;
-      }
-      out.best.push_back(b);
-    }
+  compute_best(out);
   out.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }
@@ -306,6 +426,7 @@ scan_answer answer_scan(const scan_result& s, double tol) {
   a.tol = tol;
   a.range = range_text(s);
   a.points = s.points.size();
+  a.grid_points = s.grid_points;
   for (const auto& p : s.points) a.untrusted += p.trusted ? 0 : 1;
   // Runs by (rate, method, substeps), over the trusted points.
   struct combo {
@@ -354,9 +475,12 @@ scan_answer answer_scan(const scan_result& s, double tol) {
         std::vector<std::string> spans;
         for (std::size_t k = 0; k < c.unstable.size();) {
           std::size_t e = k;
-          while (e + 1 < c.unstable.size() && c.unstable[e + 1] == c.unstable[e] + 1) ++e;
+          // Consecutive in the grid (a merged --partial scan may lack points between).
+          while (e + 1 < c.unstable.size() && s.points[c.unstable[e + 1]].index == s.points[c.unstable[e]].index + 1)
+            ++e;
           const double lo = s.points[c.unstable[k]].values[0], hi = s.points[c.unstable[e]].values[0];
-          const bool to_end = c.unstable[e] + 1 == s.points.size(), from_start = c.unstable[k] == 0;
+          const bool to_end = s.points[c.unstable[e]].index + 1 == s.grid_points,
+                     from_start = s.points[c.unstable[k]].index == 0;
           spans.push_back(to_end && !from_start   ? fmt::format("{} >= {:.3g}{}", axis.param, lo, unit)
                           : from_start && !to_end ? fmt::format("{} <= {:.3g}{}", axis.param, hi, unit)
                           : lo == hi              ? fmt::format("{} = {:.3g}{}", axis.param, lo, unit)
@@ -380,7 +504,11 @@ scan_answer answer_scan(const scan_result& s, double tol) {
 }
 
 std::string format_scan_answer(const scan_answer& a) {
-  std::string out = fmt::format("{} over {}, within {:g} {} (err_pos_max):\n", a.problem, a.range, a.tol, a.unit);
+  std::string out = fmt::format(
+      "{} over {}, within {:g} {} (err_pos_max){}:\n", a.problem, a.range, a.tol, a.unit,
+      a.points < a.grid_points
+          ? fmt::format(", on {} of the grid's {} points (a shard, or a partial merge)", a.points, a.grid_points)
+          : "");
   for (const auto& c : a.choices) {
     if (c.method.empty())
       out += fmt::format("  {:g} Hz: no method of the scan stays within {:g} {} over the whole range\n", c.hz, a.tol,
@@ -444,7 +572,12 @@ scan_result read_scan(const std::string& path, const std::string& name) {
     const H5::Group values = g.openGroup("values");
     std::vector<std::vector<double>> columns;
     for (const auto& a : o.axes) columns.push_back(h5::read_vector(values.openDataSet(a.param)));
+    s.grid_points = static_cast<std::size_t>(h5::long_attr(g, "grid_points"));
+    o.shard_index = static_cast<int>(h5::long_attr(g, "shard_index"));
+    o.shard_count = static_cast<int>(h5::long_attr(g, "shard_count"));
     const h5::table_data points = h5::read_table(g.openDataSet("points"));
+    const auto& index = points.ints("point");
+    std::map<std::int64_t, std::size_t> local_of;  // grid index -> row
     const auto& trusted = points.ints("trusted");
     const auto& source = points.strings("truth_source");
     const auto& note = points.strings("note");
@@ -456,6 +589,11 @@ scan_result read_scan(const std::string& path, const std::string& name) {
           throw std::runtime_error(fmt::format("scan '{}': values/ and points differ in length", which));
         p.values.push_back(c[i]);
       }
+      if (index[i] < 0 || static_cast<std::size_t>(index[i]) >= s.grid_points || local_of.count(index[i]))
+        throw std::runtime_error(
+            fmt::format("scan '{}': point {} is outside its grid of {} or repeated", which, index[i], s.grid_points));
+      local_of[index[i]] = i;
+      p.index = static_cast<std::size_t>(index[i]);
       p.trusted = trusted[i] != 0;
       p.truth_source = source[i];
       p.note = note[i];
@@ -472,11 +610,12 @@ scan_result read_scan(const std::string& path, const std::string& name) {
     const auto &diverged = runs.ints("diverged"), &failed = runs.ints("failed"), &skipped = runs.ints("skipped");
     const auto& run_note = runs.strings("note");
     for (std::size_t i = 0; i < runs.rows(); ++i) {
-      if (point[i] < 0 || static_cast<std::size_t>(point[i]) >= s.points.size())
+      const auto at = local_of.find(point[i]);
+      if (at == local_of.end())
         throw std::runtime_error(
-            fmt::format("scan '{}': run {} names point {}, beyond its {} points", which, i, point[i], s.points.size()));
+            fmt::format("scan '{}': run {} names point {}, which its points table lacks", which, i, point[i]));
       scan_run r;
-      r.point = static_cast<std::size_t>(point[i]);
+      r.point = at->second;
       r.hz = hz[i];
       r.method = method[i];
       r.substeps = static_cast<int>(substeps[i]);
@@ -491,6 +630,7 @@ scan_result read_scan(const std::string& path, const std::string& name) {
       r.row.metrics.note = run_note[i];
       s.runs.push_back(std::move(r));
     }
+    compute_best(s);
   } catch (const std::invalid_argument&) {
     throw;
   } catch (const H5::Exception& e) {
@@ -499,6 +639,37 @@ scan_result read_scan(const std::string& path, const std::string& name) {
     throw std::runtime_error(fmt::format("cannot read the scan in '{}': {}", path, e.what()));
   }
   return s;
+}
+
+std::vector<scan_result> read_scans(const std::string& path) {
+  std::vector<std::string> names;
+  try {
+    if (!std::filesystem::exists(path)) throw std::runtime_error("no such file");
+    if (!H5::H5File::isHdf5(path)) throw std::runtime_error("not an HDF5 file");
+    const H5::H5File file(path, H5F_ACC_RDONLY);
+    if (!h5::is_group(file, "scan")) throw std::runtime_error("it holds no scan (/scan is absent)");
+    names = h5::children(file.openGroup("scan"));
+  } catch (const H5::Exception& e) {
+    throw std::runtime_error(fmt::format("cannot read the scans in '{}': {}", path, e.getDetailMsg()));
+  } catch (const std::exception& e) {
+    throw std::runtime_error(fmt::format("cannot read the scans in '{}': {}", path, e.what()));
+  }
+  std::vector<scan_result> out;
+  for (const auto& name : names) out.push_back(read_scan(path, name));
+  return out;
+}
+
+std::string file_build(const std::string& path) {
+  try {
+    const H5::H5File file(path, H5F_ACC_RDONLY);
+    return fmt::format("format_version {}, commit {}, {} build, flags {}", h5::long_attr(file, "format_version"),
+                       h5::string_attr(file, "git_commit"), h5::string_attr(file, "build_type"),
+                       h5::string_attr(file, "build_flags"));
+  } catch (const H5::Exception& e) {
+    throw std::runtime_error(fmt::format("cannot read the build of '{}': {}", path, e.getDetailMsg()));
+  } catch (const std::exception& e) {
+    throw std::runtime_error(fmt::format("cannot read the build of '{}': {}", path, e.what()));
+  }
 }
 
 }  // namespace stepbench

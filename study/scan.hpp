@@ -49,6 +49,9 @@ struct scan_options {
   reference_tolerances ref_tol{};
   run_limits limits{};
   int jobs = 0;  // threads over the grid points (0: one a core)
+  // --shard K/N: this run takes shard `shard_index` (0-based) of `shard_count`, a
+  // deterministic share of the grid points balanced by their counted size (scan_shard).
+  int shard_index = 0, shard_count = 1;
   // Progress: called after each grid point with the points done and the total.
   std::function<void(std::size_t done, std::size_t total)> on_progress;
 };
@@ -62,7 +65,7 @@ void validate(const scan_options& opts);
 std::vector<scan_options> default_scans(bool quick = false);
 
 struct scan_run {
-  std::size_t point = 0;  // index into scan_result::points
+  std::size_t point = 0;  // index into scan_result::points (not the grid: see scan_point::index)
   double hz = 0.0;
   std::string method;
   int substeps = 1;
@@ -70,6 +73,7 @@ struct scan_run {
 };
 
 struct scan_point {
+  std::size_t index = 0;       // the point's place in the whole grid (scan_grid), across shards
   std::vector<double> values;  // one per axis
   std::string truth_source;    // closed_form, a reference, or none
   bool trusted = true;
@@ -91,8 +95,9 @@ struct scan_best {
 
 struct scan_result {
   scan_options options;
-  std::string unit;  // the problem's position unit
-  std::vector<scan_point> points;
+  std::string unit;                // the problem's position unit
+  std::size_t grid_points = 0;     // the whole grid's points; `points` holds them all unless sharded
+  std::vector<scan_point> points;  // in grid order
   std::vector<scan_run> runs;
   std::vector<scan_best> best;
   double wall_seconds = 0.0;
@@ -102,6 +107,18 @@ scan_result run_scan(const scan_options& opts);
 
 // The grid points in order: the first axis varies slowest.
 std::vector<std::vector<double>> scan_grid(const std::vector<scan_axis>& axes);
+
+// The grid points of shard k of n (0-based), in grid order: each point's size is counted
+// as its problem's coordinates (the force work of a step grows with them), and the points,
+// largest first (ties in grid order), go each to the shard with the least so far (ties to
+// the lowest shard). Deterministic: every machine computes the same split.
+std::vector<std::size_t> scan_shard(const scan_options& opts, int k, int n);
+
+// Joins shards of one scan (the same problem, axes, rates, substeps, methods, tolerance
+// and fixed parameters) into one scan, points in grid order; throws std::invalid_argument
+// naming the first difference, a point two shards hold, or, unless `partial`, the points
+// none holds. `missing` receives the grid indices no shard holds.
+scan_result merge_scans(const std::vector<scan_result>& shards, bool partial, std::vector<std::size_t>& missing);
 
 }  // namespace stepbench
 
@@ -130,7 +147,7 @@ struct scan_break {
 struct scan_answer {
   std::string problem, unit, range;  // range: "k_s 10 .. 1e7 (25 points, log)"
   double tol = 0.0;
-  std::size_t points = 0, untrusted = 0;
+  std::size_t points = 0, grid_points = 0, untrusted = 0;
   std::vector<scan_choice> choices;
   std::vector<scan_break> breaks;
 };
@@ -142,5 +159,10 @@ std::string format_scan_answer(const scan_answer& a);
 // std::runtime_error naming the file and what is wrong, std::invalid_argument for a
 // name it does not hold (listing those it does).
 scan_result read_scan(const std::string& path, const std::string& name);
+
+// Every scan of a study file, and the build that wrote it (format_version, git_commit,
+// build_type, build_flags as one line), for `stepbench merge`; errors as read_scan's.
+std::vector<scan_result> read_scans(const std::string& path);
+std::string file_build(const std::string& path);
 
 }  // namespace stepbench

@@ -250,6 +250,9 @@ void write_scans(H5::H5File& file, const std::vector<scan_result>& scans) {
     attr(g, "reference_atol", o.ref_tol.atol);
     attr(g, "work_budget", o.limits.work_budget);
     attr(g, "wall_seconds", sc.wall_seconds);
+    attr(g, "grid_points", static_cast<long>(sc.grid_points));
+    attr(g, "shard_index", o.shard_index);
+    attr(g, "shard_count", o.shard_count);
     // The grid: one 1-D dataset per axis under values/, a value per point.
     H5::Group values = g.createGroup("values");
     for (std::size_t k = 0; k < o.axes.size(); ++k) {
@@ -264,7 +267,7 @@ void write_scans(H5::H5File& file, const std::vector<scan_result>& scans) {
       std::vector<double> horizon, scale;
       for (std::size_t i = 0; i < sc.points.size(); ++i) {
         const auto& p = sc.points[i];
-        point.push_back(static_cast<std::int64_t>(i));
+        point.push_back(static_cast<std::int64_t>(p.index));
         trusted.push_back(p.trusted ? 1 : 0);
         source.push_back(p.truth_source);
         horizon.push_back(p.horizon);
@@ -287,7 +290,7 @@ void write_scans(H5::H5File& file, const std::vector<scan_result>& scans) {
       std::vector<std::string> method, note;
       for (const auto& r : sc.runs) {
         const auto& m = r.row.metrics;
-        point.push_back(static_cast<std::int64_t>(r.point));
+        point.push_back(static_cast<std::int64_t>(sc.points[r.point].index));
         hz.push_back(r.hz);
         method.push_back(r.method);
         substeps.push_back(r.substeps);
@@ -324,7 +327,7 @@ void write_scans(H5::H5File& file, const std::vector<scan_result>& scans) {
       std::vector<double> hz, err, cost;
       std::vector<std::string> method;
       for (const auto& b : sc.best) {
-        point.push_back(static_cast<std::int64_t>(b.point));
+        point.push_back(static_cast<std::int64_t>(sc.points[b.point].index));
         hz.push_back(b.hz);
         method.push_back(b.method);
         substeps.push_back(b.substeps);

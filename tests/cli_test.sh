@@ -177,6 +177,30 @@ grep -q '60 Hz  rk4  *diverges for k_s >= 5.62e+04 N/m' "$work/out" && ok || bad
 [ $? -eq 1 ] && grep -q "cannot read the scan in '.*none.h5': no such file" "$work/err" && ok ||
   bad "advise --scan of a missing file: $(cat "$work/err")"
 
+# scan --shard K/N and merge: three shards join to the unsharded scan's answer; a shard
+# twice, a missing shard, another build: one line, exit 2, no file.
+for k in 1 2 3; do
+  "$bin" scan --problem stiff_spring --param stiff_spring.k_s=1e1:1e7:13:log --hz 60 --substeps 1,4 --shard "$k/3" \
+    --quiet --out "$work/shard$k.h5" >/dev/null || bad "scan --shard $k/3 failed"
+done
+"$bin" scan --problem stiff_spring --param stiff_spring.k_s=1e1:1e7:13:log --hz 60 --substeps 1,4 --quiet \
+  --out "$work/whole.h5" >"$work/whole.txt" || bad "the unsharded scan failed"
+"$bin" merge "$work/shard2.h5" "$work/shard1.h5" "$work/shard3.h5" -o "$work/merged.h5" 2>"$work/err" ||
+  bad "merge failed: $(cat "$work/err")"
+"$bin" advise --scan "$work/merged.h5" --tol 1e-3 >"$work/merged.txt"
+cmp -s "$work/merged.txt" "$work/whole.txt" && ok || bad "the merged scan answers otherwise: $(diff "$work/merged.txt" "$work/whole.txt")"
+cp "$work/shard3.h5" "$work/shard3copy.h5"
+expect_error "grid point .* is in two shards" merge "$work/shard1.h5" "$work/shard2.h5" "$work/shard3.h5" "$work/shard3copy.h5" -o "$work/m2.h5"
+expect_error "is named twice" merge "$work/shard1.h5" "$work/shard1.h5" -o "$work/m2.h5"
+expect_error "4 of 13 grid points are in no shard\|grid points are in no shard" merge "$work/shard1.h5" "$work/shard2.h5" -o "$work/m2.h5"
+[ ! -e "$work/m2.h5" ] && ok || bad "a refused merge wrote its file"
+"$bin" merge "$work/shard1.h5" "$work/shard2.h5" --partial -o "$work/m2.h5" 2>"$work/err" && grep -q "lacks .* of 13 grid points (--partial)" "$work/err" && ok ||
+  bad "merge --partial: $(cat "$work/err")"
+cp "$work/shard3.h5" "$work/other.h5"
+/usr/bin/python3 -c 'import h5py,sys; f=h5py.File(sys.argv[1],"r+"); f.attrs["git_commit"]="0000000"' "$work/other.h5"
+expect_error "was written by another build" merge "$work/shard1.h5" "$work/shard2.h5" "$work/other.h5" -o "$work/m3.h5"
+expect_error "shard 4 of 3\|1 <= K <= N" scan --problem stiff_spring --param stiff_spring.k_s=1:2:3 --shard 4/3 --out "$work/x.h5"
+
 # stepbench_bench, beside stepbench: --help lists our flags, one line each, above Google
 # Benchmark's.
 bench=$(dirname "$bin")/stepbench_bench

@@ -129,3 +129,65 @@ TEST(scan, written_and_read_back) {
   for (const auto& p : back.points) EXPECT_EQ(p.truth_source, "closed_form");
   EXPECT_EQ(format_scan_answer(answer_scan(back, 1e-3)), format_scan_answer(answer_scan(s.scans[0], 1e-3)));
 }
+
+// A scan in three shards, merged, equals the unsharded scan in every accuracy field; the
+// shards partition the grid; a shard twice, or one missing, is refused (issue 20).
+TEST(scan, shards_merge_to_the_unsharded_scan) {
+  scan_options o;
+  o.problem = "spring_chain";
+  o.axes = {parse_scan_axis("spring_chain.masses=4:16:3:log", "spring_chain"),
+            parse_scan_axis("spring_chain.k_s=1e2:1e4:3:log", "spring_chain")};
+  o.hz = {60};
+  o.substeps = {1, 8};
+  o.methods = {"semi_implicit_euler", "rk4"};
+  const scan_result whole = run_scan(o);
+  std::vector<scan_result> shards;
+  std::vector<std::size_t> seen;
+  for (int k = 0; k < 3; ++k) {
+    scan_options part = o;
+    part.shard_index = k;
+    part.shard_count = 3;
+    shards.push_back(run_scan(part));
+    for (const auto& p : shards.back().points) seen.push_back(p.index);
+  }
+  std::sort(seen.begin(), seen.end());
+  ASSERT_EQ(seen.size(), 9u);
+  for (std::size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], i) << "each point in exactly one shard";
+  // Balanced by size: the 16-mass points (the largest) go to different shards.
+  for (const auto& s : shards) EXPECT_EQ(s.points.size(), 3u);
+  std::vector<std::size_t> missing;
+  const scan_result merged = merge_scans({shards[2], shards[0], shards[1]}, false, missing);
+  EXPECT_TRUE(missing.empty());
+  ASSERT_EQ(merged.points.size(), whole.points.size());
+  ASSERT_EQ(merged.runs.size(), whole.runs.size());
+  for (std::size_t i = 0; i < merged.points.size(); ++i) {
+    EXPECT_EQ(merged.points[i].index, whole.points[i].index);
+    EXPECT_EQ(merged.points[i].values, whole.points[i].values);
+    EXPECT_EQ(merged.points[i].truth_source, whole.points[i].truth_source);
+  }
+  const auto same = [](double x, double y) { return x == y || (std::isnan(x) && std::isnan(y)); };
+  for (std::size_t i = 0; i < merged.runs.size(); ++i) {
+    const auto &a = merged.runs[i], &b = whole.runs[i];
+    EXPECT_EQ(a.point, b.point);
+    EXPECT_EQ(a.method, b.method);
+    EXPECT_EQ(a.substeps, b.substeps);
+    EXPECT_TRUE(same(a.row.metrics.err_pos_max, b.row.metrics.err_pos_max)) << i;
+    EXPECT_TRUE(same(a.row.metrics.err_pos_final, b.row.metrics.err_pos_final)) << i;
+    EXPECT_EQ(a.row.metrics.diverged, b.row.metrics.diverged);
+    EXPECT_EQ(a.row.work.force_evals, b.row.work.force_evals);
+    EXPECT_EQ(a.row.steps, b.row.steps);
+  }
+  EXPECT_EQ(format_scan_answer(answer_scan(merged, 1e-3)), format_scan_answer(answer_scan(whole, 1e-3)));
+  // Refusals: a shard twice; a shard missing (unless partial, which says what is missing).
+  EXPECT_THROW(merge_scans({shards[0], shards[1], shards[0]}, false, missing), std::invalid_argument);
+  EXPECT_THROW(merge_scans({shards[0], shards[1]}, false, missing), std::invalid_argument);
+  const scan_result part = merge_scans({shards[0], shards[1]}, true, missing);
+  EXPECT_EQ(missing.size(), shards[2].points.size());
+  EXPECT_EQ(part.points.size() + missing.size(), 9u);
+  // Shards of different scans.
+  scan_options other = o;
+  other.tol = 1e-4;
+  other.shard_index = 2;
+  other.shard_count = 3;
+  EXPECT_THROW(merge_scans({shards[0], shards[1], run_scan(other)}, false, missing), std::invalid_argument);
+}

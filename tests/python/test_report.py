@@ -109,6 +109,7 @@ def test_outputs_exist_and_images_resolve(reports, shape):
     with h5py.File(study, "r") as f:
         problems = list(f["problems"])
         energy = {p for p in problems if f["problems"][p].attrs["has_energy"] == 1}
+        scan_names = list(f["scan"]) if "scan" in f else []
     assert "kepler" in problems and "bouncing_balls" in problems
     for p in problems:
         assert f'<a href="#{p}">' in html, p
@@ -118,7 +119,9 @@ def test_outputs_exist_and_images_resolve(reports, shape):
         "stability_regions.png", "energy_long_runs.png", "loop_shown_error.png", "substeps_equal_cost.png"}
     drawn = set(os.path.basename(i) for i in images)
     assert expected <= drawn
-    assert drawn - expected <= {f"energy_drift_{p}.png" for p in energy}
+    # The scans' two figures each, where the study holds scans (/scan; docs/study-format.md).
+    scans = [f"scan_{name}_{kind}.png" for name in scan_names for kind in ("one_step", "cheapest")]
+    assert drawn - expected <= {f"energy_drift_{p}.png" for p in energy} | set(scans)
     assert {"energy_drift_pendulum.png", "energy_drift_kepler.png"} <= drawn
     # Each problem's figures are in its own section.
     for p in problems:

@@ -59,9 +59,10 @@ struct scan_options {
 // Checks the options; throws std::invalid_argument with a one-line reason.
 void validate(const scan_options& opts);
 
-// The scans of the full study: stiff_spring over k_s 1e1 .. 1e7 N/m (25 points, log) and
-// the pendulum over its release angle 1 .. 179.9 deg (12 points), each at 30 .. 240 Hz
-// with 1 .. 64 substeps; `quick`: the stiff spring's 13 points at 60 Hz only (the CI study).
+// The scans of the full study: stiff_spring over k_s 1e1 .. 1e7 N/m (25 points, log), the
+// pendulum over its release angle 1 .. 179.9 deg (12 points) and spring_chain over 8 .. 64
+// masses x k_s 1e2 .. 1e5 N/m (4 x 4, log), each at 30 .. 240 Hz with 1 .. 64 substeps;
+// `quick`: the stiff spring's 13 points at 60 Hz only (the CI study).
 std::vector<scan_options> default_scans(bool quick = false);
 
 struct scan_run {

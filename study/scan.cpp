@@ -148,6 +148,15 @@ void validate(const scan_options& opts) {
       throw std::invalid_argument(
           fmt::format("scan: frame rate {:g} Hz does not divide the fastest, {:g} Hz", hz, fastest));
   if (opts.substeps.empty()) throw std::invalid_argument("scan: no substep count");
+  // A rate or substep count given twice would count its runs twice over the range.
+  for (std::size_t i = 0; i < opts.hz.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (opts.hz[i] == opts.hz[j])
+        throw std::invalid_argument(fmt::format("scan: frame rate {:g} Hz is given twice", opts.hz[i]));
+  for (std::size_t i = 0; i < opts.substeps.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (opts.substeps[i] == opts.substeps[j])
+        throw std::invalid_argument(fmt::format("scan: substeps {} is given twice", opts.substeps[i]));
   for (int n : opts.substeps)
     if (n < 1 || n > 1 << 20) throw std::invalid_argument(fmt::format("scan: substeps {} is not in 1 .. 2^20", n));
   if (opts.shard_count < 1 || opts.shard_index < 0 || opts.shard_index >= opts.shard_count)
@@ -535,6 +544,7 @@ std::string format_scan_answer(const scan_answer& a) {
 }
 
 scan_result read_scan(const std::string& path, const std::string& name) {
+  H5::Exception::dontPrint();  // errors become one line, not HDF5's stack
   scan_result s;
   try {
     if (!std::filesystem::exists(path)) throw std::runtime_error("no such file");
@@ -666,7 +676,10 @@ std::vector<scan_result> read_scans(const std::string& path) {
 }
 
 std::string file_build(const std::string& path) {
+  H5::Exception::dontPrint();
   try {
+    if (!std::filesystem::exists(path)) throw std::runtime_error("no such file");
+    if (!H5::H5File::isHdf5(path)) throw std::runtime_error("not an HDF5 file");
     const H5::H5File file(path, H5F_ACC_RDONLY);
     return fmt::format("format_version {}, commit {}, {} build, flags {}", h5::long_attr(file, "format_version"),
                        h5::string_attr(file, "git_commit"), h5::string_attr(file, "build_type"),

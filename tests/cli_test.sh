@@ -201,6 +201,9 @@ cp "$work/shard3.h5" "$work/other.h5"
 expect_error "was written by another build" merge "$work/shard1.h5" "$work/shard2.h5" "$work/other.h5" -o "$work/m3.h5"
 expect_error "shard 4 of 3\|1 <= K <= N" scan --problem stiff_spring --param stiff_spring.k_s=1:2:3 --shard 4/3 --out "$work/x.h5"
 
+expect_error "frame rate 60 Hz is given twice" scan --problem stiff_spring --param stiff_spring.k_s=1:2:3 --hz 60,60 --out "$work/x.h5"
+expect_error "not an HDF5 file" merge "$work/out" "$work/shard1.h5" -o "$work/m4.h5"
+
 # stepbench_bench, beside stepbench: --help lists our flags, one line each, above Google
 # Benchmark's.
 bench=$(dirname "$bin")/stepbench_bench

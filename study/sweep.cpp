@@ -133,12 +133,16 @@ method_row skipped_row(double param, const std::string& note) {
 // `round_off_fall` over the last level, at round-off (within 100 times the typical
 // round-off eps sqrt(n) scale, the fit's own cut, core/convergence_fit.hpp), or else after
 // two such levels in a row (an error floor above round-off, as a contact's timing gives).
+// The ladder's length is checked last: a last level that also reached round-off, an error
+// floor or the budget is labelled by that, which says more about the method.
 std::string fixed_ladder_end(const std::vector<method_row>& rows, double dim, double scale, const sweep_options& opts) {
   const int k = static_cast<int>(rows.size());
-  if (k >= opts.max_levels)
+  if (k < opts.levels) return "";
+  const auto or_ladder_end = [&](std::string why) {
+    if (!why.empty() || k < opts.max_levels) return why;
     return fmt::format("the ladder's last level ({}){}", opts.max_levels,
                        opts.max_levels == opts.levels ? "" : ", before round-off or the work budget");
-  if (k < opts.levels) return "";
+  };
   const auto& last = rows.back();
   if (last.metrics.skipped) return "the work budget (the finer levels were skipped)";
   if (!last.metrics.completed()) return "divergence at the finest level";
@@ -157,7 +161,7 @@ std::string fixed_ladder_end(const std::vector<method_row>& rows, double dim, do
           ? fmt::format("the work budget: the next level would take {:.3g} coordinate force evaluations, over {:.3g}",
                         next_work, opts.limits.work_budget)
           : "";
-  if (fall(n - 1) > opts.round_off_fall) return budget;
+  if (fall(n - 1) > opts.round_off_fall) return or_ladder_end(budget);
   if (err <= 100.0 * roundoff_noise(last.steps, scale))
     return fmt::format(
         "round-off: the error {:.3g} fell {:.3g}x over the last level, within 100 eps sqrt(n) of round-off", err,
@@ -168,7 +172,7 @@ std::string fixed_ladder_end(const std::vector<method_row>& rows, double dim, do
         "an error floor: the error {:.3g} fell {:.3g}x and {:.3g}x over the last two levels, above the eps sqrt(n) "
         "round-off estimate",
         err, fall(n - 2), fall(n - 1));
-  return budget;
+  return or_ladder_end(budget);
 }
 
 }  // namespace

@@ -295,6 +295,21 @@ TEST(sweep, fixed_ladder_runs_to_round_off_or_the_work_budget) {
   EXPECT_LT(find(spring, "rk4").rows.back().metrics.err_pos_max, 1e-13);
 }
 
+// A ladder whose last level is also at round-off is labelled by round-off, not by its
+// length: rk4 on the damped spring run again with max_levels at the level where it met
+// round-off (the same rows) stops for the same reason.
+TEST(sweep, a_last_level_at_round_off_is_labelled_round_off) {
+  const auto& spring = find(default_study(), "damped_spring");
+  const auto& rk4 = find(spring, "rk4");
+  ASSERT_TRUE(rk4.ladder_end.starts_with("round-off")) << rk4.ladder_end;
+  sweep_options opts = default_study().options;
+  opts.levels = opts.max_levels = static_cast<int>(rk4.rows.size());
+  const method_study again = run_method(spring, rk4.info, opts);
+  ASSERT_EQ(again.rows.size(), rk4.rows.size());
+  EXPECT_EQ(again.rows.back().metrics.err_pos_max, rk4.rows.back().metrics.err_pos_max);
+  EXPECT_TRUE(again.ladder_end.starts_with("round-off")) << again.ladder_end;
+}
+
 // The problems swept on one thread or several give the same rows, bit for bit.
 TEST(sweep, threads_do_not_change_a_row) {
   sweep_options one;

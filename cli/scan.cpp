@@ -105,6 +105,7 @@ int run_scan_command(const scan_args& a) {
   validate(o);
   check_writable(a.out);
   // Progress on stderr: a line every 5 s (the scan's answer is what stdout carries).
+  // Written with fputs, which does not throw: a closed stderr must not end a scan.
   const auto start = std::chrono::steady_clock::now();
   auto last = start;
   o.on_progress = [&](std::size_t done, std::size_t total) {
@@ -112,8 +113,10 @@ int run_scan_command(const scan_args& a) {
     if (a.quiet || (done < total && now - last < std::chrono::seconds(5))) return;
     last = now;
     const double elapsed = std::chrono::duration<double>(now - start).count();
-    fmt::print(stderr, "scan: {} of {} points, {:.0f} s elapsed{}\n", done, total, elapsed,
-               done < total ? fmt::format(", about {:.0f} s left", elapsed / done * (total - done)) : "");
+    std::fputs(fmt::format("scan: {} of {} points, {:.0f} s elapsed{}\n", done, total, elapsed,
+                           done < total ? fmt::format(", about {:.0f} s left", elapsed / done * (total - done)) : "")
+                   .c_str(),
+               stderr);
   };
   study s;
   s.scans.push_back(run_scan(o));
@@ -125,11 +128,12 @@ int run_scan_command(const scan_args& a) {
   else
     fmt::print("{}", format_scan_answer(answer));
   if (!a.quiet)
-    fmt::print(stderr,
-               "wrote {} (/scan/{}: {} points, {} runs) in {:.2f} s; `stepbench advise --scan {} --tol X` "
-               "answers at another tolerance\n",
-               a.out, o.name.empty() ? o.problem : o.name, s.scans.back().points.size(), s.scans.back().runs.size(),
-               s.wall_seconds, a.out);
+    std::fputs(fmt::format("wrote {} (/scan/{}: {} points, {} runs) in {:.2f} s; `stepbench advise --scan {} --tol X` "
+                           "answers at another tolerance\n",
+                           a.out, o.name.empty() ? o.problem : o.name, s.scans.back().points.size(),
+                           s.scans.back().runs.size(), s.wall_seconds, a.out)
+                   .c_str(),
+               stderr);
   return 0;
 }
 

@@ -46,7 +46,12 @@ void parallel_indices(std::size_t n, int jobs, const std::function<void(std::siz
         next = n;  // the others stop at their current index
       }
       std::lock_guard guard(lock);
-      if (after_each) after_each();
+      // Progress must never end a run: a report that fails (stderr closed) is dropped,
+      // where it would otherwise leave the thread and terminate the process.
+      try {
+        if (after_each) after_each();
+      } catch (...) {
+      }
     }
   };
   const int threads =

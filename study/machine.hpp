@@ -18,6 +18,7 @@ std::string utc_now_iso8601();
 // thread is one of them), then after_each() under one lock. Each body writes only its
 // own slot, so the result does not depend on the threads. After an exception the
 // threads stop at their current index and the lowest-indexed exception is rethrown here.
+// after_each reports progress: an exception from it is dropped, and the work goes on.
 void parallel_indices(std::size_t n, int jobs, const std::function<void(std::size_t)>& body,
                       const std::function<void()>& after_each);
 

@@ -168,6 +168,11 @@ expect_error "frame rate 45 Hz does not divide the fastest, 60 Hz" scan --proble
 /usr/bin/python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["points"] == 25, d' "$work/out" && ok ||
   bad "scan --json is not one JSON object: $(head -3 "$work/out")"
 grep -q '^wrote .*scan.h5 (/scan/stiff_spring: 25 points' "$work/err" && ok || bad "scan's summary: $(cat "$work/err")"
+# Progress and the summary never end a scan: with stderr closed it is written and exits 0.
+"$bin" scan --problem stiff_spring --param stiff_spring.k_s=1e1:1e3:3:log --hz 60 --substeps 1 \
+  --out "$work/closed.h5" >/dev/null 2>&-
+rc=$?
+[ "$rc" -eq 0 ] && [ -e "$work/closed.h5" ] && ok || bad "scan with stderr closed exited $rc"
 "$bin" advise --scan "$work/scan.h5" --tol 1e-3 >"$work/out"
 rc=$?  # 3: with at most 8 substeps nothing holds 1 mm over the whole range
 [ "$rc" -eq 3 ] && grep -q '60 Hz: no method of the scan stays within 0.001 m over the whole range' "$work/out" && ok ||

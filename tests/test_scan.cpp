@@ -191,3 +191,34 @@ TEST(scan, shards_merge_to_the_unsharded_scan) {
   other.shard_count = 3;
   EXPECT_THROW(merge_scans({shards[0], shards[1], run_scan(other)}, false, missing), std::invalid_argument);
 }
+
+namespace {
+
+// A small stiff-spring scan: k_s 10 .. 1000 N/m (3 points, log) at 60 Hz, one step a frame.
+scan_options small_spring_scan() {
+  scan_options o;
+  o.problem = "stiff_spring";
+  o.axes = {parse_scan_axis("stiff_spring.k_s=1e1:1e3:3:log", "stiff_spring")};
+  o.hz = {60};
+  o.substeps = {1};
+  o.methods = {"rk4"};
+  return o;
+}
+
+}  // namespace
+
+// Progress must never end a scan: a report that throws (stderr closed) is dropped, and
+// every point is still run.
+TEST(scan, a_failing_progress_report_does_not_end_the_scan) {
+  scan_options o = small_spring_scan();
+  o.jobs = 2;
+  int reports = 0;
+  o.on_progress = [&](std::size_t, std::size_t) {
+    ++reports;
+    throw std::runtime_error("stderr is closed");
+  };
+  const scan_result s = run_scan(o);
+  EXPECT_EQ(reports, 3);
+  EXPECT_EQ(s.points.size(), 3u);
+  EXPECT_EQ(s.runs.size(), 3u);
+}

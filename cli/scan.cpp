@@ -43,6 +43,7 @@ nlohmann::json scan_answer_json(const scan_answer& a) {
                         {"range", a.range},
                         {"tol", a.tol},
                         {"points", a.points},
+                        {"grid_points", a.grid_points},
                         {"untrusted_points", a.untrusted},
                         {"choices", nlohmann::json::array()},
                         {"one_step_a_frame", nlohmann::json::array()}};

@@ -343,7 +343,20 @@ table_data read_table(const H5::DataSet& ds) {
   const H5::DataSpace space = ds.getSpace();
   const std::size_t record = type.getSize();
   out.rows_ = checked_extent(space, record, file_size(ds), out.name_);
-  for (const auto& m : members) out.fields_.emplace_back(m.name, m.kind);
+  for (const auto& m : members) {
+    out.fields_.emplace_back(m.name, m.kind);
+    // Every field has its column, empty in a table of no rows (a shard without points).
+    switch (m.kind) {
+      case table_data::kind::real:
+        out.reals_[m.name];
+        break;
+      case table_data::kind::integer:
+        out.integers_[m.name];
+        break;
+      case table_data::kind::text:
+        out.texts_[m.name];
+    }
+  }
   if (out.rows_ == 0) return out;
   std::vector<unsigned char> raw(out.rows_ * record, 0);
   // HDF5 converts through a buffer of 1 MiB by default, allocated and freed on each read:

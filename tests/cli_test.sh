@@ -165,7 +165,7 @@ expect_error "frame rate 45 Hz does not divide the fastest, 60 Hz" scan --proble
 [ ! -e "$work/scan.h5" ] && ok || bad "a refused scan wrote its file"
 "$bin" scan --problem stiff_spring --param stiff_spring.k_s=1e1:1e7:25:log --hz 60 --substeps 1,8 --json \
   --out "$work/scan.h5" >"$work/out" 2>"$work/err" || bad "scan failed: $(cat "$work/err")"
-/usr/bin/python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["points"] == 25, d' "$work/out" && ok ||
+/usr/bin/python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["points"] == 25 and d["grid_points"] == 25, d' "$work/out" && ok ||
   bad "scan --json is not one JSON object: $(head -3 "$work/out")"
 grep -q '^wrote .*scan.h5 (/scan/stiff_spring: 25 points' "$work/err" && ok || bad "scan's summary: $(cat "$work/err")"
 # Progress and the summary never end a scan: with stderr closed it is written and exits 0.
@@ -208,6 +208,23 @@ expect_error "shard 4 of 3\|1 <= K <= N" scan --problem stiff_spring --param sti
 
 expect_error "frame rate 60 Hz is given twice" scan --problem stiff_spring --param stiff_spring.k_s=1:2:3 --hz 60,60 --out "$work/x.h5"
 expect_error "not an HDF5 file" merge "$work/out" "$work/shard1.h5" -o "$work/m4.h5"
+
+# A shard with no point (more shards than points) is written, read and merged; the merged
+# scan answers as the unsharded one.
+for k in 1 2 3 4 5; do
+  "$bin" scan --problem stiff_spring --param stiff_spring.k_s=1e1:1e3:3:log --hz 60 --substeps 1 --shard "$k/5" \
+    --quiet --out "$work/small$k.h5" >/dev/null || bad "scan --shard $k/5 of 3 points failed"
+done
+"$bin" advise --scan "$work/small5.h5" --tol 1e-3 --json | /usr/bin/python3 -c '
+import json, sys
+d = json.load(sys.stdin)
+assert d["points"] == 0 and d["grid_points"] == 3, d' && ok || bad "an empty shard does not read back"
+"$bin" merge "$work"/small[1-5].h5 -o "$work/small.h5" 2>"$work/err" || bad "merge with an empty shard: $(cat "$work/err")"
+"$bin" scan --problem stiff_spring --param stiff_spring.k_s=1e1:1e3:3:log --hz 60 --substeps 1 --quiet \
+  --out "$work/smallwhole.h5" >"$work/smallwhole.txt" || bad "the unsharded small scan failed"
+"$bin" advise --scan "$work/small.h5" --tol 1e-3 >"$work/small.txt"
+cmp -s "$work/small.txt" "$work/smallwhole.txt" && ok ||
+  bad "the merge with an empty shard answers otherwise: $(diff "$work/small.txt" "$work/smallwhole.txt")"
 
 # stepbench_bench, beside stepbench: --help lists our flags, one line each, above Google
 # Benchmark's.

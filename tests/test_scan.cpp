@@ -5,6 +5,7 @@
 // (Hairer & Wanner, "Solving ODEs II", sec. IV.2; the study computes the same limits
 // from the compiled steps, study/stability.hpp).
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -205,7 +206,45 @@ scan_options small_spring_scan() {
   return o;
 }
 
+// The scan written alone to a study file and read back, as a shard file meets `merge`.
+scan_result through_file(const scan_result& scan, const std::string& file) {
+  // The process id keeps test processes run at once apart.
+  const auto path = (std::filesystem::temp_directory_path() / (std::to_string(::getpid()) + "_" + file)).string();
+  study s;
+  s.scans.push_back(scan);
+  write_study(s, path);
+  scan_result back = read_scan(path, "");
+  std::filesystem::remove(path);
+  return back;
+}
+
 }  // namespace
+
+// A shard with no point (more shards than grid points) is written, read back with empty
+// tables, and merges with the others into the whole scan.
+TEST(scan, an_empty_shard_is_written_read_and_merged) {
+  scan_options o = small_spring_scan();
+  o.shard_count = 4;  // 3 points: the fourth shard holds none
+  std::vector<scan_result> shards;
+  for (int k = 0; k < 4; ++k) {
+    o.shard_index = k;
+    shards.push_back(through_file(run_scan(o), "stepbench_test_shard" + std::to_string(k) + ".h5"));
+  }
+  const scan_result& empty = shards[3];
+  EXPECT_TRUE(empty.points.empty());
+  EXPECT_TRUE(empty.runs.empty());
+  EXPECT_EQ(empty.grid_points, 3u);
+  EXPECT_EQ(empty.options.shard_index, 3);
+  std::vector<std::size_t> missing;
+  const scan_result merged = merge_scans(shards, false, missing);
+  EXPECT_TRUE(missing.empty());
+  ASSERT_EQ(merged.points.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(merged.points[i].index, i);
+  const scan_result whole = run_scan(small_spring_scan());
+  ASSERT_EQ(merged.runs.size(), whole.runs.size());
+  for (std::size_t i = 0; i < merged.runs.size(); ++i)
+    EXPECT_EQ(merged.runs[i].row.metrics.err_pos_max, whole.runs[i].row.metrics.err_pos_max) << i;
+}
 
 // Progress must never end a scan: a report that throws (stderr closed) is dropped, and
 // every point is still run.

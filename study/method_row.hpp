@@ -2,6 +2,7 @@
 // The single row shape of the study: one run of one method at one parameter, with its
 // timing when the study was timed (the sweep, the substeps and scan studies share it).
 #include <limits>
+#include <string>
 
 #include "core/concepts.hpp"
 #include "core/measure.hpp"
@@ -26,5 +27,18 @@ struct method_row {
   run_metrics metrics;
   timing time;
 };
+
+// A run not taken because its work would exceed the budget: no steps, NaN errors, the
+// reason in the note. The sweep's ladder and the scan record the same row.
+inline method_row skipped_row(double param, const std::string& note) {
+  method_row row{param, 0, 0, {}, {}, {}};
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  auto& mt = row.metrics;
+  mt.err_pos_final = mt.err_vel_final = mt.err_pos_max = mt.err_pos_rms = mt.energy_drift = mt.energy_err_max = nan;
+  mt.angmom_drift = mt.angmom_err_max = mt.contact_count_err = mt.contact_time_err = mt.contact_pos_err = nan;
+  mt.skipped = true;
+  mt.note = note;
+  return row;
+}
 
 }  // namespace stepbench

@@ -380,18 +380,33 @@ scan_result run_scan(const scan_options& opts) {
     w.point.trusted = fine.trusted;
     w.point.note = fine.note;
     w.point.pos_scale = fine.pos_scale;
+    // A fixed-step run ignores the work budget, so each run's work is estimated before it
+    // is taken, as the sweep's ladder does (study/sweep.cpp): steps x force evaluations a
+    // step x coordinates, the evaluations a step as this method took them at this point
+    // in its last run, else as it declares them, else one (the least a step takes). A run
+    // over the budget is recorded as skipped, with the estimate.
+    const double dim = problem->dim();
+    std::vector<double> evals_per_step;
+    for (const auto& m : methods) evals_per_step.push_back(std::isfinite(m.evals_per_step) ? m.evals_per_step : 1.0);
     for (double hz : opts.hz) {
       const truth_table truth = every_nth(fine, static_cast<std::size_t>(std::lround(fastest / hz)));
-      for (const auto& m : methods)
+      for (std::size_t k = 0; k < methods.size(); ++k)
         for (int n : opts.substeps) {
+          const std::string& name = methods[k].name;
           const double dt = 1.0 / (hz * n);
-          const run_result run = problem->run(m.name, dt, f.horizon, truth.times, opts.limits);
-          scan_run r{
-              local, hz, m.name, n, {dt, run.steps, run.rejected_steps, run.work, measure(*problem, run, truth), {}}};
-          // Past the work budget every finer count is too.
-          const bool done = r.row.metrics.skipped;
-          w.runs.push_back(std::move(r));
-          if (done) break;
+          const double steps = f.horizon / dt, work = steps * evals_per_step[k] * dim;
+          if (work > opts.limits.work_budget) {
+            w.runs.push_back({local, hz, name, n,
+                              skipped_row(dt, fmt::format("skipped: about {:.3g} steps x {:g} force evaluations x {:g} "
+                                                          "coordinates exceed the work budget of {:.3g}",
+                                                          steps, evals_per_step[k], dim, opts.limits.work_budget))});
+            continue;
+          }
+          const run_result run = problem->run(name, dt, f.horizon, truth.times, opts.limits);
+          if (run.steps > 0 && run.work.force_evals > 0)
+            evals_per_step[k] = static_cast<double>(run.work.force_evals) / static_cast<double>(run.steps);
+          w.runs.push_back(
+              {local, hz, name, n, {dt, run.steps, run.rejected_steps, run.work, measure(*problem, run, truth), {}}});
         }
     }
   };

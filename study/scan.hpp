@@ -47,6 +47,8 @@ struct scan_options {
   double tol = 1e-3;                    // in the problem's position unit
   std::map<std::string, double> fixed;  // other parameters of the problem (--set)
   reference_tolerances ref_tol{};
+  // A run whose work (steps x force evaluations a step x coordinates) would exceed
+  // limits.work_budget is recorded as skipped, not run.
   run_limits limits{};
   int jobs = 0;  // threads over the grid points (0: one a core)
   // --shard K/N: this run takes shard `shard_index` (0-based) of `shard_count`, a

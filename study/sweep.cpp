@@ -115,17 +115,6 @@ void fit_rows(method_study& ms, double pos_scale) {
 
 namespace {
 
-method_row skipped_row(double param, const std::string& note) {
-  method_row row{param, 0, 0, {}, {}, {}};
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  auto& mt = row.metrics;
-  mt.err_pos_final = mt.err_vel_final = mt.err_pos_max = mt.err_pos_rms = mt.energy_drift = mt.energy_err_max = nan;
-  mt.angmom_drift = mt.angmom_err_max = mt.contact_count_err = mt.contact_time_err = mt.contact_pos_err = nan;
-  mt.skipped = true;
-  mt.note = note;
-  return row;
-}
-
 // Why a fixed-step ladder stops after its rows, or "" while it goes on. The first
 // `levels` rows always run (a level over the work budget is recorded as skipped); beyond
 // them the ladder halves dt while the last level completed, the next fits the work

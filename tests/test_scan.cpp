@@ -246,6 +246,41 @@ TEST(scan, an_empty_shard_is_written_read_and_merged) {
     EXPECT_EQ(merged.runs[i].row.metrics.err_pos_max, whole.runs[i].row.metrics.err_pos_max) << i;
 }
 
+// A run whose work (steps x force evaluations a step x coordinates) would exceed the work
+// budget is recorded as skipped, with the estimate, not run: rk4 takes 4 evaluations a
+// step, so with a budget of three times one step a frame's, 2 substeps run and 4 do not;
+// 2^20 substeps (134 million evaluations) are over the default budget of 2^25.
+TEST(scan, runs_over_the_work_budget_are_skipped) {
+  scan_options o = small_spring_scan();
+  o.axes = {parse_scan_axis("stiff_spring.k_s=1e2:1e2:1", "stiff_spring")};
+  const long one_step_a_frame = run_scan(o).runs.at(0).row.work.force_evals;
+  EXPECT_EQ(one_step_a_frame, 32 * 4);  // 32 frames of 60 Hz in the horizon
+  o.substeps = {1, 2, 4, 1 << 20};
+  o.limits.work_budget = 3.0 * static_cast<double>(one_step_a_frame);
+  const scan_result s = run_scan(o);
+  ASSERT_EQ(s.runs.size(), 4u);
+  EXPECT_TRUE(s.runs[0].row.metrics.completed());
+  EXPECT_EQ(s.runs[1].row.work.force_evals, 2 * one_step_a_frame);
+  EXPECT_TRUE(s.runs[1].row.metrics.completed());
+  for (std::size_t i : {2u, 3u}) {
+    const auto& r = s.runs[i].row;
+    EXPECT_TRUE(r.metrics.skipped) << i;
+    EXPECT_EQ(r.steps, 0) << i;
+    EXPECT_EQ(r.work.force_evals, 0) << i;
+    EXPECT_TRUE(std::isnan(r.metrics.err_pos_max)) << i;
+    EXPECT_NE(r.metrics.note.find("exceed the work budget of 384"), std::string::npos) << r.metrics.note;
+  }
+  EXPECT_NE(s.runs[2].row.metrics.note.find("about 128 steps x 4 force evaluations x 1 coordinates"), std::string::npos)
+      << s.runs[2].row.metrics.note;
+  // The default budget: 2^20 substeps are skipped; the answer does not count them as stable.
+  scan_options huge = small_spring_scan();
+  huge.substeps = {1 << 20};
+  const scan_result h = run_scan(huge);
+  ASSERT_EQ(h.runs.size(), 3u);
+  for (const auto& r : h.runs) EXPECT_TRUE(r.row.metrics.skipped);
+  EXPECT_EQ(answer_scan(h, 1.0).choices.at(0).method, "");
+}
+
 // Progress must never end a scan: a report that throws (stderr closed) is dropped, and
 // every point is still run.
 TEST(scan, a_failing_progress_report_does_not_end_the_scan) {

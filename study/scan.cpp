@@ -238,27 +238,37 @@ std::vector<std::size_t> scan_shard(const scan_options& opts, int k, int n) {
 scan_result merge_scans(const std::vector<scan_result>& shards, bool partial, std::vector<std::size_t>& missing) {
   if (shards.empty()) throw std::invalid_argument("merge: no shard");
   const auto& first = shards.front();
-  const auto same_axes = [](const std::vector<scan_axis>& a, const std::vector<scan_axis>& b) {
-    if (a.size() != b.size()) return false;
-    for (std::size_t i = 0; i < a.size(); ++i)
-      if (a[i].param != b[i].param || a[i].lo != b[i].lo || a[i].hi != b[i].hi || a[i].count != b[i].count ||
-          a[i].log != b[i].log)
-        return false;
-    return true;
-  };
-  for (const auto& s : shards) {
+  // What makes two shards one scan, each as text: doubles in fmt's shortest form that
+  // reads back exactly, so equal text is equal values, and the refusal can show both.
+  const auto described = [](const scan_result& s) {
     const auto& o = s.options;
-    const auto& f = first.options;
-    const char* differs = o.problem != f.problem               ? "problem"
-                          : !same_axes(o.axes, f.axes)         ? "axes"
-                          : o.hz != f.hz                       ? "frame rates"
-                          : o.substeps != f.substeps           ? "substeps"
-                          : o.tol != f.tol                     ? "tolerance"
-                          : o.fixed != f.fixed                 ? "fixed parameters"
-                          : s.grid_points != first.grid_points ? "grid"
-                                                               : nullptr;
-    if (differs)
-      throw std::invalid_argument(fmt::format("merge: scan '{}': the shards differ in their {}", f.name, differs));
+    std::vector<std::string> axes, fixed;
+    for (const auto& a : o.axes)
+      axes.push_back(fmt::format("{}={}:{}:{}{}", a.param, a.lo, a.hi, a.count, a.log ? ":log" : ""));
+    for (const auto& [name, value] : o.fixed) fixed.push_back(fmt::format("{}={}", name, value));
+    return std::vector<std::pair<std::string_view, std::string>>{
+        {"problem", o.problem},
+        {"axes", fmt::format("{}", fmt::join(axes, " x "))},
+        {"frame rates", fmt::format("{} Hz", fmt::join(o.hz, ","))},
+        {"substeps", fmt::format("{}", fmt::join(o.substeps, ","))},
+        {"methods", fmt::format("{}", fmt::join(o.methods, ","))},
+        {"tolerance", fmt::format("{}", o.tol)},
+        {"fixed parameters (--set)", fixed.empty() ? "none" : fmt::format("{}", fmt::join(fixed, ","))},
+        {"reference tolerances", fmt::format("rtol {} atol {}", o.ref_tol.rtol, o.ref_tol.atol)},
+        {"work budget", fmt::format("{}", o.limits.work_budget)},
+        {"grid", fmt::format("{} points", s.grid_points)}};
+  };
+  const auto label = [](const scan_result& s, std::size_t k) {
+    return s.source.empty() ? fmt::format("shard {}", k + 1) : fmt::format("'{}'", s.source);
+  };
+  const auto want = described(first);
+  for (std::size_t k = 1; k < shards.size(); ++k) {
+    const auto have = described(shards[k]);
+    for (std::size_t i = 0; i < want.size(); ++i)
+      if (have[i].second != want[i].second)
+        throw std::invalid_argument(fmt::format("merge: scan '{}': the shards differ in their {}: {} has {}, {} has {}",
+                                                first.options.name, want[i].first, label(first, 0), want[i].second,
+                                                label(shards[k], k), have[i].second));
   }
   // Every point once: the first shard holding it, refusing a second.
   std::vector<std::pair<const scan_result*, std::size_t>> owner(first.grid_points, {nullptr, 0});
@@ -344,6 +354,8 @@ scan_result run_scan(const scan_options& opts) {
         (opts.methods.empty() ? m.origin == method_origin::ours
                               : std::find(opts.methods.begin(), opts.methods.end(), m.name) != opts.methods.end()))
       methods.push_back(m);
+  out.options.methods.clear();  // the file records the methods run, which merge compares
+  for (const auto& m : methods) out.options.methods.push_back(m.name);
   const auto grid = scan_grid(opts.axes);
   const auto mine = scan_shard(opts, opts.shard_index, opts.shard_count);
   out.grid_points = grid.size();
@@ -558,6 +570,22 @@ std::string format_scan_answer(const scan_answer& a) {
   return out;
 }
 
+namespace {
+
+// The names of a comma-separated attribute ("" : none; the names hold no commas).
+std::vector<std::string> names_of(const std::string& text) {
+  std::vector<std::string> out;
+  if (text.empty()) return out;
+  for (std::size_t start = 0; start <= text.size();) {
+    const auto comma = std::min(text.find(',', start), text.size());
+    out.push_back(text.substr(start, comma - start));
+    start = comma + 1;
+  }
+  return out;
+}
+
+}  // namespace
+
 scan_result read_scan(const std::string& path, const std::string& name) {
   H5::Exception::dontPrint();  // errors become one line, not HDF5's stack
   scan_result s;
@@ -586,13 +614,7 @@ scan_result read_scan(const std::string& path, const std::string& name) {
     o.tol = h5::double_attr(g, "tol");
     const auto lo = h5::double_array_attr(g, "axis_lo"), hi = h5::double_array_attr(g, "axis_hi");
     const auto count = h5::int_array_attr(g, "axis_count"), log = h5::int_array_attr(g, "axis_log");
-    const std::string axes = h5::string_attr(g, "axes");
-    std::vector<std::string> axis_names;
-    for (std::size_t start = 0; start <= axes.size();) {
-      const auto comma = std::min(axes.find(',', start), axes.size());
-      axis_names.push_back(axes.substr(start, comma - start));
-      start = comma + 1;
-    }
+    const std::vector<std::string> axis_names = names_of(h5::string_attr(g, "axes"));
     if (axis_names.size() != lo.size() || lo.size() != hi.size() || hi.size() != count.size() ||
         count.size() != log.size())
       throw std::runtime_error(fmt::format("scan '{}': its axis attributes differ in length", which));
@@ -600,6 +622,17 @@ scan_result read_scan(const std::string& path, const std::string& name) {
       o.axes.push_back({axis_names[k], lo[k], hi[k], static_cast<int>(count[k]), log[k] != 0, false});
     o.hz = h5::double_array_attr(g, "hz");
     for (long n : h5::int_array_attr(g, "substeps")) o.substeps.push_back(static_cast<int>(n));
+    o.methods = names_of(h5::string_attr(g, "methods"));
+    const auto fixed_names = names_of(h5::string_attr(g, "fixed_params"));
+    const auto fixed_values = h5::double_array_attr(g, "fixed_values");
+    if (fixed_names.size() != fixed_values.size())
+      throw std::runtime_error(fmt::format("scan '{}': {} fixed_params but {} fixed_values", which, fixed_names.size(),
+                                           fixed_values.size()));
+    for (std::size_t k = 0; k < fixed_names.size(); ++k) o.fixed[fixed_names[k]] = fixed_values[k];
+    o.ref_tol.rtol = h5::double_attr(g, "reference_rtol");
+    o.ref_tol.atol = h5::double_attr(g, "reference_atol");
+    o.limits.work_budget = h5::double_attr(g, "work_budget");
+    s.wall_seconds = h5::double_attr(g, "wall_seconds");
     const H5::Group values = g.openGroup("values");
     std::vector<std::vector<double>> columns;
     for (const auto& a : o.axes) columns.push_back(h5::read_vector(values.openDataSet(a.param)));
@@ -662,6 +695,7 @@ scan_result read_scan(const std::string& path, const std::string& name) {
       s.runs.push_back(std::move(r));
     }
     compute_best(s);
+    s.source = path;
   } catch (const std::invalid_argument&) {
     throw;
   } catch (const H5::Exception& e) {

@@ -43,7 +43,8 @@ struct scan_options {
   std::vector<scan_axis> axes;
   std::vector<double> hz{30, 60, 120, 240};  // each divides the fastest (--dt X is hz 1/X)
   std::vector<int> substeps{1, 2, 4, 8, 16, 32, 64};
-  std::vector<std::string> methods;     // empty: our fixed-step methods on the problem
+  // Empty: our fixed-step methods on the problem. A scan's result holds those it ran.
+  std::vector<std::string> methods;
   double tol = 1e-3;                    // in the problem's position unit
   std::map<std::string, double> fixed;  // other parameters of the problem (--set)
   reference_tolerances ref_tol{};
@@ -103,7 +104,8 @@ struct scan_result {
   std::vector<scan_point> points;  // in grid order
   std::vector<scan_run> runs;
   std::vector<scan_best> best;
-  double wall_seconds = 0.0;
+  double wall_seconds = 0.0;  // a merged scan's: the sum of its shards'
+  std::string source;         // the file it was read from ("" when run here): merge names it
 };
 
 scan_result run_scan(const scan_options& opts);
@@ -117,10 +119,11 @@ std::vector<std::vector<double>> scan_grid(const std::vector<scan_axis>& axes);
 // the lowest shard). Deterministic: every machine computes the same split.
 std::vector<std::size_t> scan_shard(const scan_options& opts, int k, int n);
 
-// Joins shards of one scan (the same problem, axes, rates, substeps, methods, tolerance
-// and fixed parameters) into one scan, points in grid order; throws std::invalid_argument
-// naming the first difference, a point two shards hold, or, unless `partial`, the points
-// none holds. `missing` receives the grid indices no shard holds.
+// Joins shards of one scan (the same problem, axes, rates, substeps, methods, tolerance,
+// fixed parameters, reference tolerances and work budget) into one scan, points in grid
+// order; throws std::invalid_argument naming the first difference and the two values, a
+// point two shards hold, or, unless `partial`, the points none holds. `missing` receives
+// the grid indices no shard holds. A shard may hold no point (N above the grid's points).
 scan_result merge_scans(const std::vector<scan_result>& shards, bool partial, std::vector<std::size_t>& missing);
 
 }  // namespace stepbench

@@ -238,6 +238,7 @@ void write_scans(H5::H5File& file, const std::vector<scan_result>& scans) {
     attr(g, "axis_log", log);
     attr(g, "hz", o.hz);
     attr(g, "substeps", std::vector<int>(o.substeps.begin(), o.substeps.end()));
+    attr(g, "methods", fmt::format("{}", fmt::join(o.methods, ",")));  // the methods run; names have no commas
     std::vector<std::string> fixed_names;
     std::vector<double> fixed_values;
     for (const auto& [name, value] : o.fixed) {

@@ -209,6 +209,17 @@ expect_error "shard 4 of 3\|1 <= K <= N" scan --problem stiff_spring --param sti
 expect_error "frame rate 60 Hz is given twice" scan --problem stiff_spring --param stiff_spring.k_s=1:2:3 --hz 60,60 --out "$work/x.h5"
 expect_error "not an HDF5 file" merge "$work/out" "$work/shard1.h5" -o "$work/m4.h5"
 
+# Shards run with another --set or other methods are another scan: refused in one line
+# naming what differs and both values.
+"$bin" scan --problem stiff_spring --param stiff_spring.k_s=1e1:1e7:13:log --hz 60 --substeps 1,4 --shard 3/3 \
+  --set stiff_spring.mass_kg=2 --quiet --out "$work/set3.h5" >/dev/null || bad "scan --shard 3/3 --set failed"
+expect_error "differ in their fixed parameters (--set): '.*shard1.h5' has none, '.*set3.h5' has mass_kg=2$" \
+  merge "$work/shard1.h5" "$work/shard2.h5" "$work/set3.h5" -o "$work/m5.h5"
+"$bin" scan --problem stiff_spring --param stiff_spring.k_s=1e1:1e7:13:log --hz 60 --substeps 1,4 --shard 3/3 \
+  --method rk4 --quiet --out "$work/rk4only3.h5" >/dev/null || bad "scan --shard 3/3 --method rk4 failed"
+expect_error "differ in their methods: '.*shard1.h5' has .*rk4.*, '.*rk4only3.h5' has rk4$" \
+  merge "$work/shard1.h5" "$work/shard2.h5" "$work/rk4only3.h5" -o "$work/m5.h5"
+[ ! -e "$work/m5.h5" ] && ok || bad "a refused merge wrote its file"
 # A shard with no point (more shards than points) is written, read and merged; the merged
 # scan answers as the unsharded one.
 for k in 1 2 3 4 5; do

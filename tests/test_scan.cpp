@@ -218,7 +218,66 @@ scan_result through_file(const scan_result& scan, const std::string& file) {
   return back;
 }
 
+std::string merge_refusal(const std::vector<scan_result>& shards) {
+  std::vector<std::size_t> missing;
+  try {
+    merge_scans(shards, false, missing);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "(merged)";
+}
+
 }  // namespace
+
+// What makes shards one scan is written and read back, and merge compares all of it: shards
+// run with another --set, other methods, other reference tolerances or another work budget
+// are refused in one line naming the difference and both values; the merged scan's wall
+// time is the sum of its shards' (issue 20 review).
+TEST(scan, merge_refuses_shards_of_other_options_read_from_files) {
+  scan_options o = small_spring_scan();
+  o.shard_count = 2;
+  o.fixed = {{"mass_kg", 2.0}};
+  o.ref_tol = {1e-12, 1e-13};
+  o.limits.work_budget = 1e7;
+  const scan_result first = through_file(run_scan(o), "stepbench_test_shard1.h5");
+  EXPECT_EQ(first.options.fixed, (std::map<std::string, double>{{"mass_kg", 2.0}}));
+  EXPECT_EQ(first.options.methods, (std::vector<std::string>{"rk4"}));
+  EXPECT_EQ(first.options.ref_tol.rtol, 1e-12);
+  EXPECT_EQ(first.options.ref_tol.atol, 1e-13);
+  EXPECT_EQ(first.options.limits.work_budget, 1e7);
+  EXPECT_GT(first.wall_seconds, 0.0);
+  o.shard_index = 1;
+  const scan_result second = through_file(run_scan(o), "stepbench_test_shard2.h5");
+  std::vector<std::size_t> missing;
+  const scan_result merged = merge_scans({first, second}, false, missing);
+  EXPECT_EQ(merged.points.size(), 3u);
+  EXPECT_DOUBLE_EQ(merged.wall_seconds, first.wall_seconds + second.wall_seconds);
+
+  const auto refused = [&](const scan_options& other, const std::string& fragment) {
+    const std::string why = merge_refusal({first, through_file(run_scan(other), "stepbench_test_other.h5")});
+    EXPECT_NE(why.find(fragment), std::string::npos) << why;
+    EXPECT_EQ(why.find('\n'), std::string::npos) << "one line: " << why;
+  };
+  scan_options unset = o;
+  unset.fixed.clear();
+  refused(unset, "the shards differ in their fixed parameters (--set): ");
+  refused(unset, "has mass_kg=2, ");
+  refused(unset, "stepbench_test_other.h5' has none");
+  scan_options heavier = o;
+  heavier.fixed["mass_kg"] = 3.0;
+  refused(heavier, "has mass_kg=3");
+  scan_options methods = o;
+  methods.methods = {"rk4", "velocity_verlet"};
+  refused(methods, "the shards differ in their methods: ");
+  refused(methods, "has rk4,velocity_verlet");
+  scan_options tolerances = o;
+  tolerances.ref_tol.rtol = 1e-11;
+  refused(tolerances, "the shards differ in their reference tolerances: ");
+  scan_options budget = o;
+  budget.limits.work_budget = 2e7;
+  refused(budget, "the shards differ in their work budget: ");
+}
 
 // A shard with no point (more shards than grid points) is written, read back with empty
 // tables, and merges with the others into the whole scan.

@@ -637,6 +637,11 @@ scan_result read_scan(const std::string& path, const std::string& name) {
     std::vector<std::vector<double>> columns;
     for (const auto& a : o.axes) columns.push_back(h5::read_vector(values.openDataSet(a.param)));
     s.grid_points = static_cast<std::size_t>(h5::long_attr(g, "grid_points"));
+    double product = 1.0;  // in doubles: a damaged count cannot overflow it
+    for (const auto& a : o.axes) product *= a.count;
+    if (static_cast<double>(s.grid_points) != product)
+      throw std::runtime_error(fmt::format("scan '{}': grid_points {} is not the product of its axes' counts, {:.0f}",
+                                           which, s.grid_points, product));
     o.shard_index = static_cast<int>(h5::long_attr(g, "shard_index"));
     o.shard_count = static_cast<int>(h5::long_attr(g, "shard_count"));
     const h5::table_data points = h5::read_table(g.openDataSet("points"));

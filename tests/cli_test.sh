@@ -236,6 +236,11 @@ assert d["points"] == 0 and d["grid_points"] == 3, d' && ok || bad "an empty sha
 "$bin" advise --scan "$work/small.h5" --tol 1e-3 >"$work/small.txt"
 cmp -s "$work/small.txt" "$work/smallwhole.txt" && ok ||
   bad "the merge with an empty shard answers otherwise: $(diff "$work/small.txt" "$work/smallwhole.txt")"
+# A file whose grid_points is not the product of its axes' counts is refused by name.
+cp "$work/whole.h5" "$work/badgrid.h5"
+/usr/bin/python3 -c 'import h5py,sys; f=h5py.File(sys.argv[1],"r+"); f["scan/stiff_spring"].attrs["grid_points"]=14' "$work/badgrid.h5"
+expect_error "cannot read the scan in '.*badgrid.h5': scan 'stiff_spring': grid_points 14 is not the product of its axes' counts, 13" \
+  advise --scan "$work/badgrid.h5" --tol 1e-3
 
 # stepbench_bench, beside stepbench: --help lists our flags, one line each, above Google
 # Benchmark's.

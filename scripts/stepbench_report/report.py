@@ -9,6 +9,7 @@ from dataclasses import replace
 import numpy as np
 
 from . import figures, render, tables
+from . import challenge as challenge_section
 from . import energy_runs as energy_section
 from . import loop as loop_section
 from . import scan as scan_section
@@ -56,6 +57,8 @@ def _figure_jobs(study, figdir, whole, scans=None):
         jobs.append(("stability", None, os.path.join(figdir, "stability_regions.png")))
     if study.substeps is not None:
         jobs.append(("substeps", None, os.path.join(figdir, substeps_section.FIGURE)))
+    if study.challenge is not None:
+        jobs.append(("challenge", None, os.path.join(figdir, challenge_section.FIGURE)))
     if study.loop is not None:
         jobs.append(("loop", None, os.path.join(figdir, "loop_shown_error.png")))
     for k, s in enumerate(scans or ()):
@@ -94,6 +97,8 @@ def _draw(job):
         energy_section.figure(study.energy_runs, styles, path)
     elif kind == "substeps":
         substeps_section.figure(study.substeps, styles, path)
+    elif kind == "challenge":
+        challenge_section.figure(study.challenge, styles, path)
     elif kind.startswith("scan_"):
         scan_section.draw(_SCANS[arg], kind[len("scan_"):], study, styles, path)
     return path
@@ -168,13 +173,14 @@ def document(study, figs, whole=True, scans=None):
         doc.note(f"Incomplete study file: {gap}. The tables below rank only what the file holds.")
     if not whole:
         doc.note(f"One problem only ({study.problems[0].name}): the study-wide sections (stability, small steps, "
-                 "energy over long runs, game loop) are in the report of the whole study.")
+                 "the pendulum challenge, energy over long runs, game loop) are in the report of the whole study.")
     doc.toc()
     for p in study.problems:
         _problem(doc, study, p, figs)
     if whole:
         _stability(doc, study, figs)
         substeps_section.section(doc, study, figs)
+        challenge_section.section(doc, study, figs)  # nothing for a study without /challenge
         _energy(doc, study, figs)
         loop_section.section(doc, study, figs)
         scan_section.section(doc, study, figs, scans)  # nothing for a study without /scan

@@ -19,6 +19,7 @@ import h5py
 import numpy as np
 from h5py import h5, h5a, h5d, h5i, h5o, h5p, h5s, h5t
 
+from . import challenge as challenge_section
 from . import energy_runs as energy_section
 from . import loop as loop_section
 from . import schema
@@ -73,7 +74,7 @@ LIMIT_FIELDS = schema.fields("stability_limits")
 STABILITY_TESTS = ("oscillator", "decay")
 
 # The optional root groups have their own readers: /loop (loop.py), /energy
-# (energy_runs.py), /substeps (substeps.py).
+# (energy_runs.py), /substeps (substeps.py), /challenge (challenge.py).
 
 
 class StudyError(Exception):
@@ -209,6 +210,7 @@ class Study:
     energy_runs: object = None  # energy_runs.EnergyRuns: /energy, the long-run energy study; None when absent
     substeps: object = None  # substeps.Substeps: /substeps, small steps or one implicit step; None when absent
     verdict: object = None  # verdict.Verdict: /verdict, the answer the report opens on; None in an older file
+    challenge: object = None  # challenge.Challenge: /challenge, the pendulum challenge, Small Steps; None when absent
 
     @property
     def timed(self):
@@ -462,7 +464,8 @@ class _Reader:
             return Study(path=str(self.path), attrs=attrs, problems=problems)
         return Study(path=str(self.path), attrs=attrs, problems=problems, stability=self.stability(),
                      loop=loop_section.read(self, f), energy_runs=energy_section.read(self, f),
-                     substeps=substeps_section.read(self, f), verdict=verdict_section.read(self, f))
+                     substeps=substeps_section.read(self, f), verdict=verdict_section.read(self, f),
+                     challenge=challenge_section.read(self, f))
 
 
 def _problem_share(share, shares):

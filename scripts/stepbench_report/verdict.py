@@ -347,6 +347,9 @@ def results_doc(study, command):
     doc = Doc("stepbench results: which integrator for which need")
     doc.p(f"From the {provenance(study)}. Written by `{command}`; do not edit, run it again.")
     opening(doc, study.verdict)
+    if getattr(study, "challenge", None) is not None:
+        from . import challenge
+        challenge.answer(doc, study.challenge)
     return doc
 
 
@@ -381,6 +384,9 @@ def readme_block(study, command):
               "the frame), then which of them are stable at one step a frame.",
               "", f"Study `{study.path}`, commit {a['git_commit']}, {a['cpu']}, {a['created_utc']}; written by "
               f"`{command}`."]
+    if getattr(study, "challenge", None) is not None:  # before the line naming the study
+        from . import challenge
+        lines[-2:-2] = challenge.readme_lines(study.challenge)
     return "\n".join(lines)
 
 

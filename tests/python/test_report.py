@@ -110,6 +110,7 @@ def test_outputs_exist_and_images_resolve(reports, shape):
         problems = list(f["problems"])
         energy = {p for p in problems if f["problems"][p].attrs["has_energy"] == 1}
         scan_names = list(f["scan"]) if "scan" in f else []
+        challenge = {"pendulum_challenge.png"} if "challenge" in f else set()  # a full sweep of n_pendulum
     assert "kepler" in problems and "bouncing_balls" in problems
     for p in problems:
         assert f'<a href="#{p}">' in html, p
@@ -121,7 +122,8 @@ def test_outputs_exist_and_images_resolve(reports, shape):
     assert expected <= drawn
     # The scans' two figures each, where the study holds scans (/scan; docs/study-format.md).
     scans = [f"scan_{name}_{kind}.png" for name in scan_names for kind in ("one_step", "cheapest")]
-    assert drawn - expected <= {f"energy_drift_{p}.png" for p in energy} | set(scans)
+    assert challenge <= drawn
+    assert drawn - expected <= {f"energy_drift_{p}.png" for p in energy} | set(scans) | challenge
     assert {"energy_drift_pendulum.png", "energy_drift_kepler.png"} <= drawn
     # Each problem's figures are in its own section.
     for p in problems:

@@ -49,7 +49,8 @@ void balls_case(benchmark::State& state, const std::string& method) {
 
 void register_balls(const std::vector<std::string>& problems) {
   if (!selected(problems, "bouncing_balls")) return;
-  for (const auto& m : integrators()) {
+  for (const auto& m : make_problem("bouncing_balls")->methods()) {  // those that run on it
+    if (m.origin != method_origin::ours) continue;
     // Explicit fixed-step methods: what a game steps a ball pit with. An implicit step
     // would difference the 2N-coordinate force for its Jacobian (no analytic one here).
     if (m.kind != method_kind::fixed_step || m.traits.needs_jacobian) continue;

@@ -66,8 +66,8 @@ bool selected(const std::vector<std::string>& problems, const std::string& probl
 void register_scaling(const std::vector<std::string>& problems) {
   const bool chain = selected(problems, "spring_chain");
   if (!chain && !selected(problems, "bouncing_balls")) return;
-  for (const auto& m : integrators()) {
-    if (!chain || m.kind != method_kind::fixed_step) continue;
+  for (const auto& m : make_problem("spring_chain")->methods()) {  // ours that run on it, xpbd included
+    if (!chain || m.origin != method_origin::ours || m.kind != method_kind::fixed_step) continue;
     auto* b = benchmark::RegisterBenchmark(fmt::format("spring_chain/{}", m.name).c_str(),
                                            [name = m.name](benchmark::State& state) { chain_case(state, name); });
     b->ArgName("masses");

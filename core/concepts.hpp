@@ -143,6 +143,15 @@ concept has_angular_momentum = requires(const P& p, const typename P::vec& x) {
   { p.angular_momentum(x, x) } -> std::convertible_to<double>;
 };
 
+// A problem whose coordinates are not the positions its errors are measured on
+// (n_pendulum: link angles, measured on the bobs' Cartesian positions): `observe` writes
+// those positions and their velocities, observed_dim() entries each, from a state.
+template <class P>
+concept has_observed_positions = requires(const P& p, const typename P::vec& x, Eigen::VectorXd& out) {
+  { p.observed_dim() } -> std::convertible_to<int>;
+  {p.observe(x, x, out, out)};
+};
+
 // A problem with a period (pendulum, kepler): the long-run energy study counts its
 // horizon in periods.
 template <class P>

@@ -36,14 +36,30 @@ double kinetic(const problem_instance& p, std::span<const double> y) {
   return p.energy(moving) - p.energy(rest);
 }
 
+// States mapped to the positions errors are measured on (problem_instance::observed).
+std::vector<std::vector<double>> observed_all(const problem_instance& p, std::span<const std::vector<double>> ys) {
+  std::vector<std::vector<double>> out;
+  out.reserve(ys.size());
+  for (const auto& y : ys) out.push_back(p.observed(y));
+  return out;
+}
+
+// compare() on the observed positions.
+agreement compare_observed(const problem_instance& p, std::span<const std::vector<double>> a,
+                           std::span<const std::vector<double>> b, const truth_table& t) {
+  return compare(observed_all(p, a), observed_all(p, b), p.observed_dim(), t.pos_scale, t.vel_scale);
+}
+
 void set_scales(const problem_instance& p, truth_table& t) {
-  const int dim = p.dim();
+  const int dim = p.observed_dim();
   const auto y0 = p.initial();
-  double xs = norm_part(y0, 0, dim), vs = norm_part(y0, dim, dim);
+  const auto o0 = p.observed(y0);
+  double xs = norm_part(o0, 0, dim), vs = norm_part(o0, dim, dim);
   double es = p.has_energy() ? std::max(std::abs(p.energy(y0)), kinetic(p, y0)) : 1.0;
   for (const auto& y : t.y) {
-    xs = std::max(xs, norm_part(y, 0, dim));
-    vs = std::max(vs, norm_part(y, dim, dim));
+    const auto o = p.observed(y);
+    xs = std::max(xs, norm_part(o, 0, dim));
+    vs = std::max(vs, norm_part(o, dim, dim));
     if (p.has_energy()) es = std::max({es, std::abs(p.energy(y)), kinetic(p, y)});
   }
   if (p.has_angular_momentum()) {
@@ -118,7 +134,7 @@ void truth_from_closed_form(const problem_instance& problem, truth_table& t, con
   set_scales(problem, t);
   for (auto* r : ok) {
     r->compared_with = t.source;
-    r->vs = compare(r->solution.y, t.y, problem.dim(), t.pos_scale, t.vel_scale);
+    r->vs = compare_observed(problem, r->solution.y, t.y, t);
     judge_agreement(*r, t);
   }
 }
@@ -135,7 +151,7 @@ void truth_from_references(const problem_instance& problem, truth_table& t, cons
   double best = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < ok.size(); ++i)
     for (std::size_t k = i + 1; k < ok.size(); ++k) {
-      const double w = compare(ok[i]->solution.y, ok[k]->solution.y, dim, t.pos_scale, t.vel_scale).worst();
+      const double w = compare_observed(problem, ok[i]->solution.y, ok[k]->solution.y, t).worst();
       if (w < best) best = w, best_i = i, best_k = k;
     }
   if (ok.size() < 2 || !(best <= t.agreement_limit)) {
@@ -157,7 +173,7 @@ void truth_from_references(const problem_instance& problem, truth_table& t, cons
     // The truth itself is reported against its partner, so its own row is not a 0.
     const auto& other = r == &truth ? *ok[best_k] : truth;
     r->compared_with = other.source;
-    r->vs = compare(r->solution.y, other.solution.y, dim, t.pos_scale, t.vel_scale);
+    r->vs = compare_observed(problem, r->solution.y, other.solution.y, t);
     judge_agreement(*r, t);
   }
 }
@@ -193,7 +209,7 @@ truth_table build_truth(const problem_instance& problem, std::span<const double>
 
 run_metrics measure(const problem_instance& problem, const run_result& run, const truth_table& truth) {
   run_metrics m;
-  const int dim = problem.dim();
+  const int dim = problem.dim(), observed_dim = problem.observed_dim();
   auto all_nan = [&] {
     m.err_pos_final = m.err_vel_final = m.err_pos_max = m.err_pos_rms = m.energy_drift = m.energy_err_max = nan;
     m.angmom_drift = m.angmom_err_max = m.contact_count_err = m.contact_time_err = m.contact_pos_err = nan;
@@ -228,7 +244,7 @@ run_metrics measure(const problem_instance& problem, const run_result& run, cons
   for (size_t j = 0; j < truth.times.size(); ++j) {
     if (std::abs(run.sample_t[j] - truth.times[j]) > 1e-12 * std::max(1.0, truth.times[j]))
       throw std::logic_error("measure: a sample time differs from the truth's");
-    const double e = norm_diff(run.sample_y[j], truth.y[j], 0, dim);
+    const double e = norm_diff(problem.observed(run.sample_y[j]), problem.observed(truth.y[j]), 0, observed_dim);
     m.err_pos_max = std::max(m.err_pos_max, e);
     sum_sq += e * e;
     if (problem.has_energy())
@@ -240,8 +256,9 @@ run_metrics measure(const problem_instance& problem, const run_result& run, cons
   m.err_pos_rms = std::sqrt(sum_sq / static_cast<double>(truth.times.size()));
   const auto& y_final = run.final_y;
   const auto& y_true = truth.y.back();
-  m.err_pos_final = norm_diff(y_final, y_true, 0, dim);
-  m.err_vel_final = norm_diff(y_final, y_true, dim, dim);
+  const auto o_final = problem.observed(y_final), o_true = problem.observed(y_true);
+  m.err_pos_final = norm_diff(o_final, o_true, 0, observed_dim);
+  m.err_vel_final = norm_diff(o_final, o_true, observed_dim, observed_dim);
   if (problem.has_energy()) {
     m.energy_drift = (problem.energy(y_final) - problem.energy(y_true)) / truth.energy_scale;
     m.energy_err_max = e_max / truth.energy_scale;

@@ -45,6 +45,11 @@ class problem_instance {
   // Angular momentum of [x; v] about the problem's fixed point; NaN when it has none.
   virtual bool has_angular_momentum() const = 0;
   virtual double angular_momentum(std::span<const double> y) const = 0;
+  // The positions errors are measured on, and their velocities, [X; V] of a state
+  // [x; v], observed_dim() entries each: the state itself, except for a problem whose
+  // coordinates are not positions (core/concepts.hpp's has_observed_positions).
+  virtual int observed_dim() const = 0;
+  virtual std::vector<double> observed(std::span<const double> y) const = 0;
   // The period of the motion (pendulum, kepler); NaN when it has none.
   virtual double period() const = 0;
   // Contacts: "none", "end_of_step" or "locate" (core/concepts.hpp's has_contacts).

@@ -19,6 +19,7 @@
 #include <cmath>
 
 #include "core/concepts.hpp"
+#include "core/constraints.hpp"
 
 namespace stepbench {
 
@@ -108,6 +109,24 @@ struct spring_damper {
   // solution's energy, not with E(0).
   double energy(const vec& x, const vec& v) const {
     return 0.5 * mass_kg * v.squaredNorm() + 0.5 * k_s * x.squaredNorm();
+  }
+
+  // The constraint view: the body a particle at (L + x, 0, 0) on a distance constraint of
+  // rest length L = 1 m to the origin, compliance 1 / k_s, damping k_d. Along the axis
+  // C = x is linear, so one XPBD pass is one backward Euler step (integrators/xpbd.hpp).
+  static constexpr double view_rest_length = 1.0;
+  particle_system particles(const vec& x, const vec& v) const {
+    particle_system s;
+    s.x = Eigen::Vector3d(view_rest_length + x[0], 0.0, 0.0);
+    s.v = Eigen::Vector3d(v[0], 0.0, 0.0);
+    s.inverse_mass = Eigen::VectorXd::Constant(1, 1.0 / mass_kg);
+    s.constraints.push_back(
+        {.a = -1, .b = 0, .rest_length = view_rest_length, .compliance = 1.0 / k_s, .damping = k_d});
+    return s;
+  }
+  void from_particles(const particle_system& s, vec& x, vec& v) const {
+    x[0] = s.x(0, 0) - view_rest_length;
+    v[0] = s.v(0, 0);
   }
 };
 

@@ -19,6 +19,7 @@
 #include <numbers>
 
 #include "core/concepts.hpp"
+#include "core/constraints.hpp"
 
 namespace stepbench {
 
@@ -80,6 +81,23 @@ struct pendulum {
   }
   double energy(const vec& x, const vec& v) const {
     return 0.5 * mass() * v.squaredNorm() + mass_kg * gravity * length_m * (1.0 - std::cos(x[0]));
+  }
+
+  // The constraint view: the bob a particle at L (sin theta, -cos theta) on a rigid link
+  // to the pivot; back through theta = atan2(x, -y), theta' = (x y' - y x') / |p|^2.
+  particle_system particles(const vec& x, const vec& v) const {
+    particle_system s;
+    s.x = Eigen::Vector3d(length_m * std::sin(x[0]), -length_m * std::cos(x[0]), 0.0);
+    s.v = Eigen::Vector3d(length_m * std::cos(x[0]) * v[0], length_m * std::sin(x[0]) * v[0], 0.0);
+    s.inverse_mass = Eigen::VectorXd::Constant(1, 1.0 / mass_kg);
+    s.acceleration = {0.0, -gravity, 0.0};
+    s.constraints.push_back({.a = -1, .b = 0, .rest_length = length_m});
+    return s;
+  }
+  void from_particles(const particle_system& s, vec& x, vec& v) const {
+    const Eigen::Vector3d p = s.x.col(0), pv = s.v.col(0);
+    x[0] = std::atan2(p.x(), -p.y());
+    v[0] = (p.x() * pv.y() - p.y() * pv.x()) / p.head<2>().squaredNorm();
   }
 };
 

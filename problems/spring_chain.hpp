@@ -24,6 +24,7 @@
 
 #include "core/band_matrix.hpp"
 #include "core/concepts.hpp"
+#include "core/constraints.hpp"
 
 namespace stepbench {
 
@@ -121,6 +122,25 @@ struct spring_chain {
     for (int r = 0; r < 3; ++r)  // the pinned mass
       for (int c = std::max(0, r - bandwidth); c <= std::min(dim() - 1, r + bandwidth); ++c)
         dfdx(r, c) = dfdv(r, c) = 0.0;
+  }
+
+  // The constraint view: a particle a mass (the first pinned: inverse mass 0), each
+  // spring a distance constraint of compliance 1 / k_s and damping k_d.
+  particle_system particles(const vec& x, const vec& v) const {
+    particle_system s;
+    s.x = Eigen::Map<const Eigen::Matrix3Xd>(x.data(), 3, count());
+    s.v = Eigen::Map<const Eigen::Matrix3Xd>(v.data(), 3, count());
+    s.inverse_mass = Eigen::VectorXd::Constant(count(), 1.0 / mass());
+    s.inverse_mass[0] = 0.0;
+    s.acceleration = {0.0, 0.0, -gravity};
+    for (int i = 0; i + 1 < count(); ++i)
+      s.constraints.push_back(
+          {.a = i, .b = i + 1, .rest_length = rest_length(), .compliance = 1.0 / k_s, .damping = k_d});
+    return s;
+  }
+  void from_particles(const particle_system& s, vec& x, vec& v) const {
+    x = Eigen::Map<const vec>(s.x.data(), dim());
+    v = Eigen::Map<const vec>(s.v.data(), dim());
   }
 
   // Kinetic, gravitational and spring energy; the dampers dissipate it.

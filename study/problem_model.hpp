@@ -96,6 +96,22 @@ class problem_model final : public problem_instance {
     else
       return std::numeric_limits<double>::quiet_NaN();
   }
+  int observed_dim() const override {
+    if constexpr (stepbench::has_observed_positions<P>)
+      return p_.observed_dim();
+    else
+      return p_.dim();
+  }
+  std::vector<double> observed(std::span<const double> y) const override {
+    if constexpr (stepbench::has_observed_positions<P>) {
+      const int n = p_.observed_dim();
+      Eigen::VectorXd pos(n), vel(n);
+      p_.observe(unflatten(y, 0), unflatten(y, p_.dim()), pos, vel);
+      return flatten(pos, vel);
+    } else {
+      return {y.begin(), y.end()};
+    }
+  }
   double period() const override {
     if constexpr (stepbench::has_period<P>)
       return p_.period();
@@ -170,7 +186,11 @@ class problem_model final : public problem_instance {
           "the game loop runs our fixed-step integrators; {} is {}", method,
           m.origin == method_origin::ours ? std::string("adaptive") : fmt::format("a {} method", to_string(m.origin))));
     if (auto err = loop_config_error(config); !err.empty()) throw std::invalid_argument(err);
-    return slot(method).loop(p_, config);
+    const auto& s = slot(method);
+    if (s.loop == nullptr)  // the position-based methods step particles, not the loop's states
+      throw std::invalid_argument(
+          fmt::format("the game loop runs force-based integrators; {} steps a constraint view", method));
+    return s.loop(p_, config);
   }
 };
 

@@ -31,8 +31,7 @@ const std::vector<method_info>& all_methods() {
   static const std::vector<method_info> all = [] {
     std::vector<method_info> out;
     // Ours, then the peers: the registry's order (the study file's, `stepbench list`'s).
-    for_each_type(type_list_cat_t<all_integrators, all_peers>{},
-                  [&]<class M>() { out.push_back(info_of<entry_t<M>>()); });
+    for_each_type(type_list_cat_t<all_ours, all_peers>{}, [&]<class M>() { out.push_back(info_of<entry_t<M>>()); });
     return out;
   }();
   return all;

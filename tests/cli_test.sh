@@ -37,12 +37,12 @@ PY
 import json, sys
 d = json.load(sys.stdin)
 names = {p["name"] for p in d["problems"]}
-assert names == {"constant_acceleration", "projectile", "damped_spring", "pendulum", "stiff_spring", "spring_chain",
+assert names == {"constant_acceleration", "projectile", "damped_spring", "pendulum", "n_pendulum", "stiff_spring", "spring_chain",
                  "kepler", "falling_drag", "sliding_block", "sliding_block_stick", "bouncing_ball",
                  "bouncing_ball_locate", "bouncing_balls"}, names
 orders = {m["name"]: m["declared_order"] for m in d["methods"] if m["origin"] == "ours" and m["kind"] == "fixed_step"}
 assert orders == {"euler": 1, "semi_implicit_euler": 1, "midpoint": 2, "rk4": 4, "momentum": 1, "velocity_verlet": 2,
-                  "forest_ruth": 4, "implicit_euler": 1, "implicit_midpoint": 2, "rk8": 8}, orders
+                  "forest_ruth": 4, "implicit_euler": 1, "implicit_midpoint": 2, "rk8": 8, "xpbd": 1}, orders
 adaptive = {m["name"]: m["declared_order"] for m in d["methods"] if m["origin"] == "ours" and m["kind"] == "adaptive"}
 assert adaptive == {"adaptive_euler": 1, "rk45": 5, "dop853": 8}, adaptive
 origins = {m["name"]: m["origin"] for m in d["methods"]}

@@ -32,6 +32,7 @@ int run_sweep_command(sweep_args a) {
     a.opts.levels = a.opts.max_levels = 8;
     a.opts.scans = default_scans(true);
     a.opts.tolerances = tolerance_ladder(true);
+    a.opts.challenge.enabled = false;  // its timings and 1000 s energy run belong to the full study
   }
   a.opts.progress = !a.quiet;
   validate(a.opts);

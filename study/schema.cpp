@@ -169,6 +169,17 @@ constexpr field scan_run_fields[] = {{"point", i64},
 constexpr field scan_best_fields[] = {{"point", i64},    {"hz", f64},          {"method", str},
                                       {"substeps", i64}, {"err_pos_max", f64}, {"force_evals_per_frame", f64}};
 
+// The pendulum challenge and the Small Steps experiment (study/challenge.hpp).
+constexpr field challenge_entry_fields[] = {
+    {"method", str},       {"steps_per_frame", i64}, {"ns_per_frame", f64},
+    {"err_pos_max", f64},  {"energy_drift", f64},    {"energy_err_max", f64},
+    {"link_err_max", f64}, {"stable", i8},           {"ns_per_frame_at_xpbd_error", f64},
+    {"note", str}};
+constexpr field challenge_verdict_fields[] = {{"criterion", str}, {"verdict", str}};
+constexpr field small_steps_fields[] = {{"problem", str},      {"design", str},   {"n", i64},
+                                        {"err_pos", f64},      {"link_err", f64}, {"work_per_frame", f64},
+                                        {"ns_per_frame", f64}, {"diverged", i8}};
+
 constexpr field_group runs_groups[] = {{run_fields}, {run_timing_fields, true}};
 constexpr field_group substep_runs_groups[] = {{run_fields}, {run_timing_fields, true}, {substep_fields}};
 constexpr field_group parameters_groups[] = {{parameter_fields}};
@@ -186,6 +197,9 @@ constexpr field_group frame_rate_run_groups[] = {{frame_rate_run_fields}};
 constexpr field_group scan_point_groups[] = {{scan_point_fields}};
 constexpr field_group scan_run_groups[] = {{scan_run_fields}};
 constexpr field_group scan_best_groups[] = {{scan_best_fields}};
+constexpr field_group challenge_entry_groups[] = {{challenge_entry_fields}};
+constexpr field_group challenge_verdict_groups[] = {{challenge_verdict_fields}};
+constexpr field_group small_steps_groups[] = {{small_steps_fields}};
 
 constexpr table all_tables[] = {
     {"runs", "/problems/<p>/methods/<m>/runs", runs_groups},
@@ -205,6 +219,9 @@ constexpr table all_tables[] = {
     {"scan_points", "/scan/<name>/points", scan_point_groups},
     {"scan_runs", "/scan/<name>/runs", scan_run_groups},
     {"scan_best", "/scan/<name>/best", scan_best_groups},
+    {"challenge_entries", "/challenge/entries", challenge_entry_groups},
+    {"challenge_verdicts", "/challenge/verdicts", challenge_verdict_groups},
+    {"small_steps", "/challenge/small_steps", small_steps_groups},
 };
 
 }  // namespace

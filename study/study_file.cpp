@@ -403,6 +403,7 @@ std::vector<unsigned char> study_image(const study& s, const std::string& name) 
   write_energy(file, s.energy);  // /energy: the long-run energy study (study/energy.hpp)
   write_verdict(file, s);        // /verdict and /frame_rates: the answer (study/verdict.hpp)
   write_scans(file, s.scans);    // /scan: parameter scans (study/scan.hpp)
+  if (s.challenge) write_challenge(file, *s.challenge);  // /challenge (study/challenge.hpp)
   file.flush(H5F_SCOPE_GLOBAL);
   const ssize_t size = H5Fget_file_image(file.getId(), nullptr, 0);
   std::vector<unsigned char> image(size > 0 ? static_cast<std::size_t>(size) : 0);

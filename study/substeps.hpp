@@ -1,10 +1,11 @@
 #pragma once
 // "Small steps or one implicit step?" Macklin et al., Small Steps in Physics Simulation
 // (SCA 2019), report that n small explicit steps per frame beat one implicit step with
-// n solver iterations on stiff systems. Measured here for springs: on stiff_spring and
-// spring_chain at a frame of horizon / 32 (60 Hz with their defaults), one implicit_euler
-// (and one implicit_midpoint) step per frame against n substeps of semi_implicit_euler
-// and of velocity_verlet, n = 1 .. 64, each run and measured like every study row
+// n solver iterations on stiff systems. Measured here on stiff_spring, spring_chain and
+// n_pendulum at a frame of horizon / 32 (60 Hz with their defaults), one implicit_euler
+// (and one implicit_midpoint) step per frame against n substeps of semi_implicit_euler,
+// velocity_verlet and xpbd (one constraint pass a substep: the paper's own method),
+// n = 1 .. 64, each run and measured like every study row
 // (position error over the run against the truth at the frame ends), plus the
 // artificial damping: the largest energy removed beyond the true damper's loss over the
 // run, max_j (E_true(t_j) - E(t_j)) / energy_scale. At equal cost per frame (the

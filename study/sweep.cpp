@@ -300,6 +300,15 @@ study run_sweep(const sweep_options& opts) {
       warn(fmt::format("scan    {:<22} {} points in {:.2f} s", sc.problem, out.scans.back().points.size(),
                        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
   }
+  // The pendulum challenge is one scene, the challenge's own: run with n_pendulum at its defaults.
+  if (opts.challenge.enabled && (opts.problems.empty() || contains(opts.problems, std::string("n_pendulum"))) &&
+      !opts.overrides.contains("n_pendulum") && opts.methods.empty()) {
+    const auto t0 = std::chrono::steady_clock::now();
+    out.challenge = run_challenge(opts.challenge);
+    if (opts.progress)
+      warn(fmt::format("challenge n_pendulum in {:.2f} s",
+                       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
+  }
   part_done();
   out.stability = compute_stability();
   out.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -14,6 +14,7 @@
 #include "core/convergence_fit.hpp"
 #include "core/measure.hpp"
 #include "core/method.hpp"
+#include "study/challenge.hpp"
 #include "study/energy.hpp"
 #include "study/loop.hpp"
 #include "study/method_row.hpp"
@@ -33,8 +34,9 @@ std::vector<double> tolerance_ladder(bool thinned = false);
 
 struct substep_options {
   bool enabled = true;
-  std::vector<std::string> problems{"stiff_spring", "spring_chain"};
-  std::vector<std::string> explicit_methods{"semi_implicit_euler", "velocity_verlet"};
+  std::vector<std::string> problems{"stiff_spring", "spring_chain", "n_pendulum"};
+  // xpbd's n substeps of one constraint pass: the method the Small Steps paper is about.
+  std::vector<std::string> explicit_methods{"semi_implicit_euler", "velocity_verlet", "xpbd"};
   std::vector<std::string> implicit_methods{"implicit_euler", "implicit_midpoint"};
   std::vector<int> counts{1, 2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 64};
   int frames = 32;  // the frame is horizon / frames; the truth's sample times are its ends
@@ -69,8 +71,9 @@ struct sweep_options {
   energy_options energy{};                            // the long-run energy study (study/energy.hpp)
   frame_rate_options frame_rates{};                   // the game programmer's frame-rate table (study/verdict.hpp)
   std::vector<scan_options> scans = default_scans();  // parameter scans (study/scan.hpp), under /scan
-  bool progress = false;                              // one line per problem on stderr
-  int jobs = 0;                                       // threads the problems are swept on (0: one a core)
+  challenge_options challenge{};  // the pendulum challenge and Small Steps (study/challenge.hpp), with n_pendulum
+  bool progress = false;          // one line per problem on stderr
+  int jobs = 0;                   // threads the problems are swept on (0: one a core)
   // A caller's live progress: called after each problem and each later study (frame
   // rates, loop, energy) with the parts done and the total (sweep_parts); and where the
   // sweep's warnings go (a reference that disagrees), so that they do not land on a
@@ -153,7 +156,8 @@ struct study {
   // The stability limits and regions of our integrators (study/stability.hpp): not of the
   // selected problems, so every study carries the same, computed by run_sweep.
   stability_data stability;
-  std::vector<scan_result> scans;  // parameter scans (study/scan.hpp), written under /scan
+  std::vector<scan_result> scans;             // parameter scans (study/scan.hpp), written under /scan
+  std::optional<challenge_result> challenge;  // under /challenge
   double wall_seconds = 0.0;
   std::optional<timing_settings> timed;
 };

@@ -387,7 +387,25 @@ def readme_block(study, command):
     if getattr(study, "challenge", None) is not None:  # before the line naming the study
         from . import challenge
         lines[-2:-2] = challenge.readme_lines(study.challenge)
+    orders = xpbd_orders(study)
+    if orders:
+        lines[-2:-2] = ["", "**xpbd's observed order** over the substep ladder (the study's fit, its levels in "
+                        "brackets): " + "; ".join(orders) + "."]
     return "\n".join(lines)
+
+
+def xpbd_orders(study):
+    """'pendulum 0.990 (levels 10-18)' for each problem xpbd ran on, as the C++ fit wrote it."""
+    out = []
+    for p in study.problems:
+        m = next((m for m in p.methods if m.name == "xpbd"), None)
+        if m is None:
+            continue
+        levels = m.fit_levels
+        order = float(m.attrs["observed_order"])
+        span = f"levels {levels[0]}-{levels[-1]}" if levels else "no fit"
+        out.append(f"{p.name} {order:.3f} ({span})" if np.isfinite(order) else f"{p.name} n/a ({m.attrs['fit_note']})")
+    return out
 
 
 BEGIN, END = "<!-- results:begin -->", "<!-- results:end -->"

@@ -358,7 +358,7 @@ def test_substeps_verdicts_are_the_files(reports, shape):
     assert "fig/substeps_equal_cost.png" in md
     with h5py.File(study, "r") as f:
         g = f["substeps"]
-        assert set(g) == {"stiff_spring", "spring_chain"}
+        assert set(g) == {"stiff_spring", "spring_chain", "n_pendulum"}
         for scene, sg in g.items():
             summaries = [text(v) for v in sg["verdict"]["summary"]]
             assert summaries and all(v.startswith(f"{scene}: ") for v in summaries)

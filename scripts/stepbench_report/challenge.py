@@ -16,20 +16,9 @@ from . import schema
 ATTRS = ("hz", "xpbd_substeps", "horizon", "energy_horizon", "small_steps_time", "energy_scale", "wall_seconds")
 
 
-def _fields(table, declared):
-    """The table's fields from schema.json; until schema.json is regenerated with the
-    challenge's tables (`stepbench schema`), the ones study/schema.cpp declares."""
-    if table in schema.SCHEMA["tables"]:
-        return schema.fields(table)
-    return declared
-
-
-ENTRY_FIELDS = _fields("challenge_entries", ("method", "steps_per_frame", "ns_per_frame", "err_pos_max",
-                                             "energy_drift", "energy_err_max", "link_err_max", "stable",
-                                             "ns_per_frame_at_xpbd_error", "note"))
-VERDICT_FIELDS = _fields("challenge_verdicts", ("criterion", "verdict"))
-SMALL_STEPS_FIELDS = _fields("small_steps", ("problem", "design", "n", "err_pos", "link_err", "work_per_frame",
-                                             "ns_per_frame", "diverged"))
+ENTRY_FIELDS = schema.fields("challenge_entries")
+VERDICT_FIELDS = schema.fields("challenge_verdicts")
+SMALL_STEPS_FIELDS = schema.fields("small_steps")
 CRITERIA = ("accuracy", "stability", "speed")  # the challenge's, in the order the section opens on
 SMALL_STEPS = "small_steps"  # the criterion of the Small Steps lines, one a problem
 DESIGNS = ("xpbd_substeps", "xpbd_iterations", "semi_implicit_euler_substeps", "implicit_euler")

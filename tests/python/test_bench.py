@@ -137,7 +137,7 @@ def test_quick_timed_study(timed_study, stepbench):
     assert "Benchmark " not in done.stdout and "real_time" not in done.stdout
     assert done.stdout.strip(), "the run ends without the verdict on stdout"
     assert "Library was built as DEBUG" not in done.stderr
-    assert "stepbench_bench: swept 13 problems (" in done.stderr and "stepbench_bench: timed " in done.stderr
+    assert "stepbench_bench: swept 14 problems (" in done.stderr and "stepbench_bench: timed " in done.stderr
     assert "\r" not in done.stderr and "\x1b[" not in done.stderr  # not a terminal: plain lines
     doc = json.loads((path.parent / "bench.json").read_text())
     assert "library_build_type" in doc["context"]

@@ -71,6 +71,7 @@ struct drive_result {
   bool non_finite = false;   // a NaN or Inf appeared: the run stopped there
   std::string stop_reason;   // why the run stopped early (step size underflow, the step budget), else empty
   bool over_budget = false;  // stopped by the step budget (with the reason in `stop_reason`): skipped, not failed
+  double constraint_violation = std::numeric_limits<double>::quiet_NaN();  // run_result's (core/method.hpp)
   std::vector<double> sample_t;
   Eigen::MatrixXd samples;  // column j: [x; v] at sample_t[j]
   double t_final = 0.0;

@@ -213,6 +213,7 @@ run_metrics measure(const problem_instance& problem, const run_result& run, cons
   auto all_nan = [&] {
     m.err_pos_final = m.err_vel_final = m.err_pos_max = m.err_pos_rms = m.energy_drift = m.energy_err_max = nan;
     m.angmom_drift = m.angmom_err_max = m.contact_count_err = m.contact_time_err = m.contact_pos_err = nan;
+    m.constraint_violation_max = nan;
     return m;
   };
   m.contacts = run.contacts;
@@ -254,6 +255,12 @@ run_metrics measure(const problem_instance& problem, const run_result& run, cons
           std::max(l_max, std::abs(problem.angular_momentum(run.sample_y[j]) - problem.angular_momentum(truth.y[j])));
   }
   m.err_pos_rms = std::sqrt(sum_sq / static_cast<double>(truth.times.size()));
+  m.constraint_violation_max = run.constraint_violation;
+  if (!std::isfinite(m.constraint_violation_max)) {
+    m.constraint_violation_max = problem.constraint_violation(run.final_y);
+    for (const auto& y : run.sample_y)
+      m.constraint_violation_max = std::max(m.constraint_violation_max, problem.constraint_violation(y));
+  }
   const auto& y_final = run.final_y;
   const auto& y_true = truth.y.back();
   const auto o_final = problem.observed(y_final), o_true = problem.observed(y_true);

@@ -83,6 +83,10 @@ struct run_metrics {
   double energy_err_max = 0.0;  // max over samples of |E(y_j) - E(y(t_j))| / energy_scale
   double angmom_drift = 0.0;    // (L(y_N) - L(y(T))) / angmom_scale, signed; NaN without angular momentum
   double angmom_err_max = 0.0;  // max over samples of |L(y_j) - L(y(t_j))| / angmom_scale; NaN without
+  // max over samples of max_j |C_j| / L_j of the run's constraint view: the method's own
+  // particles (xpbd), else the state's view (0 for rigid links in generalized coordinates,
+  // a spring's stretch); NaN on a problem without a constraint view.
+  double constraint_violation_max = 0.0;
   // Contacts (0 and NaN on a problem without them). Errors are matched contact by contact,
   // the k-th of the run with the k-th exact one, over the first min(run's, exact, 64).
   long contacts = 0;               // contacts the run resolved

@@ -81,6 +81,9 @@ struct run_result {
   // Why the run stopped before the horizon: a solver error, or the work budget
   // (`skipped`); empty when it reached the horizon.
   std::string stop_reason;
+  // A method that steps its own particles (xpbd): the largest max_j |C_j| / L_j of them
+  // over the recorded samples; NaN for a method that steps the problem's state.
+  double constraint_violation = std::numeric_limits<double>::quiet_NaN();
   bool skipped = false;  // not run to the end because it would exceed the work budget (reason in `stop_reason`)
   std::vector<double> sample_t;
   std::vector<std::vector<double>> sample_y;  // [x; v] at sample_t

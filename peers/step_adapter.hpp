@@ -51,6 +51,7 @@ template <class Vec, class Adapter>
   a.state_into(x, v);
   out.t_final = t;
   out.work.force_evals = a.force_evals();
+  if constexpr (requires { a.constraint_violation(); }) out.constraint_violation = a.constraint_violation();
   out.non_finite = out.non_finite || !all_finite(x, v);
   out.final_state = {x, v};
 }

@@ -52,6 +52,7 @@ run_result to_run_result(const drive_result<Vec>& r, double param, double horizo
   out.non_finite = r.non_finite;
   out.stop_reason = r.stop_reason;
   out.skipped = r.over_budget;
+  out.constraint_violation = r.constraint_violation;
   out.sample_t = r.sample_t;
   for (std::size_t j = 0; j < r.sample_t.size(); ++j) {
     const auto col = r.samples.col(static_cast<Eigen::Index>(j));

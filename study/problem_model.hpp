@@ -16,6 +16,7 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "core/constraints.hpp"
 #include "core/first_order.hpp"
 #include "core/game_loop.hpp"
 #include "study/method_table.hpp"
@@ -111,6 +112,12 @@ class problem_model final : public problem_instance {
     } else {
       return {y.begin(), y.end()};
     }
+  }
+  double constraint_violation(std::span<const double> y) const override {
+    if constexpr (stepbench::has_constraint_view<P>)
+      return stepbench::constraint_violation(p_.particles(unflatten(y, 0), unflatten(y, p_.dim())));
+    else
+      return std::numeric_limits<double>::quiet_NaN();
   }
   double period() const override {
     if constexpr (stepbench::has_period<P>)

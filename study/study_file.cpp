@@ -482,6 +482,7 @@ h5::table runs_table(const std::vector<method_row>& rows, bool timed) {
   t.add("energy_err_max", col([](const method_row& r) { return r.metrics.energy_err_max; }));
   t.add("angmom_drift", col([](const method_row& r) { return r.metrics.angmom_drift; }));
   t.add("angmom_err_max", col([](const method_row& r) { return r.metrics.angmom_err_max; }));
+  t.add("constraint_violation_max", col([](const method_row& r) { return r.metrics.constraint_violation_max; }));
   t.add("contacts", col([](const method_row& r) { return std::int64_t{r.metrics.contacts}; }));
   t.add("contact_count_err", col([](const method_row& r) { return r.metrics.contact_count_err; }));
   t.add("contact_time_err", col([](const method_row& r) { return r.metrics.contact_time_err; }));

@@ -261,3 +261,22 @@ TEST(challenge, entries_are_the_runs_they_name) {
   EXPECT_TRUE(row("spring_chain", "semi_implicit_euler_substeps", 1).diverged);
   EXPECT_FALSE(row("spring_chain", "xpbd_substeps", 1).diverged);
 }
+
+// Every run records its constraint violation: xpbd's own links, a force-based method's
+// state seen through the view (rigid links in generalized coordinates hold exactly), NaN
+// where there is no view.
+TEST(xpbd, runs_record_their_constraint_violation) {
+  auto p = make_problem("n_pendulum");
+  std::vector<double> frames;
+  for (int i = 1; i <= 32; ++i) frames.push_back(i / 60.0);
+  const truth_table truth = build_truth(*p, frames, {});
+  const run_metrics x = measure(*p, p->run("xpbd", 1.0 / 600.0, p->horizon(), frames), truth);
+  EXPECT_GT(x.constraint_violation_max, 1e-8);
+  EXPECT_LT(x.constraint_violation_max, 1e-2);
+  const run_metrics r = measure(*p, p->run("rk4", 1.0 / 600.0, p->horizon(), frames), truth);
+  EXPECT_LT(r.constraint_violation_max, 1e-15);
+  auto q = make_problem("projectile");
+  const std::vector<double> end{q->horizon()};
+  const truth_table qt = build_truth(*q, end, {});
+  EXPECT_TRUE(std::isnan(measure(*q, q->run("rk4", 0.1, q->horizon(), end), qt).constraint_violation_max));
+}

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -60,10 +61,19 @@ study_method read_method(const H5::Group& g, const std::string& name) {
       m.notes = runs.strings(field);
   }
   // Every field the schema declares for runs (the timing fields only in a timed study).
+  // constraint_violation_max came within format_version 4 (with xpbd): a file written
+  // before it reads the field as NaN (no constraint view measured), so an older study
+  // still compares with a newer one.
   for (const auto& group : schema::find("runs").groups)
-    for (const auto& f : group.fields)
-      if (!group.timed_only && !runs.has(std::string(f.name)))
-        throw std::runtime_error(fmt::format("missing field '{}' in {}/runs", f.name, g.getObjName()));
+    for (const auto& f : group.fields) {
+      const std::string field(f.name);
+      if (group.timed_only || runs.has(field)) continue;
+      if (field == "constraint_violation_max") {
+        m.columns[field].assign(runs.rows(), std::numeric_limits<double>::quiet_NaN());
+        continue;
+      }
+      throw std::runtime_error(fmt::format("missing field '{}' in {}/runs", f.name, g.getObjName()));
+    }
   return m;
 }
 

@@ -13,7 +13,7 @@ import pytest
 
 RUN_FIELDS = ["param", "steps", "rejected_steps", "force_evals", "jacobian_evals", "newton_iterations",
               "linear_solves", "err_pos_final", "err_vel_final", "err_pos_max", "err_pos_rms", "energy_drift",
-              "energy_err_max", "angmom_drift", "angmom_err_max", "contacts", "contact_count_err", "contact_time_err",
+              "energy_err_max", "angmom_drift", "angmom_err_max", "constraint_violation_max", "contacts", "contact_count_err", "contact_time_err",
               "contact_pos_err", "tunnelled", "max_penetration", "diverged", "failed", "skipped", "note"]
 TIMED_FIELDS = ["time_ns", "time_ns_min", "time_ns_max", "repetitions", "cut"]
 ROOT_ATTRS = ["format_version", "version", "git_commit", "compiler", "build_type", "dependencies", "created_utc",

@@ -87,16 +87,14 @@ struct n_pendulum {
     f = Eigen::LLT<small_matrix>(m).solve(r);
   }
 
-  // Kinetic and gravitational energy of the bobs (the rods are massless and rigid).
+  // Kinetic and gravitational energy of the bobs (the rods are massless and rigid), from
+  // their positions and velocities (observe, below).
   double energy(const vec& x, const vec& v) const {
-    double e = 0.0, px = 0.0, py = 0.0, vx = 0.0, vy = 0.0;
-    for (int i = 0; i < count(); ++i) {
-      px += length_m * std::sin(x[i]);
-      py -= length_m * std::cos(x[i]);
-      vx += length_m * std::cos(x[i]) * v[i];
-      vy += length_m * std::sin(x[i]) * v[i];
-      e += mass_kg * (0.5 * (vx * vx + vy * vy) + gravity * py);
-    }
+    Eigen::VectorXd pos(observed_dim()), vel(observed_dim());
+    observe(x, v, pos, vel);
+    double e = 0.0;
+    for (int i = 0; i < count(); ++i)
+      e += mass_kg * (0.5 * vel.segment<2>(2 * i).squaredNorm() + gravity * pos[2 * i + 1]);
     return e;
   }
 

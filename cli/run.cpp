@@ -117,9 +117,13 @@ int run_run(const run_args& a) {
   const truth_table truth = build_truth(problem, times, topts);
   const run_metrics metrics = measure(problem, run, truth);
 
-  const int dim = problem.dim();
+  // Positions and velocities as the errors are measured: the problem's observed
+  // positions (n_pendulum's bobs in m, not its link angles), else its state.
+  const int dim = problem.observed_dim();
   auto part = [&](const std::vector<double>& y, int offset) {
-    return y.empty() ? std::vector<double>{} : std::vector<double>(y.begin() + offset, y.begin() + offset + dim);
+    if (y.empty()) return std::vector<double>{};
+    const std::vector<double> o = problem.observed(y);
+    return std::vector<double>(o.begin() + offset, o.begin() + offset + dim);
   };
   json out = {{"problem", a.problem},
               {"integrator", m.name},

@@ -9,6 +9,6 @@
 
 namespace stepbench {
 
-using constraint_integrators = type_list<peers::fixed_step_peer<xpbd>>;
+using constraint_integrators = type_list<peers::fixed_step_peer<xpbd>, peers::fixed_step_peer<xpbd_iterations>>;
 
 }  // namespace stepbench

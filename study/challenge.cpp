@@ -43,9 +43,11 @@ std::vector<double> frame_ends(double hz, double horizon) {
   return t;
 }
 
-// One method at k steps a frame over the challenge's horizon: error and time.
+// One method at k steps a frame (or, adaptive, at a tolerance) over the challenge's
+// horizon: error and time.
 struct ladder_point {
-  int k = 0;
+  int k = 0;  // steps a frame; an adaptive method's: its accepted steps a frame, rounded
+  double tolerance = nan;
   double err = nan, ns_per_frame = nan;
   bool completed = false;
   std::string note;
@@ -62,6 +64,26 @@ ladder_point measure_at(const problem_instance& p, const truth_table& truth, con
   if (!out.completed) return out;
   const std::vector<double> end{horizon};
   auto once = p.timed_run(method, dt, horizon, end);
+  volatile double sink = 0.0;
+  out.ns_per_frame = median_ns([&] { sink = sink + once(); }) / (horizon * hz);
+  return out;
+}
+
+// An adaptive method at relative tolerance `tol`, over the whole horizon in one run (its
+// step size carries across frames, as a game would keep it); timed with a state at every
+// frame end, which a game draws.
+ladder_point measure_at_tolerance(const problem_instance& p, const truth_table& truth, const std::string& method,
+                                  double tol, double hz, double horizon) {
+  ladder_point out;
+  out.tolerance = tol;
+  const run_result r = p.run(method, tol, horizon, truth.times);
+  const run_metrics m = measure(p, r, truth);
+  out.k = static_cast<int>(std::lround(static_cast<double>(r.steps) / (horizon * hz)));
+  out.completed = m.completed();
+  out.err = m.err_pos_max;
+  out.note = m.note;
+  if (!out.completed) return out;
+  auto once = p.timed_run(method, tol, horizon, truth.times);
   volatile double sink = 0.0;
   out.ns_per_frame = median_ns([&] { sink = sink + once(); }) / (horizon * hz);
   return out;
@@ -249,24 +271,45 @@ challenge_result run_challenge(const challenge_options& o, void (*progress)(cons
 
   for (const auto& method : o.competitors) {
     say("challenge: " + method);
-    // Steps a frame 1, 2, 4, ... until the error is xpbd's or smaller (the speed curve).
-    std::vector<ladder_point> pts;
-    for (int k = 1; k <= 1 << 12; k *= 2) {
-      pts.push_back(measure_at(*p, truth, method, k, o.hz, o.horizon));
-      if (pts.back().completed && pts.back().err <= x.err_pos_max) break;
+    std::vector<ladder_point> pts;  // in increasing cost
+    ladder_point at;
+    if (find_method(method).kind == method_kind::adaptive) {
+      // Tolerances 1e-1, 1e-2, ... until the error is xpbd's or smaller (the speed
+      // curve) and the time is past xpbd's (the accuracy at equal time: the tightest
+      // tolerance whose measured time per frame is at most xpbd's; the loosest when none is).
+      for (int e = 1; e <= 13; ++e) {
+        pts.push_back(measure_at_tolerance(*p, truth, method, std::pow(10.0, -e), o.hz, o.horizon));
+        const auto& b = pts.back();
+        if (b.completed && b.err <= x.err_pos_max && b.ns_per_frame > x.ns_per_frame) break;
+      }
+      at = pts.front();
+      for (const auto& q : pts)
+        if (q.completed && q.ns_per_frame <= x.ns_per_frame) at = q;
+    } else {
+      // Steps a frame 1, 2, 4, ... until the error is xpbd's or smaller (the speed curve).
+      for (int k = 1; k <= 1 << 12; k *= 2) {
+        pts.push_back(measure_at(*p, truth, method, k, o.hz, o.horizon));
+        if (pts.back().completed && pts.back().err <= x.err_pos_max) break;
+      }
+      // At xpbd's time per frame: the most whole steps whose time is at most xpbd's,
+      // from the time of one step a frame (time is linear in the steps).
+      const double one = pts.front().completed ? pts.front().ns_per_frame : nan;
+      const int k_equal = std::isfinite(one) ? std::max(1, static_cast<int>(std::floor(x.ns_per_frame / one))) : 1;
+      at = measure_at(*p, truth, method, k_equal, o.hz, o.horizon);
     }
-    // At xpbd's time per frame: the most whole steps whose time is at most xpbd's,
-    // from the time of one step a frame (time is linear in the steps).
-    const double one = pts.front().completed ? pts.front().ns_per_frame : nan;
-    const int k_equal = std::isfinite(one) ? std::max(1, static_cast<int>(std::floor(x.ns_per_frame / one))) : 1;
-    const ladder_point at = measure_at(*p, truth, method, k_equal, o.hz, o.horizon);
     challenge_entry e{.method = method,
-                      .steps_per_frame = k_equal,
+                      .steps_per_frame = at.k,
+                      .tolerance = at.tolerance,
                       .ns_per_frame = at.ns_per_frame,
                       .err_pos_max = at.completed ? at.err : nan,
                       .note = at.note};
     e.stable = at.completed;
-    if (e.stable) energy_of(e, method, 1.0 / (o.hz * k_equal));
+    if (e.stable) {
+      if (std::isfinite(at.tolerance))
+        energy_of(e, method, at.tolerance);
+      else
+        energy_of(e, method, 1.0 / (o.hz * at.k));
+    }
     e.ns_per_frame_at_xpbd_error = time_at_error(pts, x.err_pos_max);
     out.entries.push_back(e);
   }
@@ -281,7 +324,11 @@ challenge_result run_challenge(const challenge_options& o, void (*progress)(cons
   }
   std::string acc = fmt::format("accuracy at xpbd's {:.3g} us a frame: ", xe.ns_per_frame / 1e3);
   for (const auto& e : out.entries)
-    acc += fmt::format("{}{} x{} {:.3g} m", &e == &xe ? "" : ", ", e.method, e.steps_per_frame, e.err_pos_max);
+    acc += fmt::format("{}{} {} {:.3g} m", &e == &xe ? "" : ", ", e.method,
+                       std::isfinite(e.tolerance)
+                           ? fmt::format("tol {:.0e} ({} steps a frame)", e.tolerance, e.steps_per_frame)
+                           : fmt::format("x{}", e.steps_per_frame),
+                       e.err_pos_max);
   acc += fmt::format(" (bobs' largest error over {:g} s); most accurate: {}", o.horizon, most_accurate->method);
   std::string stab = fmt::format("stability over {:g} s: ", o.energy_horizon);
   for (const auto& e : out.entries)
@@ -322,16 +369,17 @@ void write_challenge(H5::Group& root, const challenge_result& r) {
     h5::table t;
     std::vector<std::string> method, note;
     std::vector<std::int64_t> k;
-    std::vector<double> ns, err, drift, emax, link, ns_eq;
+    std::vector<double> tol, ns, err, drift, emax, link, ns_eq;
     std::vector<std::int8_t> stable;
     for (const auto& e : r.entries) {
-      method.push_back(e.method), note.push_back(e.note), k.push_back(e.steps_per_frame);
+      method.push_back(e.method), note.push_back(e.note), k.push_back(e.steps_per_frame), tol.push_back(e.tolerance);
       ns.push_back(e.ns_per_frame), err.push_back(e.err_pos_max), drift.push_back(e.energy_drift);
       emax.push_back(e.energy_err_max), link.push_back(e.link_err_max), ns_eq.push_back(e.ns_per_frame_at_xpbd_error);
       stable.push_back(e.stable ? 1 : 0);
     }
     t.add("method", method);
     t.add("steps_per_frame", k);
+    t.add("tolerance", tol);
     t.add("ns_per_frame", ns);
     t.add("err_pos_max", err);
     t.add("energy_drift", drift);

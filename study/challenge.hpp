@@ -6,11 +6,12 @@
 // a 60 Hz frame with 50 substeps, and invites anyone "to beat our method in terms of
 // simplicity, speed, stability or accuracy". Here, on problems/n_pendulum.hpp with its
 // defaults: xpbd with 50 substeps a frame against rk4, rk8 (DOP853's step at a fixed
-// dt), implicit_midpoint and semi_implicit_euler in generalized coordinates, each given
-// the most whole steps a frame whose measured time per frame is at most xpbd's
-// (at least one). Per method: the bobs' largest position error over `horizon` against the
-// references, the energy drift over `energy_horizon`, the link-length error, and the
-// time per frame. A verdict a criterion the challenge names, computed here:
+// dt), dop853 (adaptive), implicit_midpoint and semi_implicit_euler in generalized
+// coordinates, each given the most whole steps a frame whose measured time per frame is
+// at most xpbd's (at least one); dop853, the tightest of the tolerances 1e-1, 1e-2, ...
+// whose measured time per frame is at most xpbd's. Per method: the bobs' largest position error over `horizon` against
+// the references, the energy drift over `energy_horizon`, the link-length error, and the time per frame. A verdict a
+// criterion the challenge names, computed here:
 //   accuracy: the smallest error at xpbd's time per frame;
 //   stability: every method's energy drift over energy_horizon (bounded or not);
 //   speed: the time per frame each needs for xpbd's error, interpolated log-log between
@@ -24,6 +25,7 @@
 // a frame for each.
 #include <H5Cpp.h>
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -35,14 +37,15 @@ struct challenge_options {
   int xpbd_substeps = 50;
   double horizon = 2.0;            // s; GSL rk8pd and ARKODE erk8 agree to 4e-14 on the bobs here
   double energy_horizon = 1000.0;  // s
-  std::vector<std::string> competitors{"rk4", "rk8", "implicit_midpoint", "semi_implicit_euler"};
+  std::vector<std::string> competitors{"rk4", "rk8", "dop853", "implicit_midpoint", "semi_implicit_euler"};
   std::vector<int> small_steps_counts{1, 2, 4, 8, 16, 32, 64};
   double small_steps_time = 1.0;  // s
 };
 
 struct challenge_entry {
   std::string method;
-  int steps_per_frame = 0;
+  int steps_per_frame = 0;  // an adaptive method's: its accepted steps a frame, rounded
+  double tolerance = std::numeric_limits<double>::quiet_NaN();  // an adaptive method's; NaN otherwise
   double ns_per_frame = 0.0;                // measured: the median of repeated whole runs over `horizon`
   double err_pos_max = 0.0;                 // bobs [m] over horizon
   double energy_drift = 0.0;                // (E(energy_horizon) - E0) / |E0 scale|, signed

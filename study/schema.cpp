@@ -171,11 +171,17 @@ constexpr field scan_best_fields[] = {{"point", i64},    {"hz", f64},          {
                                       {"substeps", i64}, {"err_pos_max", f64}, {"force_evals_per_frame", f64}};
 
 // The pendulum challenge and the Small Steps experiment (study/challenge.hpp).
-constexpr field challenge_entry_fields[] = {
-    {"method", str},       {"steps_per_frame", i64}, {"ns_per_frame", f64},
-    {"err_pos_max", f64},  {"energy_drift", f64},    {"energy_err_max", f64},
-    {"link_err_max", f64}, {"stable", i8},           {"ns_per_frame_at_xpbd_error", f64},
-    {"note", str}};
+constexpr field challenge_entry_fields[] = {{"method", str},
+                                            {"steps_per_frame", i64},
+                                            {"tolerance", f64},
+                                            {"ns_per_frame", f64},
+                                            {"err_pos_max", f64},
+                                            {"energy_drift", f64},
+                                            {"energy_err_max", f64},
+                                            {"link_err_max", f64},
+                                            {"stable", i8},
+                                            {"ns_per_frame_at_xpbd_error", f64},
+                                            {"note", str}};
 constexpr field challenge_verdict_fields[] = {{"criterion", str}, {"verdict", str}};
 constexpr field small_steps_fields[] = {{"problem", str},      {"design", str},   {"n", i64},
                                         {"err_pos", f64},      {"link_err", f64}, {"work_per_frame", f64},

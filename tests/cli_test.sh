@@ -42,7 +42,8 @@ assert names == {"constant_acceleration", "projectile", "damped_spring", "pendul
                  "bouncing_ball_locate", "bouncing_balls"}, names
 orders = {m["name"]: m["declared_order"] for m in d["methods"] if m["origin"] == "ours" and m["kind"] == "fixed_step"}
 assert orders == {"euler": 1, "semi_implicit_euler": 1, "midpoint": 2, "rk4": 4, "momentum": 1, "velocity_verlet": 2,
-                  "forest_ruth": 4, "implicit_euler": 1, "implicit_midpoint": 2, "rk8": 8, "xpbd": 1}, orders
+                  "forest_ruth": 4, "implicit_euler": 1, "implicit_midpoint": 2, "rk8": 8, "xpbd": 1,
+                  "xpbd_iterations": 1}, orders
 adaptive = {m["name"]: m["declared_order"] for m in d["methods"] if m["origin"] == "ours" and m["kind"] == "adaptive"}
 assert adaptive == {"adaptive_euler": 1, "rk45": 5, "dop853": 8}, adaptive
 origins = {m["name"]: m["origin"] for m in d["methods"]}
@@ -53,6 +54,19 @@ assert not caps["rk4"]["symplectic"] and caps["cvode_bdf"]["error_estimate"], ca
 assert caps["implicit_midpoint"]["symplectic"] and caps["implicit_midpoint"]["needs_jacobian"], caps
 assert caps["rk45"]["dense_output"] and caps["rk45"]["reuses_last_force"], caps
 ' && ok || bad "list --json"
+
+# n_pendulum's state is link angles; `run` prints what its errors are measured on, the
+# bobs' positions in m: the first bob sits on its 0.3 m circle, each next one 0.3 m on.
+"$bin" run --problem n_pendulum --integrator rk4 --dt 1e-3 --json | /usr/bin/python3 -c '
+import json, math, sys
+d = json.load(sys.stdin)
+p, q = d["position"], d["true_position"]
+assert len(p) == 6 and len(d["velocity"]) == 6 and len(q) == 6, d
+bobs = [(0.0, 0.0)] + [(p[2 * i], p[2 * i + 1]) for i in range(3)]
+for a, b in zip(bobs, bobs[1:]):
+    assert abs(math.dist(a, b) - 0.3) < 1e-12, bobs
+assert abs(d["err_pos_final"] - math.dist(p, q)) < 1e-12, d
+' && ok || bad "run --problem n_pendulum prints the bobs"
 
 # A parameter override changes the answer as the closed form says: 20 N gives 1000 m.
 "$bin" run --problem constant_acceleration --integrator rk4 --dt 0.5 --set force_n=20 --json |
@@ -205,6 +219,24 @@ cp "$work/shard3.h5" "$work/other.h5"
 /usr/bin/python3 -c 'import h5py,sys; f=h5py.File(sys.argv[1],"r+"); f.attrs["git_commit"]="0000000"' "$work/other.h5"
 expect_error "was written by another build" merge "$work/shard1.h5" "$work/shard2.h5" "$work/other.h5" -o "$work/m3.h5"
 expect_error "shard 4 of 3\|1 <= K <= N" scan --problem stiff_spring --param stiff_spring.k_s=1:2:3 --shard 4/3 --out "$work/x.h5"
+
+# A 10^4-point scan over 4 local shards (xargs -P 2, the README's recipe) finishes and
+# merges: every grid point once, in grid order, each with its runs.
+start=$(date +%s.%N)
+seq 1 4 | xargs -P 2 -I{} "$bin" scan --problem stiff_spring --param stiff_spring.k_s=1e1:1e7:100:log \
+  --param stiff_spring.k_d=0:40:100 --hz 60 --substeps 1,4 --method rk4 --method semi_implicit_euler \
+  --shard {}/4 --quiet --out "$work/big{}.h5" >/dev/null || bad "the 10^4-point shards failed"
+"$bin" merge "$work"/big[1-4].h5 -o "$work/big.h5" 2>"$work/err" || bad "merging the 10^4-point shards: $(cat "$work/err")"
+/usr/bin/python3 -c '
+import h5py, numpy as np, sys
+g = h5py.File(sys.argv[1], "r")["scan/stiff_spring"]
+pts, runs = g["points"][:], g["runs"][:]
+assert g.attrs["grid_points"] == 10000 and len(pts) == 10000, (g.attrs["grid_points"], len(pts))
+assert (pts["point"] == np.arange(10000)).all()
+assert len(runs) == 10000 * 2 * 2, len(runs)
+' "$work/big.h5" && ok || bad "the merged 10^4-point scan"
+fmt_secs=$(/usr/bin/python3 -c "import sys; print(f'{float(sys.argv[2]) - float(sys.argv[1]):.2f}')" "$start" "$(date +%s.%N)")
+echo "10^4-point scan, 4 shards by xargs -P 2, and merge: $fmt_secs s" >&2
 
 expect_error "frame rate 60 Hz is given twice" scan --problem stiff_spring --param stiff_spring.k_s=1:2:3 --hz 60,60 --out "$work/x.h5"
 expect_error "not an HDF5 file" merge "$work/out" "$work/shard1.h5" -o "$work/m4.h5"

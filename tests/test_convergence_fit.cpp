@@ -102,3 +102,32 @@ TEST(fit, an_odd_finest_pair_does_not_hide_the_asymptotic_range) {
   EXPECT_NEAR(r.order, 4.0, 1e-9);
   EXPECT_EQ(r.levels.back(), 6);
 }
+
+// Round-off that grows faster than the random walk reaches the levels before the rise.
+// xpbd on n_pendulum (full study at 3a53ac5, levels 0..17 of the 60 Hz ladder): the
+// error halves to level 12 (slope 1.00), then 1.11 and 1.14, then rises. The levels
+// just before the rise are not the asymptotic range: the fit ends two levels earlier.
+TEST(fit, the_levels_before_a_roundoff_rise_are_left_out) {
+  fit_input in;
+  const double err[] = {0.15734340568538097,   0.08041570863886992,    0.04108572409422652,    0.021013792699352038,
+                        0.010661544044029973,  0.005374756912146361,   0.00269909421386244,    0.001352569813874764,
+                        0.0006770523687635662, 0.00033871951700500675, 0.00016940905407504718, 8.472105676144979e-05,
+                        4.23913064080766e-05,  2.1231364918808608e-05, 9.844375604998209e-06,  4.47234441003712e-06,
+                        5.553703818823655e-06, 2.3130483813448354e-05};
+  for (int k = 0; k < 18; ++k) {
+    in.dt.push_back(1.0 / (60.0 * std::ldexp(1.0, k)));
+    in.error.push_back(err[k]);
+    in.steps.push_back(32L << k);
+    in.incomplete.push_back(false);
+  }
+  in.scale = 1.2;
+  const auto r = fit_order(in);
+  ASSERT_EQ(r.state, fit_result::status::fitted) << r.note;
+  EXPECT_NEAR(r.order, 1.0, 0.02);
+  EXPECT_LE(r.levels.back(), 13);
+  EXPECT_GE(r.levels.size(), 10u);
+  // Without the rise (the ladder ends at level 15) the finest window is taken as before.
+  for (auto* v : {&in.dt, &in.error}) v->resize(16);
+  in.steps.resize(16), in.incomplete.resize(16);
+  EXPECT_EQ(fit_order(in).levels.back(), 15);
+}

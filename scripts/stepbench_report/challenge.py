@@ -3,7 +3,8 @@
 
 Mueller's challenge (Ten Minute Physics, 2022): XPBD with 50 substeps a 60 Hz frame on a
 3-link pendulum, against our methods in generalized coordinates, each given the most
-whole steps a frame whose measured time is at most xpbd's. Every number is the study
+whole steps a frame whose measured time is at most xpbd's (an adaptive method: the
+tightest of the tolerances 1e-1, 1e-2, ... whose time is). Every number is the study
 file's: the errors, the times, the interpolated time at xpbd's error and the verdict
 lines were computed by stepbench (study/challenge.cpp); the lines are printed verbatim.
 The only arithmetic here is a unit: nanoseconds shown in microseconds."""
@@ -90,6 +91,29 @@ def _num(v, signed=False):
     return f"{v:+.3g}" if signed else f"{v:.3g}"
 
 
+def adaptive(r):
+    """An entry of an adaptive method: its `tolerance` is finite (NaN for a fixed step)."""
+    return bool(np.isfinite(float(r["tolerance"])))
+
+
+def tolerance_text(r):
+    """"tol 1e-07", as the accuracy verdict writes a power of ten ("2.5e-07" otherwise)."""
+    mantissa, exponent = f"{float(r['tolerance']):.2e}".split("e")
+    return f"tol {mantissa.rstrip('0').rstrip('.')}e{exponent}"
+
+
+def steps_text(r):
+    """The entries' "steps a frame": "7", or for an adaptive entry its tolerance and, in
+    brackets, its accepted steps a frame (rounded, as stored): "tol 1e-07 (3)"."""
+    k = int(r["steps_per_frame"])
+    return f"{tolerance_text(r)} ({k})" if adaptive(r) else str(k)
+
+
+def entry_label(r):
+    """An entry's name in the figure: "rk4 x7", "dop853 tol 1e-07"."""
+    return f"{r['method']} {tolerance_text(r) if adaptive(r) else 'x%d' % int(r['steps_per_frame'])}"
+
+
 def entry_head(c):
     a = c.attrs
     return ["method", "steps a frame", "time a frame [us]", f"bobs' max error over {float(a['horizon']):g} s [m]",
@@ -101,7 +125,7 @@ def entry_head(c):
 def entry_rows(c):
     rows = []
     for r in c.entries:
-        rows.append([r["method"], str(int(r["steps_per_frame"])), us_text(r["ns_per_frame"]), _num(r["err_pos_max"]),
+        rows.append([r["method"], steps_text(r), us_text(r["ns_per_frame"]), _num(r["err_pos_max"]),
                      _num(r["energy_drift"], signed=True), _num(r["energy_err_max"]),
                      _num(r["link_err_max"]),
                      us_text(r["ns_per_frame_at_xpbd_error"]), "yes" if r["stable"] else "NO", r["note"]])
@@ -192,8 +216,7 @@ def _challenge_panel(ax, c, styles, figures):
         xs.append(x)
         ax.plot([x], [y], linestyle="none", marker=st["marker"], color=st["color"], markersize=10,
                 markeredgecolor="black", markeredgewidth=0.6, zorder=5)
-        points.append((x, y, f"{r['method']} x{int(r['steps_per_frame'])}" + ("" if r["stable"] else " (unstable)"),
-                       st["color"]))
+        points.append((x, y, entry_label(r) + ("" if r["stable"] else " (unstable)"), st["color"]))
     ax.set_xscale("log")
     ax.set_yscale("log")
     lo, hi = figures._log_limits([p[1] for p in points] + [xerr], pad=8.0)
@@ -213,10 +236,10 @@ def _challenge_panel(ax, c, styles, figures):
     ax.set_title(f"(a) the challenge: n_pendulum at {float(c.attrs['hz']):g} Hz")
 
 
-def _small_steps_panel(ax, c, problem, styles, figures):
-    """(b): error at small_steps_time against n for each design; diverged runs as x marks
-    in a band at the top; implicit Euler's one step a large marker at n = 1 with a dotted
-    line across."""
+def _small_steps_panel(ax, c, problem, letter, styles, figures):
+    """(b), (c), ... (`letter`), a panel a problem: error at small_steps_time against n for
+    each design; diverged runs as x marks in a band at the top; implicit Euler's one step a
+    large marker at n = 1 with a dotted line across."""
     rows = c.small_steps[c.small_steps["problem"] == problem]
     ok_err = [float(r["err_pos"]) for r in rows if not r["diverged"] and np.isfinite(r["err_pos"]) and r["err_pos"] > 0]
     lo, hi = figures._log_limits(ok_err)
@@ -258,12 +281,24 @@ def _small_steps_panel(ax, c, problem, styles, figures):
                 color="0.35")
     ax.set_xlabel("n (substeps or passes a frame)")
     ax.set_ylabel(f"position error at t = {float(c.attrs['small_steps_time']):g} s [m]")
-    ax.set_title(f"(b) Small Steps: {problem}")
+    ax.set_title(f"({letter}) Small Steps: {problem}")
+
+
+def small_steps_letters(c):
+    """The letters of the Small Steps panels, one a problem after (a): "b", "c", ..."""
+    return [chr(ord("b") + i) for i in range(len(c.problems))]
+
+
+def _letters_text(letters):
+    """"(b)", "(b, c)", "(b-d)": the panels a legend entry or the caption speaks of."""
+    if len(letters) <= 2:
+        return f"({', '.join(letters)})"
+    return f"({letters[0]}-{letters[-1]})"
 
 
 def figure(c, styles, path):
-    """One figure, three panels in a row: (a) the challenge's entries, error against
-    measured time a frame; (b) Small Steps, error against n for each design, a panel per
+    """One figure, panels in a row: (a) the challenge's entries, error against measured
+    time a frame; (b), (c), ... Small Steps, error against n for each design, a panel per
     problem. The legend below the panels; at most 1380 px wide."""
     from . import figures  # matplotlib, only when drawing
     plt, Line2D = figures.plt, figures.Line2D
@@ -272,8 +307,10 @@ def figure(c, styles, path):
                              gridspec_kw=dict(width_ratios=[1.25] + [1.0] * len(problems)))
     axes = axes[0]
     _challenge_panel(axes[0], c, styles, figures)
-    for ax, p in zip(axes[1:], problems):
-        _small_steps_panel(ax, c, p, styles, figures)
+    letters = small_steps_letters(c)
+    for ax, p, letter in zip(axes[1:], problems, letters):
+        _small_steps_panel(ax, c, p, letter, styles, figures)
+    small = _letters_text(letters)
     grey = "0.45"
     hs = [Line2D([], [], color=grey, linestyle="--"), Line2D([], [], color=grey, linestyle=":"),
           Line2D([], [], color=grey, marker="o", markerfacecolor="white", linestyle="none")]
@@ -291,10 +328,10 @@ def figure(c, styles, path):
             hollow = d == "xpbd_iterations"
             hs.append(Line2D([], [], color=st["color"], marker=st["marker"], linestyle="--" if hollow else "-",
                              markerfacecolor="white" if hollow else st["color"]))
-        labels.append(f"(b) {DESIGN_TEXT[d]}")
+        labels.append(f"{small} {DESIGN_TEXT[d]}")
     if (c.small_steps["diverged"] != 0).any():
         hs.append(Line2D([], [], color="grey", marker="x", linestyle="none", markeredgewidth=2))
-        labels.append("(b) x in the top band: diverged")
+        labels.append(f"{small} x in the top band: diverged")
     fig.legend(hs, labels, loc="lower center", ncol=3, frameon=False, fontsize=8.5)
     fig.tight_layout(rect=(0, 0.14, 1, 1))
     figures._save(fig, path)
@@ -316,7 +353,10 @@ def section(doc, study, figs):
           f"defaults) at {float(a['hz']):g} Hz with {int(a['xpbd_substeps'])} substeps a frame, and invites anyone to "
           "beat it in simplicity, speed, stability or accuracy. Against it here: our methods in generalized "
           "coordinates, each given the most whole steps a frame whose measured time a frame is at most xpbd's "
-          f"({us_text(xp['ns_per_frame'])} us). The lines above are stepbench's own verdicts: accuracy at xpbd's time "
+          f"({us_text(xp['ns_per_frame'])} us"
+          + ("; an adaptive method, the tightest of the tolerances 1e-1, 1e-2, ... that keeps to it"
+             if any(adaptive(r) for r in c.entries) else "")
+          + "). The lines above are stepbench's own verdicts: accuracy at xpbd's time "
           f"a frame (the bobs' largest position error over {float(a['horizon']):g} s), stability (the energy drift "
           f"over {float(a['energy_horizon']):g} s, of m g l N(N+1)/2 = {float(a['energy_scale']):g} J), speed (the "
           "time a frame each method needs for xpbd's error, interpolated log-log between the two measured step "
@@ -326,12 +366,16 @@ def section(doc, study, figs):
                       "measured when the study was written (the challenge's own timings, "
                       f"{float(a['wall_seconds']):.1f} s in all); the last time is interpolated, the one the speed "
                       "verdict rests on. Energy drift: (E(end) - E0) / energy scale, signed; link error: the largest "
-                      "relative error of a link's length over the frames (0 in generalized coordinates).")
+                      "relative error of a link's length over the frames (0 in generalized coordinates)."
+                      + (" Steps a frame of an adaptive method: its tolerance, and in brackets its accepted steps a "
+                         "frame (rounded)." if any(adaptive(r) for r in c.entries) else ""))
     if FIGURE in figs:
         doc.img(f"fig/{FIGURE}", "the pendulum challenge: error against time a frame; Small Steps: error against n")
-    doc.p("(a) each entry's error against its measured time a frame (steps a frame beside the name); hollow on "
-          "xpbd's error line: the time a frame at which each would match xpbd's error. (b) Small Steps (Macklin et "
-          "al., SCA 2019): the position error at "
+    letters = small_steps_letters(c)
+    on = " and ".join(f"({x}) on {p}" for x, p in zip(letters, c.problems))
+    doc.p("(a) each entry's error against its measured time a frame (steps a frame beside the name, or an adaptive "
+          "method's tolerance); hollow on xpbd's error line: the time a frame at which each would match xpbd's error. "
+          f"{_letters_text(letters)} Small Steps (Macklin et al., SCA 2019), {on}: the position error at "
           f"t = {float(a['small_steps_time']):g} s for n substeps of one XPBD constraint pass, one step of n passes, "
           "n semi-implicit Euler substeps and one implicit Euler step (at n = 1, dotted across).", cls="caption")
     doc.h(3, "Small Steps: substeps against iterations")

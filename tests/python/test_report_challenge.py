@@ -2,17 +2,24 @@
 study holding /challenge: `stepbench sweep --problem n_pendulum` at a few levels (the
 challenge runs with every full sweep of n_pendulum; --quick leaves it out, so
 conftest.py's plain_study is the study without it). Every number is checked against the
-file read with h5py, independently of the report's code."""
+file read with h5py, independently of the report's code.
+
+The report requires /challenge/entries' `tolerance` (schema.json). A stepbench built
+before that column writes none, and no adaptive entry: challenge_study then adds the
+column, NaN in every row, to a copy; adaptive_study adds a made-up adaptive entry where
+the file has none, so that the tolerance is checked whichever stepbench wrote the file."""
 import html
+import os
 import re
 import subprocess
+import sys
 
 import h5py
 import numpy as np
 import pytest
 from conftest import run_study
 
-from test_report import PYTHON, REPORT, drop_field, edit, md_table, report_text, run_report
+from test_report import PYTHON, REPORT, ROOT, drop_field, edit, md_table, report_text, run_report
 
 TITLE = "## The pendulum challenge (XPBD, 50 substeps) and Small Steps"
 FIGURE = "fig/pendulum_challenge.png"
@@ -22,10 +29,49 @@ def text(v):
     return v.decode() if isinstance(v, bytes) else v
 
 
+ENTRIES = "challenge/entries"
+
+
+def has_tolerance(path):
+    with h5py.File(path, "r") as f:
+        return "tolerance" in f[ENTRIES].dtype.names
+
+
+def rewrite(f, path, rows):
+    del f[path]
+    f.create_dataset(path, data=rows)
+
+
+def add_tolerance(f):
+    """/challenge/entries with `tolerance` after `steps_per_frame`, NaN in every row (a
+    fixed step's), as a stepbench built before the column would have written it."""
+    rows = f[ENTRIES][()]
+    names = list(rows.dtype.names)
+    at = names.index("steps_per_frame") + 1
+    new = np.empty(len(rows), dtype=[(n, rows.dtype[n]) for n in names[:at]] + [("tolerance", "<f8")]
+                   + [(n, rows.dtype[n]) for n in names[at:]])
+    for n in names:
+        new[n] = rows[n]
+    new["tolerance"] = np.nan
+    rewrite(f, ENTRIES, new)
+
+
+def add_adaptive_entry(f):
+    """A made-up adaptive entry after rk8, with rk8's numbers: "dop853" at tolerance 1e-07,
+    3 steps a frame."""
+    rows = f[ENTRIES][()]
+    at = [text(m) for m in rows["method"]].index("rk8") + 1
+    new = np.insert(rows, at, rows[at - 1])
+    new["method"][at] = b"dop853"
+    new["tolerance"][at] = 1e-7
+    new["steps_per_frame"][at] = 3
+    rewrite(f, ENTRIES, new)
+
+
 @pytest.fixture(scope="module")
-def challenge_study(stepbench, tmp_path_factory):
+def challenge_written(stepbench, tmp_path_factory):
     """n_pendulum alone, 4 levels: the sweep is quick, the challenge (about 5 s) runs whole."""
-    path = tmp_path_factory.mktemp("challenge") / "study.h5"
+    path = tmp_path_factory.mktemp("challenge") / "written.h5"
     run_study([stepbench, "sweep", "--problem", "n_pendulum", "--levels", "4", "--max-levels", "4", "--quiet",
                "--out", str(path)], stdout=subprocess.DEVNULL, timeout=300)
     with h5py.File(path, "r") as f:
@@ -34,12 +80,44 @@ def challenge_study(stepbench, tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
-def challenge_report(challenge_study, tmp_path_factory):
+def challenge_study(challenge_written, tmp_path_factory):
+    """stepbench's file; from a stepbench built before /challenge/entries had `tolerance`,
+    a copy with the column added (add_tolerance)."""
+    if has_tolerance(challenge_written):
+        return challenge_written
+    path = tmp_path_factory.mktemp("challenge") / "study.h5"
+    edit(challenge_written, path, add_tolerance)
+    return path
+
+
+@pytest.fixture(scope="module")
+def adaptive_study(challenge_study, tmp_path_factory):
+    """challenge_study where it has an adaptive entry (finite tolerance), else a copy with
+    a made-up one (add_adaptive_entry)."""
+    with h5py.File(challenge_study, "r") as f:
+        if np.isfinite(f[ENTRIES]["tolerance"]).any():
+            return challenge_study
+    path = tmp_path_factory.mktemp("adaptive") / "study.h5"
+    edit(challenge_study, path, add_adaptive_entry)
+    return path
+
+
+def made_report(study, tmp_path_factory):
     out = tmp_path_factory.mktemp("challenge_report") / "report"
-    p = run_report(challenge_study, out, jobs=2)
+    p = run_report(study, out, jobs=2)
     assert p.returncode == 0, p.stderr
     assert p.stderr == ""
-    return challenge_study, out
+    return study, out
+
+
+@pytest.fixture(scope="module")
+def challenge_report(challenge_study, tmp_path_factory):
+    return made_report(challenge_study, tmp_path_factory)
+
+
+@pytest.fixture(scope="module")
+def adaptive_report(adaptive_study, challenge_study, challenge_report, tmp_path_factory):
+    return challenge_report if adaptive_study == challenge_study else made_report(adaptive_study, tmp_path_factory)
 
 
 def section(md):
@@ -84,9 +162,18 @@ def number(cell):
     return float(cell.split(" ")[0])
 
 
-def test_the_entries_table_is_the_files(challenge_report):
-    """A row per entry, xpbd first, in the file's order; each number the file's (times in us)."""
-    study, folder = challenge_report
+def steps_cell(e):
+    """An entry's "steps a frame": its steps, or an adaptive one's tolerance (a power of
+    ten, written as the accuracy verdict writes it) and its steps."""
+    k = int(e["steps_per_frame"])
+    return f"tol {e['tolerance']:.0e} ({k})" if np.isfinite(e["tolerance"]) else str(k)
+
+
+@pytest.mark.parametrize("shape", ["challenge_report", "adaptive_report"])
+def test_the_entries_table_is_the_files(request, shape):
+    """A row per entry, xpbd first, in the file's order; each number the file's (times in
+    us); an adaptive entry's steps a frame: "tol 1e-07 (3)", its tolerance and its steps."""
+    study, folder = request.getfixturevalue(shape)
     head, rows = md_table(section(report_text(folder)), "| method | steps a frame | time a frame [us] | bobs' max "
                           "error over 2 s [m] | energy drift over 1000 s [of 18 J] | largest energy error | link error"
                           " | time a frame at xpbd's error [us] | stable | note |")
@@ -98,7 +185,7 @@ def test_the_entries_table_is_the_files(challenge_report):
     assert rows[0][0] == "xpbd" and rows[0][1] == str(int(a["xpbd_substeps"])) == "50"
     for cells, e in zip(rows, entries):
         r = dict(zip(head, cells))
-        assert int(r["steps a frame"]) == e["steps_per_frame"]
+        assert r["steps a frame"] == steps_cell(e)
         assert number(r["time a frame [us]"]) == pytest.approx(e["ns_per_frame"] / 1e3, rel=5e-3)
         assert number(r["bobs' max error over 2 s [m]"]) == pytest.approx(e["err_pos_max"], rel=5e-3)
         assert number(r["energy drift over 1000 s [of 18 J]"]) == pytest.approx(e["energy_drift"], rel=5e-3)
@@ -111,6 +198,28 @@ def test_the_entries_table_is_the_files(challenge_report):
     # xpbd's own time at its own error is its time, and its links are the only ones not exact.
     assert rows[0][2] == rows[0][7]
     assert float(rows[0][6]) > 0 and all(float(r[6]) == 0 for r in rows[1:])
+    if shape == "adaptive_report":
+        assert any(re.fullmatch(r"tol 1e-\d\d \(\d+\)", r[1]) for r in rows), rows
+
+
+def test_dop853_is_the_adaptive_entry(challenge_written):
+    """From a stepbench that writes `tolerance`: dop853 is an entry, at one of the
+    tolerances 1e-1, 1e-2, ..., every other entry at a fixed step (NaN), rk8 too; the
+    accuracy verdict names it "dop853 tol 1e-07 (3 steps a frame)", the file's numbers."""
+    if not has_tolerance(challenge_written):
+        pytest.skip("stepbench was built before /challenge/entries had `tolerance`")
+    with h5py.File(challenge_written, "r") as f:
+        entries = f[ENTRIES][()]
+    methods = [text(m) for m in entries["method"]]
+    assert methods == ["xpbd", "rk4", "rk8", "dop853", "implicit_midpoint", "semi_implicit_euler"]
+    tol = dict(zip(methods, entries["tolerance"]))
+    assert [m for m in methods if np.isfinite(tol[m])] == ["dop853"]
+    exponent = -np.log10(tol["dop853"])
+    assert exponent == round(exponent) and 1 <= exponent <= 13, tol["dop853"]
+    e = entries[methods.index("dop853")]
+    assert e["steps_per_frame"] >= 1
+    accuracy = verdicts(challenge_written, "accuracy")[0]
+    assert f" dop853 tol {tol['dop853']:.0e} ({e['steps_per_frame']} steps a frame) " in accuracy, accuracy
 
 
 def test_the_small_steps_table_is_the_files(challenge_report):
@@ -145,6 +254,42 @@ def test_the_small_steps_table_is_the_files(challenge_report):
     assert implicit and all(r[2] and not any(r[3:2 + len(ns)]) for r in implicit)
 
 
+def test_the_figure_names_its_entries_and_letters_its_panels(adaptive_study, monkeypatch):
+    """Drawn from the file: each entry named "rk4 x7", an adaptive one "dop853 tol 1e-07";
+    the panels (a) the challenge, then (b), (c) Small Steps a problem each, and the
+    legend's Small Steps entries "(b, c) ..."."""
+    sys.path.insert(0, os.path.join(ROOT, "scripts"))
+    try:
+        from stepbench_report import challenge, figures, study as study_module
+    finally:
+        sys.path.pop(0)
+    drawn = []
+    monkeypatch.setattr(figures, "_save", lambda fig, path, tight=True: drawn.append(fig))
+    s = study_module.load(str(adaptive_study))
+    challenge.figure(s.challenge, figures.Styles(figures.method_names(s)), "unused.png")
+    fig = drawn[0]
+    with h5py.File(adaptive_study, "r") as f:
+        entries = f[ENTRIES][()]
+        problems = list(dict.fromkeys(text(p) for p in f["challenge/small_steps"]["problem"]))
+    assert problems == ["n_pendulum", "spring_chain"]
+    titles = [ax.get_title() for ax in fig.axes]
+    assert titles[0].startswith("(a) the challenge")
+    assert titles[1:] == ["(b) Small Steps: n_pendulum", "(c) Small Steps: spring_chain"]
+    names = [t.get_text() for t in fig.axes[0].texts]
+    want = []
+    for e in entries:
+        if not (np.isfinite(e["ns_per_frame"]) and np.isfinite(e["err_pos_max"]) and e["err_pos_max"] > 0):
+            continue
+        name = text(e["method"]) + (f" tol {e['tolerance']:.0e}" if np.isfinite(e["tolerance"])
+                                    else f" x{e['steps_per_frame']}")
+        want.append(name + ("" if e["stable"] else " (unstable)"))
+    assert names == want
+    assert any(re.fullmatch(r"dop853 tol 1e-\d\d", n) for n in names), names
+    legend = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert [x for x in legend if not x.startswith("(a) ")] and all(
+        x.startswith("(b, c) ") for x in legend if not x.startswith("(a) ")), legend
+
+
 def test_the_figure_exists_and_fits(challenge_report):
     from matplotlib import image
     _, folder = challenge_report
@@ -154,6 +299,9 @@ def test_the_figure_exists_and_fits(challenge_report):
     assert pixels.ndim == 3 and 800 <= pixels.shape[1] <= 1400 and pixels.shape[0] > 300, pixels.shape
     assert pixels[..., :3].std() > 0.05  # not blank
     assert f'src="{FIGURE}"' in (folder / "index.html").read_text()
+    # The caption letters the Small Steps panels as the figure does.
+    assert "(b, c) Small Steps (Macklin et al., SCA 2019), (b) on n_pendulum and (c) on spring_chain: " in sec
+    assert "(b) Small Steps (" not in sec
 
 
 def test_markdown_and_readme_carry_the_verdicts(challenge_study, tmp_path):
@@ -192,8 +340,8 @@ def test_a_study_without_challenge_has_no_such_section(plain_study, tmp_path):
     assert "Pendulum challenge" not in readme.read_text()
 
 
-@pytest.mark.parametrize("path, field", [("challenge/entries", "err_pos_max"), ("challenge/verdicts", "verdict"),
-                                         ("challenge/small_steps", "diverged")])
+@pytest.mark.parametrize("path, field", [("challenge/entries", "err_pos_max"), ("challenge/entries", "tolerance"),
+                                         ("challenge/verdicts", "verdict"), ("challenge/small_steps", "diverged")])
 def test_a_challenge_lacking_a_field_is_refused(challenge_study, tmp_path, path, field):
     bad = tmp_path / "bad.h5"
     edit(challenge_study, bad, drop_field(path, field))

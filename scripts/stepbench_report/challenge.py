@@ -387,17 +387,79 @@ def section(doc, study, figs):
                       "passes) and the measured time a frame:")
 
 
+# --- --markdown and --readme: the verdict lines, and Small Steps as one compact table ------------
+
+BRIEF_COUNTS = (1, 4, 16, 64)  # the n the README's Small Steps table shows, of those the study ran
+
+
+def brief_counts(c):
+    """(the n the compact table shows, the n the study ran that it leaves out): BRIEF_COUNTS
+    where the study ran them (all its n when it ran none of them), and always the n of a
+    design run at one n only (implicit Euler's one step)."""
+    ns = counts(c)
+    shown = {n for n in ns if n in BRIEF_COUNTS} or set(ns)
+    for d in DESIGNS:
+        design_ns = {int(n) for n in c.small_steps["n"][c.small_steps["design"] == d]}
+        if len(design_ns) == 1:
+            shown |= design_ns
+    return sorted(shown), [n for n in ns if n not in shown]
+
+
+def brief_cell(r):
+    """One run: "0.0144 m, 6.74 us" (its error and its measured time a frame), "diverged",
+    or "" where the design has no run at that n."""
+    if r is None:
+        return ""
+    if r["diverged"]:
+        return "diverged"
+    err = _num(r["err_pos"])
+    return f"{err if err == 'n/a' else err + ' m'}, {us_text(r['ns_per_frame'])} us"
+
+
+def small_steps_brief(c):
+    """The Small Steps table of --markdown and --readme: (caption, head, rows), a row per
+    problem and n, a column per design, each cell a run's error and time a frame."""
+    shown, left_out = brief_counts(c)
+    present = set(c.small_steps["design"].tolist())
+    designs = [d for d in DESIGNS if d in present]
+    head = ["problem", "n"] + [DESIGN_TEXT[d] for d in designs]
+    rows = []
+    for p in c.problems:
+        sel = c.small_steps[c.small_steps["problem"] == p]
+        by = {(r["design"], int(r["n"])): r for r in sel}
+        for n in shown:
+            cells = [brief_cell(by.get((d, n))) for d in designs]
+            if any(cells):
+                rows.append([p, str(n)] + cells)
+    ns = counts(c)
+    caption = (f"Small Steps at t = {float(c.attrs['small_steps_time']):g} s: each design's position error [m] and "
+               "measured time a frame [us] with n substeps or passes a frame ("
+               + ("n = " + ", ".join(map(str, shown)) + f" of the study's {ns[0]} to {ns[-1]}; every n in the report"
+                  if left_out else "every n the study ran")
+               + "); implicit Euler takes one step a frame, shown at n = 1:")
+    return caption, head, rows
+
+
+def _md_row(cells):
+    return "| " + " | ".join(str(x).replace("|", "\\|") for x in cells) + " |"
+
+
 def answer(doc, c, level=2):
-    """--markdown: the challenge's verdict lines and the Small Steps lines, verbatim."""
+    """--markdown: the challenge's verdict lines and the Small Steps lines, verbatim, and
+    the Small Steps table."""
     doc.h(level, "Pendulum challenge")
     doc.items(c.answer)
     doc.p("Small Steps:")
     doc.items(c.lines(SMALL_STEPS))
+    caption, head, rows = small_steps_brief(c)
+    doc.table(head, rows, caption=caption)
 
 
 def readme_lines(c):
     """--readme: the same, as Markdown lines."""
+    caption, head, rows = small_steps_brief(c)
     return (["", f"**Pendulum challenge** (XPBD, {int(c.attrs['xpbd_substeps'])} substeps a "
                  f"{float(c.attrs['hz']):g} Hz frame, against our methods in generalized coordinates):", ""]
             + [f"- {line}" for line in c.answer] + ["", "Small Steps:", ""]
-            + [f"- {line}" for line in c.lines(SMALL_STEPS)])
+            + [f"- {line}" for line in c.lines(SMALL_STEPS)]
+            + ["", caption, "", _md_row(head), "|" + "---|" * len(head)] + [_md_row(r) for r in rows])

@@ -322,6 +322,69 @@ def test_markdown_and_readme_carry_the_verdicts(challenge_study, tmp_path):
     assert block.index("Small Steps:") < block.index(f"- {small[0]}") < block.index(f"Study `{challenge_study}`")
 
 
+DESIGN_COLUMNS = {"XPBD: n substeps of one pass": "xpbd_substeps", "XPBD: one step of n passes": "xpbd_iterations",
+                  "semi-implicit Euler: n substeps": "semi_implicit_euler_substeps",
+                  "implicit Euler: one step": "implicit_euler"}
+SHOWN_COUNTS = (1, 4, 16, 64)
+
+
+def small_steps_table(doc):
+    """The Small Steps table of --readme and --markdown: (caption, head, rows)."""
+    caption = next(x for x in doc.splitlines() if x.startswith("Small Steps at t = "))
+    head, rows = md_table(doc, caption)
+    return caption, head, rows
+
+
+def test_readme_and_markdown_carry_the_small_steps_table(challenge_study, tmp_path):
+    """The README block and --markdown carry Small Steps as one table: a row per problem
+    and n (1, 4, 16, 64 of the study's n), a column per design, each cell the file's error
+    and time a frame ("0.0144 m, 6.74 us", three digits) or "diverged"; implicit Euler's
+    one step at n = 1 only."""
+    readme, results = tmp_path / "README.md", tmp_path / "results.md"
+    readme.write_text("# project\n\n<!-- results:begin -->\nold\n<!-- results:end -->\n")
+    p = subprocess.run([PYTHON, REPORT, str(challenge_study), "--markdown", str(results), "--readme", str(readme)],
+                       capture_output=True, text=True, timeout=60)
+    assert p.returncode == 0, p.stderr
+    block = readme.read_text()
+    with h5py.File(challenge_study, "r") as f:
+        small = f["challenge/small_steps"][()]
+        t = float(f["challenge"].attrs["small_steps_time"])
+    problem = np.array([text(x) for x in small["problem"]])
+    design = np.array([text(x) for x in small["design"]])
+    ns = sorted({int(n) for n in small["n"]})
+    assert ns == [1, 2, 4, 8, 16, 32, 64]
+    shown = [n for n in ns if n in SHOWN_COUNTS]
+    tables = [small_steps_table(doc) for doc in (block, results.read_text())]
+    assert tables[0] == tables[1]
+    caption, head, rows = tables[0]
+    assert caption.startswith(f"Small Steps at t = {t:g} s: ")
+    assert "(n = 1, 4, 16, 64 of the study's 1 to 64; every n in the report)" in caption
+    assert head == ["problem", "n"] + list(DESIGN_COLUMNS)
+    assert [(r[0], int(r[1])) for r in rows] == [(p, n) for p in ("n_pendulum", "spring_chain") for n in shown]
+    diverged = 0
+    for cells in rows:
+        r = dict(zip(head, cells))
+        for column, d in DESIGN_COLUMNS.items():
+            sel = small[(problem == r["problem"]) & (design == d) & (small["n"] == int(r["n"]))]
+            assert len(sel) <= 1
+            if not len(sel):
+                assert r[column] == "", (r, column)
+            elif sel[0]["diverged"]:
+                assert r[column] == "diverged"
+                diverged += 1
+            else:
+                e = sel[0]
+                assert r[column] == f"{e['err_pos']:.3g} m, {e['ns_per_frame'] / 1e3:.3g} us", (r, column)
+                m = re.fullmatch(r"(\S+) m, (\S+) us", r[column])
+                assert float(m[1]) == pytest.approx(e["err_pos"], rel=5e-3)
+                assert float(m[2]) == pytest.approx(e["ns_per_frame"] / 1e3, rel=5e-3)
+        assert (r["implicit Euler: one step"] != "") == (r["n"] == "1")
+    assert diverged == np.count_nonzero(small["diverged"][np.isin(small["n"], shown)])
+    # In the block after the Small Steps lines, before the line naming the study.
+    lines = verdicts(challenge_study, "small_steps")
+    assert block.index(f"- {lines[-1]}\n") < block.index(caption) < block.index(f"Study `{challenge_study}`")
+
+
 def test_a_study_without_challenge_has_no_such_section(plain_study, tmp_path):
     with h5py.File(plain_study, "r") as f:
         assert "challenge" not in f  # --quick leaves it out

@@ -9,6 +9,12 @@ report reads the runs at one step a frame (substeps == 1) for the map of each me
 stiff spring's theory overlay: the k_s at which omega dt equals each method's oscillator
 limit from /stability/limits (`theory`), k_s = mass_kg (limit * hz)^2.
 
+A scan need not hold every point of its grid: a shard file (`scan --shard K/N`) holds its
+share, a `merge --partial` holds the points of the shards merged. Point numbers are the
+grid's. A point not in the file, a point whose truth is not trusted (points.trusted 0)
+and a run skipped for the work budget (runs.skipped) are drawn as such (hatched) and take
+no part in any statement here: not stable, not unstable, never the cheapest.
+
 The study reader (study.py) predates the scans and does not hold them; load() reads
 /scan through the same checked reader (study._Reader: need_attrs, need_table)."""
 import math
@@ -30,16 +36,72 @@ SPRING_AXIS = "k_s"
 SPRING_MASS = "mass_kg"
 SPRING_DEFAULT_MASS = 1.0
 
+# What a cell of the maps shows (one_step_grid, best_grid). Only OK, UNSTABLE, CHOSEN and
+# NONE are statements about a run; the others say why there is none to make.
+OK = 0  # the run completed: coloured by its error
+UNSTABLE = 1  # the run diverged or failed
+SKIPPED = 2  # the run was not taken: its estimated work exceeds the scan's work budget
+NO_RUN = 3  # the point was measured, but the scan has no such run
+UNTRUSTED = 4  # the point's truth is not trusted (points.trusted 0): nothing is judged there
+MISSING = 5  # the point is not in the file (another shard's, or a shard not merged)
+CHOSEN = 6  # best_grid: `best` names a run
+NONE = 7  # best_grid: no run taken at the point and rate is within tol
+
 
 @dataclass
 class Scan:
     name: str
     attrs: dict
     axes: list  # the scanned parameters, in the file's order (the first varies slowest)
-    values: list  # per axis, its values (1-D), from values/<param>
+    values: list  # per axis, its values along it (1-D), every grid point's, present or not
     points: np.ndarray
     runs: np.ndarray
     best: np.ndarray
+
+    @property
+    def grid_points(self):
+        return math.prod(self.shape)
+
+    @property
+    def shard_index(self):
+        return int(self.attrs.get("shard_index", 0))
+
+    @property
+    def shard_count(self):
+        return int(self.attrs.get("shard_count", 1))
+
+    @property
+    def is_shard(self):
+        """A shard file opened as it is (`scan --shard K/N`, N > 1), not a merge."""
+        return self.shard_count > 1
+
+    @property
+    def held(self):
+        """Per grid point: the file holds it (a row of `points`)."""
+        out = np.zeros(self.grid_points, bool)
+        out[self.points["point"]] = True
+        return out
+
+    @property
+    def trusted(self):
+        """Per grid point: held, with a trusted truth."""
+        out = np.zeros(self.grid_points, bool)
+        out[self.points["point"][self.points["trusted"] != 0]] = True
+        return out
+
+    @property
+    def missing(self):
+        """The number of grid points the file does not hold."""
+        return self.grid_points - len(self.points)
+
+    @property
+    def untrusted(self):
+        return int(np.sum(self.points["trusted"] == 0))
+
+    @property
+    def missing_label(self):
+        """What a point the file does not hold is, in a legend."""
+        return "not in this shard" if self.is_shard else "not run (missing shard)"
 
     @property
     def problem(self):
@@ -63,7 +125,7 @@ class Scan:
 
     @property
     def shape(self):
-        return tuple(len(v) for v in self.values)
+        return tuple(int(c) for c in np.atleast_1d(self.attrs["axis_count"]))
 
     @property
     def fixed(self):
@@ -74,8 +136,10 @@ class Scan:
 
     @property
     def methods(self):
-        """The methods of the runs, in the file's order."""
-        return list(dict.fromkeys(self.runs["method"].tolist()))
+        """The methods of the runs, in the file's order; the scan's `methods` attribute
+        (the methods run) where it has one, so that a shard with no point still names them."""
+        listed = [m for m in str(self.attrs.get("methods", "")).split(",") if m]
+        return list(dict.fromkeys(listed + self.runs["method"].tolist()))
 
     def index(self, point):
         """The grid cell (i, j) of a point (the first axis varies slowest); j is 0 for one axis."""
@@ -106,29 +170,70 @@ def read(reader, f):
         if not axes or len(axes) > 2 or len(counts) != len(axes) or len(np.atleast_1d(attrs["axis_log"])) != len(axes):
             raise reader.error(f"{sg.name}: axes '{attrs['axes']}' do not match axis_count and axis_log "
                                "(a scan has one or two axes)")
-        # values/<param>: the parameter at each grid point, the first axis varying
-        # slowest; an axis's own values are read along it.
-        vg = reader.need_group(sg, "values")
-        values = []
-        for k, a in enumerate(axes):
-            v = reader.need_array(vg, a, 1)
-            if len(v) != math.prod(counts):
-                raise reader.error(f"{vg.name}/{a} has {len(v)} values, not the grid's {math.prod(counts)}")
-            grid = v.reshape(counts)
-            values.append(grid[:, 0] if (len(axes) == 2 and k == 0) else grid[0, :] if len(axes) == 2 else grid)
+        npoints = math.prod(counts)
+        if "grid_points" in attrs and int(attrs["grid_points"]) != npoints:
+            raise reader.error(f"{sg.name}: grid_points {attrs['grid_points']} is not the product of axis_count, "
+                               f"{npoints}")
         points = reader.need_table(sg, "points", POINT_FIELDS)
         runs = reader.need_table(sg, "runs", RUN_FIELDS)
         best = reader.need_table(sg, "best", BEST_FIELDS)
-        npoints = math.prod(counts)
         rates = [float(x) for x in np.atleast_1d(attrs["hz"])]
         for table, rows in (("points", points), ("runs", runs), ("best", best)):
             if len(rows) and (rows["point"].min() < 0 or rows["point"].max() >= npoints):
                 raise reader.error(f"{sg.name}/{table} names a point beyond the grid's {npoints}")
+        if len(np.unique(points["point"])) != len(points):
+            raise reader.error(f"{sg.name}/points names a point twice")
+        for table, rows in (("runs", runs), ("best", best)):
+            if not np.isin(rows["point"], points["point"]).all():
+                raise reader.error(f"{sg.name}/{table} names a point that is not in its points table")
+        values = _axis_values(reader, f, sg, attrs, axes, counts, points)
         for table, rows in (("runs", runs), ("best", best)):
             reader.need_column(sg, table, rows, "hz", rates)
         reader.need_column(sg, "best", best, "method", [""] + list(dict.fromkeys(runs["method"].tolist())))
         scans.append(Scan(name, attrs, axes, values, points, runs, best))
     return scans
+
+
+def _axis_values(reader, f, sg, attrs, axes, counts, points):
+    """Each axis's values along it, at every grid point, present or not. values/<param>
+    holds the parameter at each row of `points` (every grid point, the first axis varying
+    slowest, in a whole scan; a shard's or a partial merge's own points otherwise); a value
+    no point in the file holds is made as stepbench makes it (study/scan.cpp,
+    scan_axis::values: both ends as given, powers of ten between on a log axis, rounded for
+    a whole-numbered parameter)."""
+    vg = reader.need_group(sg, "values")
+    lo, hi = np.atleast_1d(attrs["axis_lo"]), np.atleast_1d(attrs["axis_hi"])
+    log = np.atleast_1d(attrs["axis_log"])
+    index = np.unravel_index(points["point"], counts)
+    whole = _whole_params(reader, f, str(attrs["problem"]))
+    values = []
+    for k, a in enumerate(axes):
+        stored = reader.need_array(vg, a, 1)
+        if len(stored) != len(points):
+            raise reader.error(f"{vg.name}/{a} has {len(stored)} values, not one for each of the "
+                               f"{len(points)} rows of points")
+        n = counts[k]
+        made = []
+        for i in range(n):
+            s = 0.0 if n == 1 else i / (n - 1)
+            v = (float(lo[k]) if i == 0 else float(hi[k]) if i == n - 1
+                 else 10.0 ** (math.log10(lo[k]) + s * (math.log10(hi[k]) - math.log10(lo[k]))) if int(log[k])
+                 else float(lo[k]) + s * (float(hi[k]) - float(lo[k])))
+            made.append(float(round(v)) if a in whole else v)
+        along = np.array(made)
+        along[index[k]] = stored  # the file's own, where it has them
+        values.append(along)
+    return values
+
+
+def _whole_params(reader, f, problem):
+    """The problem's whole-numbered parameters, from /problems/<problem>/parameters where
+    the file has it (`allowed` "a whole number ..."); else none."""
+    pg = f.get(f"problems/{problem}")
+    if pg is None or not hasattr(pg, "keys") or "parameters" not in pg:  # a scan-only file: no problems
+        return set()
+    rows = reader.need_table(pg, "parameters", ("name", "allowed"))
+    return {str(r["name"]) for r in rows if str(r["allowed"]).startswith("a whole number")}
 
 
 def load(path):
@@ -147,37 +252,69 @@ def load(path):
 # --- what the figures and tables show -------------------------------------------------------------
 
 def one_step_grid(scan, hz, methods=None):
-    """The map of one rate at one step a frame, one axis only: (log10 err_pos_max,
-    unstable, present), each methods x points. `unstable`: the run did not complete
-    (diverged, failed or skipped); `present`: there is a run at all."""
+    """The map of one rate at one step a frame, one axis only: (log10 err_pos_max, state),
+    each methods x points. state: OK (the run completed; err its error), UNSTABLE (it
+    diverged or failed), SKIPPED (not taken: over the work budget), NO_RUN (no such run),
+    UNTRUSTED (the point's truth is not trusted: its runs are not judged), MISSING (the
+    file does not hold the point). err is NaN but where OK."""
     methods = scan.methods if methods is None else methods
     n = scan.shape[0]
     err = np.full((len(methods), n), np.nan)
-    unstable = np.zeros((len(methods), n), bool)
-    present = np.zeros((len(methods), n), bool)
+    state = np.full((len(methods), n), NO_RUN)
+    state[:, ~scan.held] = MISSING
+    state[:, scan.held & ~scan.trusted] = UNTRUSTED
+    trusted = scan.trusted
     rows = scan.runs[(scan.runs["hz"] == hz) & (scan.runs["substeps"] == 1)]
     done = schema.completed(rows)
     row_of = {m: k for k, m in enumerate(methods)}
     for r, ok in zip(rows, done):
         k = row_of.get(r["method"])
-        if k is None:
-            continue
         i = int(r["point"])
-        present[k, i] = True
-        if not ok:
-            unstable[k, i] = True
+        if k is None or not trusted[i]:
+            continue
+        if r["skipped"]:
+            state[k, i] = SKIPPED
+        elif not ok:
+            state[k, i] = UNSTABLE
         else:
+            state[k, i] = OK
             e = float(r["err_pos_max"])
             err[k, i] = math.log10(max(e, 1e-300)) if np.isfinite(e) else np.nan
-    return err, unstable, present
+    return err, state
+
+
+def boundary(scan, hz, method):
+    """Where `method` stops completing at one step a frame, judged on the points that
+    say: (the first axis value whose run diverged or failed, None if none did; the number
+    of points before it (or in all, when None) that say nothing: not in the file, truth
+    not trusted, run skipped or absent; the number of points judged, OK or UNSTABLE)."""
+    _, state = one_step_grid(scan, hz, [method])
+    state = state[0]
+    judged = (state == OK) | (state == UNSTABLE)
+    hits = np.flatnonzero(state == UNSTABLE)
+    upto = hits[0] if len(hits) else len(state)
+    unknown = int(np.sum(~judged[:upto]))
+    return (float(scan.values[0][hits[0]]) if len(hits) else None), unknown, int(np.sum(judged))
 
 
 def first_unstable(scan, hz, method):
-    """The first axis value at which `method`'s run at one step a frame did not complete
-    (None: every run completed)."""
-    _, unstable, _ = one_step_grid(scan, hz, [method])
-    hits = np.flatnonzero(unstable[0])
-    return float(scan.values[0][hits[0]]) if len(hits) else None
+    """The first axis value at which `method`'s run at one step a frame diverged or
+    failed, among the points judged (None: none did)."""
+    return boundary(scan, hz, method)[0]
+
+
+def boundary_text(scan, hz, method):
+    """The table's cell for boundary(): the value; "none" when every point completed; a
+    word on the points that say nothing where they could hide the boundary."""
+    first, unknown, judged = boundary(scan, hz, method)
+    if judged == 0:
+        _, state = one_step_grid(scan, hz, [method])
+        return "not run (over the work budget)" if (state == SKIPPED).any() else "no point measured"
+    if first is None:
+        return "none" if unknown == 0 else f"none of the {judged} measured ({unknown} not measured)"
+    if unknown == 0:
+        return f"{first:.3g}"
+    return f"{first:.3g} ({unknown} point{'s' if unknown != 1 else ''} below it not measured)"
 
 
 def spring_mass(scan, problem=None):
@@ -229,16 +366,35 @@ def limit_flags(scan, stability):
 
 
 def best_grid(scan, hz):
-    """`best` at one rate on the grid: (method, substeps) per cell, shape of the grid
-    ((n, 1) for one axis); method "" where none meets the tolerance."""
+    """`best` at one rate on the grid, each of the grid's shape ((n, 1) for one axis):
+    (method, substeps, state, skipped). method "" but where state is CHOSEN; state NONE
+    where no run taken meets the tolerance, SKIPPED where no run was taken (each over the
+    work budget), UNTRUSTED where the point's truth is not trusted (whatever `best` says
+    there is not shown: stepbench's range answer leaves those points out too), MISSING
+    where the file does not hold the point; skipped: the runs at the point and rate not
+    taken for the work budget."""
     shape = scan.shape if len(scan.axes) == 2 else (scan.shape[0], 1)
     method = np.full(shape, "", dtype=object)
     substeps = np.zeros(shape, int)
+    state = np.full(shape, MISSING)
+    skipped = np.zeros(shape, int)
+    trusted = scan.trusted
+    for p in scan.points["point"]:
+        state[scan.index(p)] = NONE if trusted[p] else UNTRUSTED
+    taken = np.zeros(shape, int)
+    for r in scan.runs[scan.runs["hz"] == hz]:
+        if r["skipped"]:
+            skipped[scan.index(r["point"])] += 1
+        else:
+            taken[scan.index(r["point"])] += 1
+    state[(state == NONE) & (skipped > 0) & (taken == 0)] = SKIPPED  # no run taken: nothing to judge
     for r in scan.best[scan.best["hz"] == hz]:
         i, j = scan.index(r["point"])
-        method[i, j] = r["method"]
-        substeps[i, j] = int(r["substeps"])
-    return method, substeps
+        if r["method"] and trusted[r["point"]]:
+            method[i, j] = r["method"]
+            substeps[i, j] = int(r["substeps"])
+            state[i, j] = CHOSEN
+    return method, substeps, state, skipped
 
 
 def choice_text(method, n):
@@ -253,14 +409,19 @@ def _span_text(values, lo, hi):
 def best_summary(scan, hz):
     """Per choice (method x substeps) at one rate, in the order it first appears, where
     `best` names it: one axis, its runs of consecutive points; two axes, the span of each
-    axis and the count of points. "" is where no run meets the tolerance."""
-    method, substeps = best_grid(scan, hz)
+    axis and the count of points, and a note when the span holds points not judged. ""
+    is where no run meets the tolerance. Only the points judged: a point not in the file,
+    without a trusted truth or with every run skipped is in none. (choice, where, count,
+    note) each."""
+    method, substeps, state, _ = best_grid(scan, hz)
     order = {}
     for i in range(method.shape[0]):
         for j in range(method.shape[1]):
-            order.setdefault(choice_text(method[i, j], substeps[i, j]), []).append((i, j))
+            if state[i, j] in (CHOSEN, NONE):
+                order.setdefault(choice_text(method[i, j], substeps[i, j]), []).append((i, j))
     out = []
     for choice, cells in order.items():
+        note = ""
         if len(scan.axes) == 1:
             idx = [i for i, _ in cells]
             runs, start = [], idx[0]
@@ -274,8 +435,36 @@ def best_summary(scan, hz):
             j = [c[1] for c in cells]
             where = (f"{scan.axes[0]} {_span_text(scan.values[0], min(i), max(i))}, "
                      f"{scan.axes[1]} {_span_text(scan.values[1], min(j), max(j))}")
-        out.append((choice, where, len(cells)))
+            box = state[min(i):max(i) + 1, min(j):max(j) + 1]
+            unjudged = int(np.sum((box != CHOSEN) & (box != NONE)))
+            if unjudged:  # the span holds points that say nothing: not the choice's
+                note = f"{unjudged} in the span not judged"
+        out.append((choice, where, len(cells), note))
     return out
+
+
+def _count(n, what):
+    return f"{n} {what[0] if n == 1 else what[1]}"
+
+
+def unjudged_text(scan, hz):
+    """What `best` at one rate does not speak for, in words ("" when nothing): the points
+    not in the file, those without a trusted truth, and the points with no run within
+    tolerance where some runs were not taken (over the work budget)."""
+    _, _, state, skipped = best_grid(scan, hz)
+    parts = []
+    if (state == MISSING).any():
+        parts.append(f"{_count(int(np.sum(state == MISSING)), ('point', 'points'))} {scan.missing_label}")
+    if (state == UNTRUSTED).any():
+        parts.append(f"{_count(int(np.sum(state == UNTRUSTED)), ('point', 'points'))} without a trusted truth")
+    if (state == SKIPPED).any():
+        parts.append(f"{_count(int(np.sum(state == SKIPPED)), ('point', 'points'))} with every run over the work "
+                     "budget (skipped)")
+    none_skipped = int(np.sum((state == NONE) & (skipped > 0)))
+    if none_skipped:
+        parts.append(f"of the points with none within tolerance, {none_skipped} had runs not taken (over the "
+                     "work budget)")
+    return "; ".join(parts)
 
 
 # --- the figures --------------------------------------------------------------------------------
@@ -328,11 +517,41 @@ def _text_colour(colour):
 
 MAX_WIDTH_IN = 13.8  # 1380 px at the report's 100 dpi
 
+# The cells that say nothing about a run, hatched: (face, hatch colour, hatch).
+HATCHED = {SKIPPED: ("white", "#2f6fb0", "\\\\\\\\"), UNTRUSTED: ("#fff2cc", "#b86e00", "...."),
+           MISSING: ("0.9", "0.45", "////")}
+
+
+def _hatched_cell(ax, x0, x1, y0, y1, state):
+    """One cell that says nothing about a run (HATCHED), with the white rule between cells."""
+    from matplotlib.patches import Rectangle
+    face, ink, hatch = HATCHED[state]
+    ax.add_patch(Rectangle((x0, y0), x1 - x0, y1 - y0, facecolor=face, edgecolor=ink, hatch=hatch, linewidth=0))
+    ax.add_patch(Rectangle((x0, y0), x1 - x0, y1 - y0, fill=False, edgecolor="white", linewidth=0.6))
+
+
+def _hatched_handle(state):
+    from matplotlib.patches import Patch
+    face, ink, hatch = HATCHED[state]
+    return Patch(facecolor=face, edgecolor=ink, hatch=hatch, linewidth=0)
+
+
+def coverage_text(scan):
+    """The points the file holds, in a few words ("" for a whole scan)."""
+    if scan.is_shard:
+        return (f"shard {scan.shard_index + 1} of {scan.shard_count}, {len(scan.points)} of {scan.grid_points} "
+                "points")
+    if scan.missing:
+        return f"partial merge, {len(scan.points)} of {scan.grid_points} points"
+    return ""
+
 
 def one_step_figure(scan, stability, mass, path):
     """A panel per frame rate: x the scan's axis, a row per method, each cell coloured by
     log10 of the max position error of the run at one step a frame, grey with a black x
-    where it did not complete; for the stiff spring over k_s, a red bar in each method's
+    where it diverged or failed, hatched where there is nothing to judge (HATCHED: a
+    point not in the file, whole columns; a point whose truth is not trusted; a run not
+    taken for the work budget); for the stiff spring over k_s, a red bar in each method's
     row at the k_s where omega dt is its oscillator limit (theory)."""
     from . import figures  # matplotlib, only when drawing
     plt, Line2D = figures.plt, figures.Line2D
@@ -356,13 +575,19 @@ def one_step_figure(scan, stability, mass, path):
     y_edges = np.arange(len(methods) + 1) - 0.5
     grey = ListedColormap(["0.72"])
     mesh = None
-    for ax, hz, (err, unstable, present) in zip(axes.flat, rates, grids):
-        mesh = ax.pcolormesh(x_edges, y_edges, np.ma.masked_invalid(err), cmap="viridis", vmin=vmin, vmax=vmax,
-                             shading="flat")
+    for ax, hz, (err, state) in zip(axes.flat, rates, grids):
+        ax.grid(False)  # before pcolormesh, which no longer removes a grid itself
+        mesh = ax.pcolormesh(x_edges, y_edges, np.ma.masked_invalid(np.where(state == OK, err, np.nan)),
+                             cmap="viridis", vmin=vmin, vmax=vmax, shading="flat")
+        unstable = state == UNSTABLE
         ax.pcolormesh(x_edges, y_edges, np.ma.masked_where(~unstable, np.ones_like(err)), cmap=grey, shading="flat")
         ys, xs = np.nonzero(unstable)
         ax.plot(scan.values[0][xs], ys, linestyle="none", marker="x", color="black", markersize=6,
                 markeredgewidth=1.4)
+        for i in np.flatnonzero(~scan.held):  # a point not in the file: its whole column
+            _hatched_cell(ax, x_edges[i], x_edges[i + 1], y_edges[0], y_edges[-1], MISSING)
+        for k, i in zip(*np.nonzero((state == UNTRUSTED) | (state == SKIPPED))):
+            _hatched_cell(ax, x_edges[i], x_edges[i + 1], y_edges[k], y_edges[k + 1], state[k, i])
         for k, m in enumerate(methods):
             if m in limits:
                 ks = limits[m][1][hz]
@@ -379,24 +604,33 @@ def one_step_figure(scan, stability, mass, path):
         ax.set_ylim(len(methods) - 0.5, -0.5)
         ax.set_yticks(range(len(methods)))
         ax.set_yticklabels(methods, fontsize=8.5)
-        ax.grid(False)
         ax.set_xlabel(scan.axes[0])
         ax.set_title(f"{hz:g} Hz, one step a frame (dt = {1e3 / hz:.3g} ms)")
     for ax in list(axes.flat)[len(rates):]:
         ax.set_axis_off()
-    fig.suptitle(f"Scan {scan.name} ({scan.problem}): max position error at one step a frame", fontsize=12)
+    cover = coverage_text(scan)
+    fig.suptitle(f"Scan {scan.name} ({scan.problem}): max position error at one step a frame"
+                 + (f" ({cover})" if cover else ""), fontsize=12)
     fig.tight_layout(rect=(0, 0, 0.8 if ncols > 1 else 0.74, 0.96))
     cax = fig.add_axes([0.83 if ncols > 1 else 0.77, 0.55, 0.015, 0.35])
+    cax.grid(False)
     cb = fig.colorbar(mesh, cax=cax)
     cb.set_label(f"log10 max position error [{scan.unit}]")
+    shown = set(np.concatenate([g[1].ravel() for g in grids]).tolist()) if grids else set()
     handles = [Patch(facecolor="0.72", edgecolor="none")]
     labels = ["grey with x: did not complete\n(diverged, failed)"]
     if limits:
         handles.append(Line2D([], [], color="#e8003a", linewidth=3.0))
         labels.append("oscillator limit (theory,\n/stability): k_s = m (y_max hz)^2")
-    if any(not present.all() for _, _, present in grids):
+    if NO_RUN in shown:
         handles.append(Patch(facecolor="white", edgecolor="0.5"))
         labels.append("white: no run")
+    for state, label in ((SKIPPED, "skipped: over the work budget\n(not run, not judged)"),
+                         (UNTRUSTED, "truth not trusted\n(not judged)"),
+                         (MISSING, f"{scan.missing_label}\n(not judged)")):
+        if state in shown:
+            handles.append(_hatched_handle(state))
+            labels.append(label)
     fig.legend(handles, labels, loc="upper left", bbox_to_anchor=(0.81 if ncols > 1 else 0.75, 0.45),
                frameon=False, fontsize=8.5)
     figures._save(fig, path)
@@ -405,15 +639,17 @@ def one_step_figure(scan, stability, mass, path):
 
 def best_figure(scan, styles, path):
     """The cheapest run that stays within tol at each point and rate (`best`), coloured by
-    method (the report's colour for it) and labelled "method xN"; white where none does.
-    One axis: one panel, x the axis, a row per rate. Two axes: a panel per rate."""
+    method (the report's colour for it) and labelled "method xN"; white where none does;
+    hatched where there is nothing to judge (a point not in the file, or whose truth is not
+    trusted). One axis: one panel, x the axis, a row per rate. Two axes: a panel per rate."""
     from . import figures
     plt = figures.plt
     from matplotlib.colors import to_rgba
     from matplotlib.patches import Patch
     rates = scan.rates
     fallback = {}
-    used = list(dict.fromkeys(m for m in scan.best["method"].tolist() if m))
+    grids = [best_grid(scan, hz) for hz in rates]
+    used = list(dict.fromkeys(m for g in grids for m in g[0].ravel().tolist() if m))
     colour = {m: _style(styles, m, fallback)["color"] for m in used}
     two = len(scan.axes) == 2
     x_edges = _edges(scan.values[0], scan.log[0])
@@ -431,23 +667,38 @@ def best_figure(scan, styles, path):
         for ax in axes[len(rates):]:
             ax.set_axis_off()
     small = 7 if (not two and scan.shape[0] <= 16) or (two and max(scan.shape) <= 8) else 6
-    for r, (ax, hz) in enumerate(zip(axes, rates)):
-        method, substeps = best_grid(scan, hz)
+    hatched_label = {MISSING: "not run" if not scan.is_shard else "other shard", UNTRUSTED: "untrusted",
+                     SKIPPED: "skipped"}
+
+    def label(state, m, n, skipped):
+        if state == CHOSEN:
+            return (choice_text(m, n) if not two else f"x{n}"), _text_colour(colour[m])
+        if state == NONE:
+            return ("none" if not skipped else "none*"), "0.45"
+        return hatched_label[state], "0.3"
+
+    any_none_skipped = False
+    for r, (ax, hz, (method, substeps, state, skipped)) in enumerate(zip(axes, rates, grids)):
         colours = [[to_rgba(colour[m], 0.85) if m else None for m in col] for col in method]
+        y_edges = [r - 0.5, r + 0.5] if not two else _edges(scan.values[1], scan.log[1])
+        _cells(ax, x_edges, y_edges, colours)
+        for (i, j), st in np.ndenumerate(state):
+            if st in HATCHED:
+                _hatched_cell(ax, x_edges[i], x_edges[i + 1], y_edges[j], y_edges[j + 1], st)
+        any_none_skipped |= bool(((state == NONE) & (skipped > 0)).any())
         if not two:
-            _cells(ax, x_edges, [r - 0.5, r + 0.5], colours)
-            for i, m in enumerate(method[:, 0]):
-                ax.text(scan.values[0][i], r, choice_text(m, substeps[i, 0]) if m else "none", rotation=90,
-                        ha="center", va="center", fontsize=small,
-                        color=_text_colour(colour[m]) if m else "0.45")
+            for i in range(state.shape[0]):
+                text, ink = label(state[i, 0], method[i, 0], substeps[i, 0], skipped[i, 0])
+                ax.text(scan.values[0][i], r, text, rotation=90, ha="center", va="center", fontsize=small, color=ink,
+                        bbox=dict(facecolor=HATCHED[state[i, 0]][0], edgecolor="none", pad=0.6)
+                        if state[i, 0] in HATCHED else None)
         else:
-            y_edges = _edges(scan.values[1], scan.log[1])
-            _cells(ax, x_edges, y_edges, colours)
             if max(scan.shape) <= 14:
-                for (i, j), m in np.ndenumerate(method):
-                    ax.text(scan.values[0][i], scan.values[1][j],
-                            f"x{substeps[i, j]}" if m else "none", ha="center", va="center",
-                            fontsize=small, color=_text_colour(colour[m]) if m else "0.45")
+                for (i, j), st in np.ndenumerate(state):
+                    text, ink = label(st, method[i, j], substeps[i, j], skipped[i, j])
+                    ax.text(scan.values[0][i], scan.values[1][j], text, ha="center", va="center", fontsize=small,
+                            color=ink, bbox=dict(facecolor=HATCHED[st][0], edgecolor="none", pad=0.6)
+                            if st in HATCHED else None)
             if scan.log[1]:
                 ax.set_yscale("log")
             ax.set_ylim(y_edges[0], y_edges[-1])
@@ -468,12 +719,21 @@ def best_figure(scan, styles, path):
     labels = list(used)
     handles.append(Patch(facecolor="white", edgecolor="0.5"))
     labels.append(f"none within tol {scan.tol:g} {scan.unit}")
+    if any_none_skipped:
+        labels[-1] += "\n(none*: and some runs not taken,\nover the work budget)"
     if two:
         labels[-1] += "\n(in a cell: xN, N substeps a frame)"
+    shown = set(np.concatenate([g[2].ravel() for g in grids]).tolist()) if grids else set()
+    for state, text in ((SKIPPED, "every run over the work budget\n(skipped, not judged)"),
+                        (UNTRUSTED, "truth not trusted\n(not judged)"), (MISSING, f"{scan.missing_label}")):
+        if state in shown:
+            handles.append(_hatched_handle(state))
+            labels.append(text)
+    cover = coverage_text(scan)
     fig.suptitle(f"Scan {scan.name} ({scan.problem}): the cheapest run within {scan.tol:g} {scan.unit} "
-                 "(method x substeps a frame)", fontsize=12)
+                 "(method x substeps a frame)" + (f"\n{cover}" if cover else ""), fontsize=12)
     fig.legend(handles, labels, loc="upper left", bbox_to_anchor=(1.0, 0.9), frameon=False, fontsize=8.5)
-    fig.tight_layout(rect=(0, 0, 1, 0.93))
+    fig.tight_layout(rect=(0, 0, 1, 0.93 if not cover else 0.88))
     figures._save(fig, path)
 
 
@@ -495,10 +755,6 @@ def _axis_text(scan):
     return " by ".join(parts)
 
 
-def _value(v):
-    return "none" if v is None else f"{v:.3g}"
-
-
 def section(doc, study, figs, scans):
     """The section, after the per-problem and study-wide ones; nothing at all for a study
     without /scan."""
@@ -515,15 +771,63 @@ def section(doc, study, figs, scans):
         _one_scan(doc, study, figs, scan)
 
 
+def substep_counts(scan):
+    """The substep counts run, from the runs table (a merged file's `substeps` attribute
+    may list the default counts before the scan's own: stepbench's read_scan appends to
+    them); the attribute, each once, for a scan with no run."""
+    counts = scan.runs["substeps"] if len(scan.runs) else np.atleast_1d(scan.attrs["substeps"])
+    return sorted(dict.fromkeys(int(n) for n in counts))
+
+
+def _coverage_paragraph(scan):
+    """What the scan does not speak for, said once under its heading ("" for a whole scan
+    of trusted points with every run taken)."""
+    parts = []
+    held, grid, missing = len(scan.points), scan.grid_points, scan.missing
+    if scan.is_shard:
+        parts.append(f"This file is shard {scan.shard_index + 1} of {scan.shard_count} of the scan (`stepbench scan "
+                     f"--shard {scan.shard_index + 1}/{scan.shard_count}`): it holds {held} of the grid's {grid} "
+                     f"points. The other {missing} are in the other shards: hatched in the maps as \"not in this "
+                     "shard\", and left out of every statement below (not stable, not unstable, never the cheapest); "
+                     "`stepbench merge` joins the shards.")
+    elif missing:
+        parts.append(f"A partial merge (`stepbench merge --partial`): {missing} of the grid's {grid} points are "
+                     f"missing (their shards were not merged), and the scan holds {held}. The missing points are "
+                     "hatched in the maps as \"not run (missing shard)\" and take no part in any statement below: "
+                     "not stable, not unstable, never the cheapest.")
+    if scan.untrusted:
+        bad = scan.points[scan.points["trusted"] == 0]
+        first = bad[np.argmin(bad["point"])]
+        where = ", ".join(f"{a} = {float(v[i]):.3g}" for a, v, i in
+                          zip(scan.axes, scan.values, np.unravel_index(int(first["point"]), scan.shape)))
+        note = f" (at {where}: {first['note']})" if str(first["note"]) else ""
+        parts.append(f"{scan.untrusted} of the {held} points {'has' if scan.untrusted == 1 else 'have'} no trusted "
+                     f"truth{note}: hatched as \"truth not trusted\"; their runs are neither stable nor unstable "
+                     "here, and what `best` says there is not shown (stepbench's range answer leaves them out too).")
+    skipped = scan.runs[scan.runs["skipped"] != 0]
+    if len(skipped):
+        one = int(np.sum(skipped["substeps"] == 1))
+        budget = scan.attrs.get("work_budget")
+        parts.append(f"{len(skipped)} of the {len(scan.runs)} runs were not taken: their estimated work exceeds the "
+                     "scan's work budget" + (f" of {float(budget):.3g}" if budget is not None else "")
+                     + " (runs.skipped). A skipped run is not a failure: "
+                     + (f"at one step a frame ({one} of them) it is hatched as \"skipped\", and " if one else "")
+                     + "`best` chooses among the runs taken.")
+    return " ".join(parts)
+
+
 def _one_scan(doc, study, figs, scan):
     names = figure_names(scan)
     doc.h(3, f"Scan {scan.name}: {scan.problem} over {', '.join(scan.axes)}")
     fixed = ", ".join(f"{k} = {v:g}" for k, v in scan.fixed.items())
     trusted = int(np.sum(scan.points["trusted"] != 0))
     doc.p(f"{_axis_text(scan)}; at {', '.join(f'{hz:g}' for hz in scan.rates)} Hz with "
-          f"{', '.join(str(int(n)) for n in np.atleast_1d(scan.attrs['substeps']))} substeps a frame; tolerance "
+          f"{', '.join(str(n) for n in substep_counts(scan))} substeps a frame; tolerance "
           f"{scan.tol:g} {scan.unit}" + (f"; set: {fixed}" if fixed else "") + f". {trusted} of "
           f"{len(scan.points)} points have a trusted truth.")
+    cover = _coverage_paragraph(scan)
+    if cover:
+        doc.p(cover)
     if len(scan.axes) == 1:
         _one_step_part(doc, study, figs, scan, names["one_step"])
     else:
@@ -533,16 +837,19 @@ def _one_scan(doc, study, figs, scan):
     if names["best"] in figs:
         doc.img(f"fig/{names['best']}", f"the cheapest run within tolerance over the scan {scan.name}")
     rows = []
-    for hz in scan.rates:
+    unjudged = [unjudged_text(scan, hz) for hz in scan.rates]
+    for hz, other in zip(scan.rates, unjudged):
         parts, none = [], ""
-        for choice, where, count in best_summary(scan, hz):
-            text = f"{where} ({count} point{'s' if count != 1 else ''})"
+        for choice, where, count, note in best_summary(scan, hz):
+            text = f"{where} ({count} point{'s' if count != 1 else ''}{'; ' + note if note else ''})"
             if choice:
                 parts.append(f"{choice}: {text}")
             else:
                 none = text
-        rows.append([f"{hz:g} Hz", "; ".join(parts) or "none", none or "-"])
-    doc.table(["frame rate", "cheapest (method x substeps a frame): where", "no run within tolerance"], rows,
+        rows.append([f"{hz:g} Hz", "; ".join(parts) or "none", none or "-"] + ([other or "-"] if any(unjudged)
+                                                                                   else []))
+    doc.table(["frame rate", "cheapest (method x substeps a frame): where", "no run within tolerance"]
+              + (["not judged"] if any(unjudged) else []), rows,
               caption=f"The scan's `best` table by rate (tolerance {scan.tol:g} {scan.unit}); the range answer: "
                       f"`stepbench advise --scan FILE --tol {scan.tol:g}`.")
 
@@ -553,14 +860,19 @@ def _one_step_part(doc, study, figs, scan, name):
     problem = next((p for p in study.problems if p.name == scan.problem), None)
     mass = spring_mass(scan, problem)
     limits = theory_limits(scan, study.stability, mass) if theory else {}
+    grids = [one_step_grid(scan, hz) for hz in scan.rates]
+    gaps = any(((state != OK) & (state != UNSTABLE)).any() for _, state in grids)
     doc.h(4, f"Scan {scan.name}: one step a frame")
     text = ("Cells: log10 of the max position error of the run at one step a frame (substeps = 1); grey with an x "
             "where the run did not complete (diverged or failed).")
+    if gaps:
+        text += " Hatched: nothing to judge (the legend says why); white: no such run."
     if theory:
         text += (f" Red bars: each explicit method's oscillator stability limit y_max = omega dt from "
                  f"/stability/limits (theory), at k_s = m (y_max hz)^2 with m = {mass:g} kg; the damped spring "
-                 "may still complete a little beyond it: the first grey cell is the bar's cell or the next. An "
-                 "arrow at the edge: the limit is beyond the scan.")
+                 "may still complete a little beyond it: the first grey cell is the bar's cell or the next"
+                 + (" where both were measured" if gaps else "") + ". An arrow at the edge: the limit is beyond "
+                 "the scan.")
     doc.p(text)
     if name in figs:
         doc.img(f"fig/{name}", f"max position error at one step a frame over the scan {scan.name}")
@@ -580,7 +892,9 @@ def _one_step_part(doc, study, figs, scan, name):
         for hz in scan.rates:
             if theory:
                 row.append(f"{limits[m][1][hz]:.3g}" if m in limits else "-")
-            row.append(_value(first_unstable(scan, hz, m)))
+            row.append(boundary_text(scan, hz, m))
         rows.append(row)
     doc.table(head, rows, caption=f"Where each method stops completing at one step a frame ({axis}; none: it "
-                                  "completed at every point):")
+                                  "completed at every point):" if not gaps else
+              f"Where each method stops completing at one step a frame ({axis}; diverged or failed, on the points "
+              "measured; none: it completed at each of them):")

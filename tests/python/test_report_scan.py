@@ -100,12 +100,13 @@ def test_the_drawn_grid_is_the_files(scan_report):
     study, _ = scan_report
     scans = scan_section.load(str(study))
     s = next(x for x in scans if x.name == "stiff_spring")
-    err, unstable, present = scan_section.one_step_grid(s, 60.0)
+    err, state = scan_section.one_step_grid(s, 60.0)
     with h5py.File(study) as f:
         for k, method in enumerate(s.methods):
             runs = one_step_runs(f, method)
-            assert present[k].all()
-            np.testing.assert_array_equal(unstable[k], runs["completed"] == 0)
+            assert len(runs) == s.grid_points and not runs["skipped"].any()  # a whole scan, every run taken
+            np.testing.assert_array_equal(state[k] == scan_section.UNSTABLE, runs["completed"] == 0)
+            np.testing.assert_array_equal(state[k] == scan_section.OK, runs["completed"] == 1)
             ok = runs["completed"] == 1
             np.testing.assert_allclose(err[k][ok], np.log10(runs["err_pos_max"][ok]))
         assert scan_section.first_unstable(s, 60.0, "rk4") == \
@@ -159,3 +160,288 @@ def test_a_study_without_scan_has_no_section(plain_study, tmp_path, scan_report)
         with_scan[with_scan.index("\n## Appendix: how the problem sections are made"):]
     assert cut.replace(str(plain_study), "S").replace(os.path.basename(str(plain_study)), "S") == \
         md.replace(str(old), "S").replace("old.h5", "S")
+
+
+# --- scans that do not speak for every grid point --------------------------------------------------
+# Real scans by the stepbench under test: the stiff spring over k_s (9 points, log) at 30
+# and 60 Hz in three shards, two of them merged with `merge --partial` (the third's 3 points
+# missing) and one shard as it is; the sliding block over its 34 friction pairs, lubricated,
+# where the lecture's table lacks most coefficients (those points are not run: their truth
+# is not trusted); and rk8 on the stiff spring at 60 Hz and 7864320 Hz with 1 and 524288
+# substeps, whose runs over the work budget are skipped. Each is copied under /scan/<name>
+# of a copy of the quick study, and the report drawn from it once.
+
+SPRING_AXIS = "stiff_spring.k_s=1e1:1e7:9:log"
+GRAFTED = {"partial": "partial.h5", "shard2": "s2.h5", "lub": "lub.h5", "budget": "budget.h5"}
+
+
+def scan_cmd(stepbench, out, *args):
+    p = subprocess.run([stepbench, "scan", *args, "--out", str(out), "--quiet"], capture_output=True, text=True,
+                       timeout=120)
+    assert p.returncode == 0, p.stderr
+
+
+@pytest.fixture(scope="module")
+def scan_files(stepbench, tmp_path_factory):
+    d = tmp_path_factory.mktemp("scan_files")
+    for k in (1, 2, 3):
+        scan_cmd(stepbench, d / f"s{k}.h5", "--problem", "stiff_spring", "--param", SPRING_AXIS, "--hz", "30,60",
+                 "--shard", f"{k}/3")
+    p = subprocess.run([stepbench, "merge", "--partial", "-o", str(d / "partial.h5"), str(d / "s1.h5"),
+                        str(d / "s3.h5")], capture_output=True, text=True, timeout=60)
+    assert p.returncode == 0, p.stderr
+    scan_cmd(stepbench, d / "lub.h5", "--problem", "sliding_block", "--param", "sliding_block.material=0:33:34",
+             "--set", "sliding_block.lubricated=1", "--hz", "60", "--substeps", "1,4")
+    scan_cmd(stepbench, d / "budget.h5", "--problem", "stiff_spring", "--param", "stiff_spring.k_s=1e1:1e7:3:log",
+             "--hz", "60,7864320", "--substeps", "1,524288", "--method", "rk8")
+    return d
+
+
+def grafted(study, out, files):
+    """A copy of `study` with each scan file's one scan under /scan/<name>."""
+    import shutil
+    shutil.copyfile(study, out)
+    with h5py.File(out, "r+") as f:
+        for name, path in files.items():
+            with h5py.File(path) as g:
+                (only,) = g["scan"].keys()
+                g.copy(g[f"scan/{only}"], f["scan"], name=name)
+    return out
+
+
+@pytest.fixture(scope="module")
+def gaps_report(plain_study, scan_files, tmp_path_factory):
+    d = tmp_path_factory.mktemp("gaps_report")
+    study = grafted(plain_study, d / "study.h5", {n: scan_files / f for n, f in GRAFTED.items()})
+    p = subprocess.run([PYTHON, REPORT, str(study), "--out", str(d / "report"), "--jobs", "2"], capture_output=True,
+                       text=True, timeout=180)
+    assert p.returncode == 0, p.stderr
+    return study, d / "report", scan_files
+
+
+def scan_part(md, name):
+    """The subsection of one scan in the section."""
+    sec = section(md)
+    start = sec.index(f"\n### Scan {name}: ")
+    end = sec.find("\n### ", start + 1)
+    return sec[start:end if end >= 0 else None]
+
+
+def scan_group(path):
+    """(attrs, points, runs, best) of a file's one scan, read with h5py."""
+    with h5py.File(path) as f:
+        (g,) = f["scan"].values()
+        return dict(g.attrs), g["points"][()], g["runs"][()], g["best"][()]
+
+
+def load_scan(study, name):
+    from stepbench_report import scan as scan_section
+    return next(s for s in scan_section.load(str(study)) if s.name == name)
+
+
+def table_after(part, caption_start):
+    line = next(x for x in part.splitlines() if x.startswith(caption_start))
+    return md_table(part, line)
+
+
+def test_a_partial_merge_says_how_many_points_are_missing(gaps_report):
+    study, folder, files = gaps_report
+    attrs, points, _, _ = scan_group(files / "partial.h5")
+    assert attrs["shard_count"] == 1 and len(points) < attrs["grid_points"]  # a partial merge, as stepbench wrote it
+    part = scan_part(report_text(folder), "partial")
+    m = re.search(r"A partial merge \(`stepbench merge --partial`\): (\d+) of the grid's (\d+) points are "
+                  r"missing", part)
+    assert m, part[:800]
+    assert int(m.group(1)) == attrs["grid_points"] - len(points) == 3
+    assert int(m.group(2)) == attrs["grid_points"] == 9
+    assert f"the scan holds {len(points)}." in part
+    imgs = re.findall(r"!\[[^\]]*\]\((fig/[^)]+\.png)\)", part)
+    assert imgs == ["fig/scan_partial_one_step.png", "fig/scan_partial_cheapest.png"]
+    from matplotlib import image
+    for img in imgs:
+        pixels = image.imread(folder / img)
+        assert pixels.shape[1] <= 1400 and pixels[..., :3].std() > 0.05, img
+
+
+def test_missing_cells_are_neither_stable_nor_unstable(gaps_report, monkeypatch):
+    """The map at one step a frame: each missing point's column is MISSING for every method
+    and rate, neither coloured by an error nor grey, but hatched across the column; the
+    first point not completed is the file's first diverged or failed run among the points
+    it holds, with the missing points below it counted."""
+    from stepbench_report import figures
+    from stepbench_report import scan as scan_section
+    study, folder, files = gaps_report
+    _, points, runs, _ = scan_group(files / "partial.h5")
+    s = load_scan(study, "partial")
+    missing = sorted(set(range(s.grid_points)) - set(points["point"].tolist()))
+    assert missing == [1, 4, 7]
+    kept = []
+    monkeypatch.setattr(figures, "_save", lambda fig, path, tight=True: kept.append(fig))
+    grids = scan_section.one_step_figure(s, None, 1.0, "unused.png")
+    (fig,) = kept
+    x_edges = scan_section._edges(s.values[0], s.log[0])
+    for ax, (err, state) in zip(fig.axes, grids):
+        assert (state[:, missing] == scan_section.MISSING).all()
+        assert np.isnan(err[:, missing]).all()
+        colour, grey = ax.collections[0], ax.collections[1]  # the error colours, the grey of not completed
+        assert colour.get_array().mask.reshape(state.shape)[:, missing].all()
+        assert grey.get_array().mask.reshape(state.shape)[:, missing].all()
+        hatched = [(p.get_x(), p.get_height()) for p in ax.patches if p.get_hatch() == "////"]
+        for i in missing:
+            assert (x_edges[i], len(s.methods)) in hatched, i  # the whole column
+    part = scan_part(report_text(folder), "partial")
+    head, rows = table_after(part, "Where each method stops completing at one step a frame")
+    shown = {r[0]: dict(zip(head, r)) for r in rows}
+    values = s.values[0]
+    for method in s.methods:
+        for hz in (30.0, 60.0):
+            sel = np.sort(runs[(np.char.decode(runs["method"].astype(bytes)) == method) & (runs["hz"] == hz)
+                               & (runs["substeps"] == 1)], order="point")
+            bad = sel["point"][(sel["diverged"] != 0) | (sel["failed"] != 0)]
+            cell = shown[method][f"{hz:g} Hz: first k_s not completed"]
+            if len(bad):
+                below = sum(1 for i in missing if i < bad[0])
+                assert cell == f"{values[bad[0]]:.3g}" + (f" ({below} point{'s' if below != 1 else ''} below it not "
+                                                          "measured)" if below else ""), (method, hz)
+            else:
+                assert cell == f"none of the {len(points)} measured ({len(missing)} not measured)", (method, hz)
+            assert cell != "none"  # never "stable everywhere" with points missing
+
+
+def test_the_cheapest_map_leaves_the_missing_points_out(gaps_report):
+    from stepbench_report import scan as scan_section
+    study, folder, files = gaps_report
+    _, points, _, best = scan_group(files / "partial.h5")
+    s = load_scan(study, "partial")
+    missing = sorted(set(range(s.grid_points)) - set(points["point"].tolist()))
+    held_values = {f"{s.values[0][i]:.3g}" for i in points["point"]}
+    part = scan_part(report_text(folder), "partial")
+    head, rows = table_after(part, "The scan's `best` table by rate")
+    assert head[-1] == "not judged" and len(rows) == 2
+    for row, hz in zip(rows, (30.0, 60.0)):
+        method, substeps, state, _ = scan_section.best_grid(s, hz)
+        assert (state[missing, 0] == scan_section.MISSING).all() and not any(method[missing, 0])
+        counted = 0
+        for cell in (row[1], row[2]):
+            if cell in ("-", "none"):
+                continue
+            for part_text in cell.split("; "):
+                counted += int(re.search(r"\((\d+) points?\)$", part_text).group(1))
+                spans = re.search(r"k_s ([^(]+) \(", part_text).group(1)
+                for v in re.split(r", | \.\. ", spans):
+                    assert v in held_values, (v, part_text)  # never a missing point's k_s
+        mine = best[best["hz"] == hz]
+        assert counted == len(mine) == len(points)  # the points held, not the grid's
+        assert row[3] == f"{len(missing)} points not run (missing shard)"
+        for b in mine:  # each point held: the file's choice, where the figure draws it
+            i = int(b["point"])
+            assert method[i, 0] == text(b["method"]) and (not method[i, 0] or substeps[i, 0] == b["substeps"])
+
+
+def test_a_shard_file_says_which_share_it_holds(gaps_report):
+    from stepbench_report import scan as scan_section
+    study, folder, files = gaps_report
+    attrs, points, _, best = scan_group(files / "s2.h5")
+    assert (attrs["shard_index"], attrs["shard_count"]) == (1, 3)
+    part = scan_part(report_text(folder), "shard2")
+    assert (f"This file is shard {attrs['shard_index'] + 1} of {attrs['shard_count']} of the scan (`stepbench scan "
+            f"--shard 2/3`): it holds {len(points)} of the grid's {attrs['grid_points']} points. The other "
+            f"{attrs['grid_points'] - len(points)} are in the other shards") in part
+    s = load_scan(study, "shard2")
+    others = sorted(set(range(s.grid_points)) - set(points["point"].tolist()))
+    for hz in s.rates:
+        _, state = scan_section.one_step_grid(s, hz)
+        assert (state[:, others] == scan_section.MISSING).all()
+        assert scan_section.unjudged_text(s, hz) == f"{len(others)} points not in this shard"
+        assert sum(c for _, _, c, _ in scan_section.best_summary(s, hz)) == len(best[best["hz"] == hz]) == len(points)
+    assert s.missing_label == "not in this shard"
+
+
+def test_untrusted_points_are_not_judged(gaps_report):
+    """The sliding block lubricated: where the lecture's table lacks the pair's
+    coefficient, stepbench records the point untrusted and runs nothing there. The report
+    says how many, judges none of them, and counts no method stable over them."""
+    from stepbench_report import scan as scan_section
+    study, folder, files = gaps_report
+    _, points, runs, best = scan_group(files / "lub.h5")
+    untrusted = points["point"][points["trusted"] == 0]
+    assert 0 < len(untrusted) < len(points)
+    part = scan_part(report_text(folder), "lub")
+    assert f"{len(untrusted)} of the {len(points)} points have no trusted truth" in part
+    s = load_scan(study, "lub")
+    _, state = scan_section.one_step_grid(s, 60.0)
+    assert (state[:, untrusted] == scan_section.UNTRUSTED).all()
+    trusted = len(points) - len(untrusted)
+    head, rows = table_after(part, "Where each method stops completing at one step a frame")
+    for r in rows:
+        m = r[0]
+        sel = runs[(np.char.decode(runs["method"].astype(bytes)) == m) & (runs["substeps"] == 1)]
+        if not ((sel["diverged"] != 0) | (sel["failed"] != 0)).any():
+            assert r[1] == f"none of the {trusted} measured ({len(untrusted)} not measured)", r
+    head, rows = table_after(part, "The scan's `best` table by rate")
+    assert rows[0][3] == f"{len(untrusted)} points without a trusted truth"
+    method, _, bstate, _ = scan_section.best_grid(s, 60.0)
+    assert (bstate[untrusted, 0] == scan_section.UNTRUSTED).all() and not any(method[untrusted, 0])
+
+
+def test_an_untrusted_point_with_runs_is_not_judged(scan_files, tmp_path):
+    """A point whose references disagreed has runs but no trusted truth: here the merged
+    scan's point 5 marked so (trusted 0, as stepbench writes it). Its diverged runs are not
+    failures, its completed ones not stable, and `best` there is not shown."""
+    from stepbench_report import scan as scan_section
+    import shutil
+    path = tmp_path / "untrusted.h5"
+    shutil.copyfile(scan_files / "partial.h5", path)
+    with h5py.File(path, "r+") as f:
+        p = f["scan/stiff_spring/points"][()]
+        p["trusted"][p["point"] == 5] = 0
+        f["scan/stiff_spring/points"][...] = p
+        runs = f["scan/stiff_spring/runs"][()]
+    at5 = runs[(runs["point"] == 5) & (runs["substeps"] == 1)]
+    assert (at5["diverged"] != 0).any() and (at5["completed"] != 0).any()  # both kinds, to be left out
+    from stepbench_report import study as study_reader
+    with h5py.File(path) as f:
+        s = next(x for x in scan_section.read(study_reader._Reader(str(path), f), f) if x.name == "stiff_spring")
+    for hz in s.rates:
+        err, state = scan_section.one_step_grid(s, hz)
+        assert (state[:, 5] == scan_section.UNTRUSTED).all() and np.isnan(err[:, 5]).all()
+        method, _, bstate, _ = scan_section.best_grid(s, hz)
+        assert bstate[5, 0] == scan_section.UNTRUSTED and method[5, 0] == ""
+        assert sum(c for _, _, c, _ in scan_section.best_summary(s, hz)) == len(s.points) - 1
+        for m in s.methods:
+            first, _, _ = scan_section.boundary(s, hz, m)
+            assert first != s.values[0][5]
+
+
+def test_skipped_runs_are_neither_failures_nor_stable(gaps_report):
+    """rk8 at 7864320 Hz: every run over the work budget, skipped; at 60 Hz the 524288
+    substeps are. A skipped run is not a failure, and no method is stable where none ran."""
+    from stepbench_report import scan as scan_section
+    study, folder, files = gaps_report
+    _, points, runs, best = scan_group(files / "budget.h5")
+    fast = runs[runs["hz"] == 7864320.0]
+    assert (fast["skipped"] != 0).all() and (runs[(runs["hz"] == 60.0) & (runs["substeps"] == 1)]["skipped"] == 0).all()
+    s = load_scan(study, "budget")
+    _, state = scan_section.one_step_grid(s, 7864320.0)
+    assert (state == scan_section.SKIPPED).all()
+    assert scan_section.boundary_text(s, 7864320.0, "rk8") == "not run (over the work budget)"
+    part = scan_part(report_text(folder), "budget")
+    skipped = int(np.sum(runs["skipped"] != 0))
+    assert f"{skipped} of the {len(runs)} runs were not taken: their estimated work exceeds the scan's work budget" \
+        in part
+    head, rows = table_after(part, "Where each method stops completing at one step a frame")
+    shown = dict(zip(head, rows[0]))
+    assert shown["7.86432e+06 Hz: first k_s not completed"] == "not run (over the work budget)"
+    one = np.sort(runs[(runs["hz"] == 60.0) & (runs["substeps"] == 1)], order="point")
+    bad = np.flatnonzero(one["diverged"] != 0)
+    assert shown["60 Hz: first k_s not completed"] == (f"{s.values[0][bad[0]]:.3g}" if len(bad) else "none")
+    head, rows = table_after(part, "The scan's `best` table by rate")
+    by_rate = {r[0]: dict(zip(head, r)) for r in rows}
+    assert by_rate["7.86432e+06 Hz"]["cheapest (method x substeps a frame): where"] == "none"
+    assert by_rate["7.86432e+06 Hz"]["no run within tolerance"] == "-"  # not "none within tolerance": none ran
+    assert by_rate["7.86432e+06 Hz"]["not judged"] == f"{len(points)} points with every run over the work budget " \
+                                                       "(skipped)"
+    none60 = best[(best["hz"] == 60.0) & (np.char.decode(best["method"].astype(bytes)) == "")]
+    if len(none60):  # there, the 524288 substeps were not taken: said so
+        assert by_rate["60 Hz"]["not judged"] == (f"of the points with none within tolerance, {len(none60)} had runs "
+                                                  "not taken (over the work budget)")

@@ -475,7 +475,7 @@ scan_answer answer_scan(const scan_result& s, double tol) {
     double hz;
     std::string method;
     int substeps;
-    std::size_t runs = 0, within = 0;
+    std::size_t runs = 0, within = 0, skipped = 0;
     double worst = 0.0, cost = 0.0;
     std::vector<std::size_t> unstable;  // point indices
   };
@@ -483,7 +483,7 @@ scan_answer answer_scan(const scan_result& s, double tol) {
   const auto find_combo = [&](double hz, const std::string& m, int n) -> combo& {
     for (auto& c : combos)
       if (c.hz == hz && c.method == m && c.substeps == n) return c;
-    combos.push_back({hz, m, n, 0, 0, 0.0, 0.0, {}});
+    combos.push_back({hz, m, n, 0, 0, 0, 0.0, 0.0, {}});
     return combos.back();
   };
   for (const auto& r : s.runs) {
@@ -495,6 +495,7 @@ scan_answer answer_scan(const scan_result& s, double tol) {
     if (m.completed() && m.err_pos_max <= tol) ++c.within;
     c.worst = m.completed() ? std::max(c.worst, m.err_pos_max) : std::numeric_limits<double>::infinity();
     if (m.diverged || m.failed) c.unstable.push_back(r.point);
+    if (m.skipped) ++c.skipped;
     c.cost = std::max(c.cost, static_cast<double>(r.row.work.force_evals) / (p.horizon * r.hz));
   }
   const std::size_t trusted = a.points - a.untrusted;
@@ -536,6 +537,11 @@ scan_answer answer_scan(const scan_result& s, double tol) {
           at.push_back(fmt::format("{} = {:.3g}", s.options.axes[k].param, s.points[c.unstable.front()].values[k]));
         b.where =
             fmt::format("diverges at {} of {} points, first at {}", c.unstable.size(), c.runs, fmt::join(at, ", "));
+      } else if (c.skipped == c.runs) {
+        b.where = "not run: over the work budget at every point";
+      } else if (c.skipped > 0) {
+        b.where = fmt::format("stable at the {} of {} points it ran (the rest over the work budget)",
+                              c.runs - c.skipped, c.runs);
       } else {
         b.where = "stable everywhere";
       }
@@ -621,6 +627,7 @@ scan_result read_scan(const std::string& path, const std::string& name) {
     for (std::size_t k = 0; k < axis_names.size(); ++k)
       o.axes.push_back({axis_names[k], lo[k], hi[k], static_cast<int>(count[k]), log[k] != 0, false});
     o.hz = h5::double_array_attr(g, "hz");
+    o.substeps.clear();  // the file's counts replace the defaults, not extend them
     for (long n : h5::int_array_attr(g, "substeps")) o.substeps.push_back(static_cast<int>(n));
     o.methods = names_of(h5::string_attr(g, "methods"));
     const auto fixed_names = names_of(h5::string_attr(g, "fixed_params"));

@@ -119,6 +119,7 @@ TEST(scan, written_and_read_back) {
   write_study(s, path);
   const scan_result back = read_scan(path, "");
   std::filesystem::remove(path);
+  EXPECT_EQ(back.options.substeps, o.substeps);  // the file's counts, not the defaults and them
   ASSERT_EQ(back.points.size(), 3u);
   ASSERT_EQ(back.runs.size(), s.scans[0].runs.size());
   for (std::size_t i = 0; i < back.runs.size(); ++i) {
@@ -337,7 +338,15 @@ TEST(scan, runs_over_the_work_budget_are_skipped) {
   const scan_result h = run_scan(huge);
   ASSERT_EQ(h.runs.size(), 3u);
   for (const auto& r : h.runs) EXPECT_TRUE(r.row.metrics.skipped);
-  EXPECT_EQ(answer_scan(h, 1.0).choices.at(0).method, "");
+  const scan_answer ha = answer_scan(h, 1.0);
+  EXPECT_EQ(ha.choices.at(0).method, "");
+  // Nor is a method skipped at every point "stable everywhere" at one step a frame.
+  scan_options one = small_spring_scan();
+  one.substeps = {1};
+  one.limits.work_budget = 1.0;  // below one step: every run skipped
+  const scan_answer oa = answer_scan(run_scan(one), 1.0);
+  ASSERT_FALSE(oa.breaks.empty());
+  for (const auto& b : oa.breaks) EXPECT_EQ(b.where, "not run: over the work budget at every point") << b.method;
 }
 
 // Progress must never end a scan: a report that throws (stderr closed) is dropped, and

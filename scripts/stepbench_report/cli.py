@@ -1,4 +1,4 @@
-"""scripts/report [study.h5] [--out results/report] [--problem P] [--self-contained] [--jobs N]
+"""scripts/report [study.h5 | scan.h5] [--out results/report] [--problem P] [--self-contained] [--jobs N]
 [--markdown FILE] [--readme FILE]"""
 import argparse
 import os
@@ -91,8 +91,10 @@ def main(argv=None, start=None):
         description="Turn a stepbench study file into a report folder: index.html (opens offline; the verdict "
                     "first), REPORT.md, summary.json and fig/*.png. The folder is replaced whole: it is built beside "
                     "the target and renamed into place. --markdown and --readme write only the verdict tables "
-                    "(and the folder too when --out is given).")
-    ap.add_argument("study", nargs="?", default="results/study.h5", help="study file (default: %(default)s)")
+                    "(and the folder too when --out is given). A scan file (`stepbench scan --out`, `stepbench "
+                    "merge`: /scan and no problems) gets a report of its scans alone.")
+    ap.add_argument("study", nargs="?", default="results/study.h5",
+                    help="study file, or scan file (default: %(default)s)")
     ap.add_argument("--out", default=None, help="report folder (default: results/report)")
     ap.add_argument("--problem", metavar="P", help="a report (or --markdown, --readme) of this problem only")
     ap.add_argument("--self-contained", action="store_true",
@@ -109,6 +111,16 @@ def main(argv=None, start=None):
     except study.StudyError as e:
         print(f"report: error: {e}", file=sys.stderr)
         return 1
+    if s.scan_only and (args.markdown or args.readme):
+        which = " and ".join(o for o, v in (("--markdown", args.markdown), ("--readme", args.readme)) if v)
+        verb = "write" if " and " in which else "writes"
+        print(f"report: error: '{args.study}' is a scan file (only /scan, no problems): {which} {verb} the verdict "
+              "tables of a study file; nothing written", file=sys.stderr)
+        return 1
+    if s.scan_only and args.problem is not None:
+        print(f"report: error: --problem {args.problem}: '{args.study}' is a scan file (only /scan): it has no "
+              "problem sections", file=sys.stderr)
+        return 2
     if args.problem is not None and args.problem not in [p.name for p in s.problems]:
         print(f"report: error: unknown problem '{args.problem}' (the study has "
               f"{', '.join(p.name for p in s.problems)})", file=sys.stderr)

@@ -328,10 +328,15 @@ def spring_mass(scan, problem=None):
     return SPRING_DEFAULT_MASS
 
 
+def spring_over_ks(scan):
+    """A one-axis scan of the stiff spring over k_s: the scan the overlay is drawn on."""
+    return scan.problem == SPRING and len(scan.axes) == 1 and scan.axes[0] == SPRING_AXIS
+
+
 def has_theory(scan, stability):
-    """The overlay applies to a one-axis scan of the stiff spring over k_s."""
-    return (stability is not None and scan.problem == SPRING and len(scan.axes) == 1
-            and scan.axes[0] == SPRING_AXIS and SPRING_MASS not in scan.axes)
+    """The overlay applies to a one-axis scan of the stiff spring over k_s, in a file whose
+    /stability/limits has rows (a scan file's /stability is empty)."""
+    return stability is not None and len(stability.limits) > 0 and spring_over_ks(scan)
 
 
 def theory_limits(scan, stability, mass):
@@ -534,6 +539,19 @@ def _hatched_handle(state):
     from matplotlib.patches import Patch
     face, ink, hatch = HATCHED[state]
     return Patch(facecolor=face, edgecolor=ink, hatch=hatch, linewidth=0)
+
+
+def held_text(scan):
+    """The points the file holds of the grid's, in words: "holds H of its G grid points
+    (the whole grid | a partial merge: M missing | shard K of N)"."""
+    return f"holds {len(scan.points)} of its {scan.grid_points} grid points ({coverage_kind(scan)})"
+
+
+def coverage_kind(scan):
+    """"shard K of N", "a partial merge: M missing" or "the whole grid"."""
+    if scan.is_shard:
+        return f"shard {scan.shard_index + 1} of {scan.shard_count}"
+    return f"a partial merge: {scan.missing} missing" if scan.missing else "the whole grid"
 
 
 def coverage_text(scan):
@@ -755,6 +773,19 @@ def _axis_text(scan):
     return " by ".join(parts)
 
 
+def method_names(scans):
+    """(name, origin) of every method the scans ran, for figures.Styles where the file has
+    no problems to name them (a scan file): each is a fixed-step method of ours."""
+    return sorted((m, "ours") for m in dict.fromkeys(m for s in scans for m in s.methods))
+
+
+def summary(scans):
+    """summary.json's entry for the scans: what each is and how much of its grid it holds."""
+    return [{"name": s.name, "problem": s.problem, "axes": s.axes, "hz": s.rates, "tol": s.tol,
+             "grid_points": s.grid_points, "points": len(s.points), "shard_index": s.shard_index,
+             "shard_count": s.shard_count} for s in scans]
+
+
 def section(doc, study, figs, scans):
     """The section, after the per-problem and study-wide ones; nothing at all for a study
     without /scan."""
@@ -876,6 +907,10 @@ def _one_step_part(doc, study, figs, scan, name):
     doc.p(text)
     if name in figs:
         doc.img(f"fig/{name}", f"max position error at one step a frame over the scan {scan.name}")
+    if spring_over_ks(scan) and not theory:
+        doc.note("No stability-limit overlay: it needs /stability/limits, which this file does not hold (a scan "
+                 "file never does); the report of a study file with /stability draws it, and `stepbench stability "
+                 "--json` prints the limits.")
     flags = limit_flags(scan, study.stability) if theory else {}
     head = ["method"]
     if theory:

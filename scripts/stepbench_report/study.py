@@ -211,6 +211,11 @@ class Study:
     substeps: object = None  # substeps.Substeps: /substeps, small steps or one implicit step; None when absent
     verdict: object = None  # verdict.Verdict: /verdict, the answer the report opens on; None in an older file
     challenge: object = None  # challenge.Challenge: /challenge, the pendulum challenge, Small Steps; None when absent
+    # A scan file (`stepbench scan --out`, `stepbench merge`): /scan and no problem. Its
+    # report is the scan section alone (report.scan_file_document); problems is empty,
+    # verdict and the study-wide sections None, stability only where /stability/limits
+    # has rows (a scan file's /stability is empty).
+    scan_only: bool = False
 
     @property
     def timed(self):
@@ -429,6 +434,20 @@ class _Reader:
             regions[name] = grid
         return Stability(attrs, limits, re, im, regions)
 
+    def has_scan(self):
+        """The file holds at least one /scan/<name> group."""
+        g = self.f.get("scan")
+        return isinstance(g, h5py.Group) and bool(self.subgroups(g))
+
+    def scan_file(self, attrs, share):
+        """The Study of a scan file (Study.scan_only): the root attributes, and for share 0
+        /stability where its limits table has rows. The scans themselves are read by
+        scan.load, as for a study."""
+        stability = self.stability() if share == 0 else None
+        if stability is not None and not len(stability.limits):
+            stability = None
+        return Study(path=str(self.path), attrs=attrs, problems=[], stability=stability, scan_only=True)
+
     def study(self, share=0, shares=1):
         """Share `share` of `shares` of the study (see load): the problems _problem_share
         gives it and, for share 0, the rest of the file; every share checks the root."""
@@ -456,9 +475,14 @@ class _Reader:
         timed = int(attrs["timing"]) == 1
         if timed:
             self.need_attrs(f, TIMED_ROOT_ATTRS)
-        groups = [g for g in self.need_group(f, "problems").values() if isinstance(g, h5py.Group)]
+        problems_group = f.get("problems")
+        groups = [g for g in problems_group.values() if isinstance(g, h5py.Group)] \
+            if isinstance(problems_group, h5py.Group) else []
         if not groups:
-            raise self.error("/problems holds no problem")
+            if self.has_scan():
+                return self.scan_file(attrs, share)
+            self.need_group(f, "problems")
+            raise self.error("/problems holds no problem and the file has no /scan (neither a study nor a scan file)")
         problems = [self.problem(g, timed) for g in groups[_problem_share(share, shares)]]
         if share > 0:
             return Study(path=str(self.path), attrs=attrs, problems=problems)
@@ -484,7 +508,7 @@ def _merged(shares):
         problems[_problem_share(k, len(shares))] = share.problems
     study.problems = problems
     study.gaps = _gaps(problems)
-    if study.stability is None:
+    if study.stability is None and not study.scan_only:
         study.gaps.append("no /stability group (the stability limits and regions)")
     return study
 

@@ -18,6 +18,8 @@ const char* own_flags_help() {
          "  --quick              CI mode: 8-level ladder, thinned tolerances, min time 0.002 s, 1 repetition\n"
          "  --study_out=PATH     write the study file (timings beside accuracy); results to bench.json beside it\n"
          "  --problem=NAME       sweep and time this problem only, and its scaling family (repeatable)\n"
+         "  --shard=K/N          the timed study of shard K of N: the share of the problems `stepbench sweep\n"
+         "                       --shard K/N` takes, timing only their cases (`stepbench merge` joins the shards)\n"
          "  --set=P.NAME=VALUE   a problem parameter, as stepbench's --set; NAME=VALUE with one --problem\n"
          "  --case_budget=S      cut a family's finer cases once one run would exceed S s (0.5; quick 0.05)\n"
          "  --strict             exit 3 when some case failed (recorded in the study; else exit 0)\n"
@@ -52,7 +54,11 @@ options take_own_flags(int& argc, char** argv, std::vector<std::string>& extra) 
     } else if (a.rfind("--problem=", 0) == 0) {
       o.problems.push_back(a.substr(10));  // checked by run_sweep's validate()
       if (o.problems.back().empty()) throw std::invalid_argument("--problem needs a problem name");
-    } else if (a == "--study_out" || a == "--case_budget" || a == "--set" || a == "--problem") {
+    } else if (a.rfind("--shard=", 0) == 0) {
+      const auto shard = parse_shard(a.substr(8));
+      o.shard_index = shard.index;
+      o.shard_count = shard.count;
+    } else if (a == "--study_out" || a == "--case_budget" || a == "--set" || a == "--problem" || a == "--shard") {
       throw std::invalid_argument(a + " takes its value after '=': " + a + "=VALUE");
     } else if (a.rfind("--study_out=", 0) == 0) {
       o.study_out = a.substr(12);

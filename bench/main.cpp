@@ -130,12 +130,18 @@ int main(int argc, char** argv) {
     }
     sopts.overrides = opts.overrides;
     sopts.problems = opts.problems;
+    sopts.shard_index = opts.shard_index;
+    sopts.shard_count = opts.shard_count;
     validate(sopts);  // before any output: one line and exit 2 on a bad name or value
     bench::progress_line progress("stepbench_bench", !opts.list_only);
     const auto start = std::chrono::steady_clock::now();
-    const std::size_t problem_count = opts.problems.empty() ? problem_names().size() : opts.problems.size();
-    progress.begin(fmt::format("sweeping {} for accuracy", count_of(problem_count, "problem")), sweep_parts(sopts),
-                   "parts");
+    // A shard sweeps and times only its share of the problems (study/sweep.hpp sweep_shard).
+    const auto share = shard_problems(sopts);
+    progress.begin(
+        fmt::format(
+            "sweeping {} for accuracy{}", count_of(share.size(), "problem"),
+            sopts.shard_count > 1 ? fmt::format(" (shard {} of {})", sopts.shard_index + 1, sopts.shard_count) : ""),
+        sweep_parts(sopts), "parts");
     sopts.on_progress = [&](std::size_t, std::size_t) { progress.advance(); };
     sopts.on_warning = [&](const std::string& line) {
       progress.around([&] { std::fprintf(stderr, "%s\n", line.c_str()); });
@@ -146,8 +152,12 @@ int main(int argc, char** argv) {
 
     bench::case_book book(opts.case_budget_s);
     book.register_all(s);
-    bench::register_scaling(opts.problems);
-    bench::register_balls(opts.problems);
+    // The scaling families of the shard's problems only (an empty list selects every one).
+    if (sopts.shard_count == 1 || !share.empty()) {
+      const auto& scaled = sopts.shard_count == 1 ? opts.problems : share;
+      bench::register_scaling(scaled);
+      bench::register_balls(scaled);
+    }
     const std::size_t total = opts.list_only ? 0 : count_selected(argv[0]);
 
     // The display reporter is made after Initialize, from the flags it parsed.
@@ -169,7 +179,7 @@ int main(int argc, char** argv) {
                           std::chrono::duration<double>(std::chrono::steady_clock::now() - timing_start).count())));
     if (opts.list_only) return 0;
 
-    if (!opts.study_out.empty() && !book.any_timed())
+    if (!opts.study_out.empty() && !book.any_timed() && !share.empty())
       throw std::runtime_error("no case was timed (does --benchmark_filter match any?); " + opts.study_out +
                                " was not written");
     book.merge_into_rows();

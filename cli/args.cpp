@@ -4,6 +4,7 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <vector>
 
@@ -57,6 +58,16 @@ void add_override(parameter_overrides& out, std::string_view text, std::span<con
   if (auto why = it->check(value); !why.empty())
     throw std::invalid_argument(fmt::format("--set {}={}: {}", qualified, value_text, why));
   out[problem][name] = value;
+}
+
+shard_choice parse_shard(std::string_view text) {
+  const auto slash = text.find('/');
+  if (slash == std::string_view::npos) throw std::invalid_argument(fmt::format("--shard {}: expected K/N", text));
+  const double k = parse_number(text.substr(0, slash), "--shard K");
+  const double n = parse_number(text.substr(slash + 1), "--shard N");
+  if (!(n >= 1 && n <= 1e6 && n == std::floor(n) && k >= 1 && k <= n && k == std::floor(k)))
+    throw std::invalid_argument(fmt::format("--shard {}: K and N must be whole numbers with 1 <= K <= N", text));
+  return {static_cast<int>(k) - 1, static_cast<int>(n)};
 }
 
 }  // namespace stepbench

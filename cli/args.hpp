@@ -23,6 +23,13 @@ using parameter_overrides = std::map<std::string, std::map<std::string, double>>
 // parameter's declared constraint.
 void add_override(parameter_overrides& out, std::string_view text, std::span<const std::string> selected);
 
+// `--shard K/N`: shard K of N, 1 <= K <= N <= 10^6, as the 0-based index and the count.
+// Throws std::invalid_argument("--shard <text>: ...") on anything else.
+struct shard_choice {
+  int index = 0, count = 1;
+};
+shard_choice parse_shard(std::string_view text);
+
 // A count and its noun, the plural when the count is not one: "1 step", "2 steps",
 // "1 repetition"; `plural` for the irregular ones.
 std::string count_of(long long n, std::string_view singular, std::string_view plural = {});

@@ -1,6 +1,8 @@
-// `stepbench merge`: joins the shards of scans run with `scan --shard K/N` on one machine
-// or many (study/scan.hpp merge_scans) into one study file.
+// `stepbench merge`: joins the shards of a study run with `sweep --shard K/N` or
+// `stepbench_bench --shard=K/N` (study/study_merge.hpp merge_studies), or of scans run with
+// `scan --shard K/N` (study/scan.hpp merge_scans), on one machine or many, into one file.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <map>
 
@@ -8,6 +10,7 @@
 #include "cli/commands.hpp"
 #include "study/scan.hpp"
 #include "study/study_file.hpp"
+#include "study/study_merge.hpp"
 
 namespace stepbench::cli {
 namespace {
@@ -17,6 +20,26 @@ struct merge_args {
   std::string out;
   bool partial = false;
 };
+
+int run_study_merge(const merge_args& a) {
+  const auto r = merge_studies(a.inputs, a.out, a.partial);
+  if (!r.missing.empty())
+    fmt::print(stderr, "merge: {} of the {} selected problems are in no shard (--partial): {}\n", r.missing.size(),
+               r.missing.size() + r.problems.size(), fmt::join(r.missing, ", "));
+  if (!r.machines.empty()) {
+    std::vector<std::string> parts;
+    for (const auto& [machine, problems] : r.machines)
+      parts.push_back(fmt::format("{}: {}", machine, fmt::join(problems, ", ")));
+    fmt::print(stderr,
+               "merge: the shards ran on {} machines ({}); each problem records its machine (/problems/<p> cpu), and "
+               "timings are compared only within a problem\n",
+               r.machines.size(), fmt::join(parts, "; "));
+  }
+  fmt::print(stderr, "merge: {} of {} from {}\n", count_of(static_cast<long long>(r.problems.size()), "problem"),
+             r.problems.size() + r.missing.size(), count_of(static_cast<long long>(a.inputs.size()), "shard"));
+  fmt::print(stderr, "wrote {}\n", a.out);
+  return 0;
+}
 
 int run_merge(const merge_args& a) {
   if (a.inputs.size() < 2) throw std::invalid_argument("merge: give at least two shard files");
@@ -30,6 +53,15 @@ int run_merge(const merge_args& a) {
     if (const std::string b = file_build(path); b != build)
       throw std::invalid_argument(fmt::format("merge: '{}' was written by another build ({}) than '{}' ({})", path, b,
                                               a.inputs.front(), build));
+  // Study shards (written by a sweep) or scan shards, not both.
+  std::vector<bool> study_shard;
+  for (const auto& path : a.inputs) study_shard.push_back(is_study_file(path));
+  for (std::size_t i = 1; i < a.inputs.size(); ++i)
+    if (study_shard[i] != study_shard[0])
+      throw std::invalid_argument(fmt::format("merge: '{}' is a {} and '{}' a {}; merge joins shards of one kind",
+                                              a.inputs[0], study_shard[0] ? "study shard" : "scan file", a.inputs[i],
+                                              study_shard[i] ? "study shard" : "scan file"));
+  if (study_shard[0]) return run_study_merge(a);
   std::map<std::string, std::vector<scan_result>> by_name;
   for (const auto& path : a.inputs)
     for (auto& s : read_scans(path)) by_name[s.options.name].push_back(std::move(s));
@@ -58,13 +90,16 @@ int run_merge(const merge_args& a) {
 
 command add_merge(CLI::App& app) {
   auto a = std::make_shared<merge_args>();
-  auto* sub = app.add_subcommand("merge", "join the shard files of scans run with `scan --shard K/N` into one file");
+  auto* sub = app.add_subcommand(
+      "merge",
+      "join the shard files of a study (`sweep --shard K/N`, `stepbench_bench --shard=K/N`) or of scans "
+      "(`scan --shard K/N`) into one file");
   sub->add_option("inputs", a->inputs, "the shard files")->required();
   sub->add_option("-o,--out", a->out, "the merged file")->required();
-  sub->add_flag("--partial", a->partial, "merge even when some grid points are in no shard (says which)");
+  sub->add_flag("--partial", a->partial, "merge even when some problems (or grid points) are in no shard (says which)");
   sub->footer(
-      "exit codes: 0 merged; 1 a file unreadable or unwritable; 2 shards that overlap, miss points (without "
-      "--partial), or differ in build, format or scan options\n");
+      "exit codes: 0 merged; 1 a file unreadable or unwritable; 2 shards that overlap, miss problems or points "
+      "(without --partial), differ in build, format or options, or mix study and scan shards\n");
   return {sub, [a] { return run_merge(*a); }};
 }
 

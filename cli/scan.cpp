@@ -89,14 +89,9 @@ int run_scan_command(const scan_args& a) {
   }
   o.tol = parse_number(a.tol_text, "--tol");
   if (!a.shard.empty()) {
-    const auto slash = a.shard.find('/');
-    if (slash == std::string::npos) throw std::invalid_argument(fmt::format("--shard {}: expected K/N", a.shard));
-    const double k = parse_number(std::string_view(a.shard).substr(0, slash), "--shard K");
-    const double n = parse_number(std::string_view(a.shard).substr(slash + 1), "--shard N");
-    if (!(n >= 1 && n <= 1e6 && n == std::floor(n) && k >= 1 && k <= n && k == std::floor(k)))
-      throw std::invalid_argument(fmt::format("--shard {}: K and N must be whole numbers with 1 <= K <= N", a.shard));
-    o.shard_index = static_cast<int>(k) - 1;
-    o.shard_count = static_cast<int>(n);
+    const auto shard = parse_shard(a.shard);
+    o.shard_index = shard.index;
+    o.shard_count = shard.count;
   }
   o.methods = a.methods;
   o.jobs = a.jobs;

@@ -15,6 +15,7 @@ namespace {
 struct sweep_args {
   sweep_options opts;
   std::vector<std::string> sets;
+  std::string shard;  // K/N
   std::string out = "results/study.h5";
   bool quiet = false;
   bool quick = false;
@@ -33,6 +34,11 @@ int run_sweep_command(sweep_args a) {
     a.opts.scans = default_scans(true);
     a.opts.tolerances = tolerance_ladder(true);
     a.opts.challenge.enabled = false;  // its timings and 1000 s energy run belong to the full study
+  }
+  if (!a.shard.empty()) {
+    const auto shard = parse_shard(a.shard);
+    a.opts.shard_index = shard.index;
+    a.opts.shard_count = shard.count;
   }
   a.opts.progress = !a.quiet;
   validate(a.opts);
@@ -59,9 +65,10 @@ int run_sweep_command(sweep_args a) {
                    r.vs.pos_rel, r.vs.vel_rel, r.solution.stats.steps, r.solution.stats.rhs_evals_counted);
   }
   std::fflush(stdout);
-  fmt::print(stderr, "wrote {} ({}, {}) in {:.2f} s\n", a.out,
-             count_of(static_cast<long long>(s.problems.size()), "problem"), count_of(a.opts.levels, "level"),
-             s.wall_seconds);
+  fmt::print(stderr, "wrote {} ({}{}, {}) in {:.2f} s\n", a.out,
+             count_of(static_cast<long long>(s.problems.size()), "problem"),
+             a.opts.shard_count > 1 ? fmt::format(": shard {} of {}", a.opts.shard_index + 1, a.opts.shard_count) : "",
+             count_of(a.opts.levels, "level"), s.wall_seconds);
   return report_study_outcome(s, "stepbench", a.strict);
 }
 
@@ -83,6 +90,9 @@ command add_sweep(CLI::App& app) {
   sub->add_option("--base-steps", a->opts.base_steps, "steps at the coarsest level")->capture_default_str();
   sub->add_option("--set", a->sets,
                   "override a parameter, problem.name=value, or name=value with one --problem (repeatable)");
+  sub->add_option("--shard", a->shard,
+                  "K/N: sweep shard K of N, a deterministic share of the selected problems balanced by their counted "
+                  "cost, with every part of the study that belongs to them (`stepbench merge` joins the shards)");
   sub->add_option("--out", a->out, "study file to write")->capture_default_str();
   sub->add_flag("--quick", a->quick, "8 levels (no more) and every other tolerance (the CI study)");
   sub->add_flag("--quiet", a->quiet, "print only the summary line");

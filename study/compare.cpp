@@ -311,8 +311,10 @@ constexpr problem_check problem_checks[] = {check_truth, check_references, check
 std::string number(double v) { return fmt::format("{:.12g}", v); }
 
 void root_differences(const study_data& base, const study_data& next, comparison& out) {
-  // Run-specific figures that always differ are left out.
-  const std::set<std::string> skip{"created_utc", "wall_seconds", "benchmark_wall_seconds"};
+  // Run-specific figures that always differ are left out, and `sweep_options`, the
+  // options as a block of lines for `stepbench merge`: the settings that shape results
+  // have attributes of their own (levels, tolerances, ...), and --set shows as parameters.
+  const std::set<std::string> skip{"created_utc", "wall_seconds", "benchmark_wall_seconds", "sweep_options"};
   // Machine, build and mode first: they decide whether the timings compare at all.
   const std::vector<std::string> first{
       "cpu",        "cores",      "num_cpus",      "mhz_per_cpu", "cpu_scaling_enabled",

@@ -169,9 +169,13 @@ void write_front(H5::Group& g, const problem_study& ps, bool by_time, bool timed
   t.write(g, by_time ? "front_time" : "front_force_evals", schema::find("front"));
 }
 
-void write_problem(H5::Group& parent, const problem_study& ps, bool timed) {
+void write_problem(H5::Group& parent, const problem_study& ps, const std::optional<timing_settings>& timing) {
+  const bool timed = timing.has_value();
   const auto& p = *ps.problem;
   H5::Group g = parent.createGroup(std::string(p.name()));
+  // The machine that ran (and timed) this problem: the root's in a study run on one
+  // machine; in a merge of shards, each problem keeps its shard's (stepbench merge).
+  write_machine(g, timing);
   parameters_table(p.params()).write(g, "parameters", schema::find("parameters"));
   attr(g, "horizon", ps.horizon);
   attr(g, "dim", p.dim());
@@ -347,6 +351,20 @@ void write_scans(H5::H5File& file, const std::vector<scan_result>& scans) {
   }
 }
 
+}  // namespace
+
+void write_machine(H5::H5Object& obj, const std::optional<timing_settings>& timing) {
+  attr(obj, "cpu", cpu_model());
+  attr(obj, "cores", core_count());
+  if (timing) {
+    attr(obj, "num_cpus", timing->num_cpus);
+    attr(obj, "mhz_per_cpu", timing->mhz_per_cpu);
+    attr(obj, "cpu_scaling_enabled", timing->cpu_scaling_enabled);
+  }
+}
+
+namespace {
+
 std::string temp_path_for(const std::string& path) { return fmt::format("{}.tmp.{}", path, ::getpid()); }
 
 // The whole study file built in memory (HDF5's core driver without a backing store;
@@ -368,6 +386,14 @@ std::vector<unsigned char> study_image(const study& s, const std::string& name) 
   attr(file, "created_utc", utc_now_iso8601());
   attr(file, "cpu", cpu_model());
   attr(file, "cores", core_count());
+  if (s.swept) {
+    // Which problems the study selected and which share of them this file holds
+    // (sweep --shard K/N, stepbench_bench --shard=K/N); stepbench merge reads these.
+    attr(file, "selection", fmt::format("{}", fmt::join(selected_problems(s.options), ",")));
+    attr(file, "shard_index", s.options.shard_index);
+    attr(file, "shard_count", s.options.shard_count);
+    attr(file, "sweep_options", describe_options(s.options));
+  }
   attr(file, "levels", s.options.levels);
   attr(file, "max_levels", s.options.max_levels);
   attr(file, "base_steps", s.options.base_steps);
@@ -396,7 +422,7 @@ std::vector<unsigned char> study_image(const study& s, const std::string& name) 
   write_stability(file, s.stability);  // /stability: our compiled steps' limits (study/stability.hpp)
   {
     H5::Group problems = file.createGroup("problems");
-    for (const auto& ps : s.problems) write_problem(problems, ps, s.timed.has_value());
+    for (const auto& ps : s.problems) write_problem(problems, ps, s.timed);
   }
   write_substeps(file, s.substeps, s.timed.has_value());
   write_loop(file, s);           // /loop: the game-loop study (study/loop.hpp), when the study holds one
@@ -541,6 +567,26 @@ void write_study(const study& s, const std::string& path) {
   } catch (const H5::Exception& e) {
     throw std::runtime_error(fmt::format("cannot write results file '{}': HDF5: {}", path, e.getDetailMsg()));
   }
+  write_image(image, path);
+}
+
+H5::H5File in_memory_file(const std::string& path) {
+  H5::FileAccPropList in_memory;
+  in_memory.setCore(std::size_t{1} << 20, false);
+  return H5::H5File(temp_path_for(path), H5F_ACC_TRUNC, H5::FileCreatPropList::DEFAULT, in_memory);
+}
+
+std::vector<unsigned char> file_image(H5::H5File& file) {
+  file.flush(H5F_SCOPE_GLOBAL);
+  const ssize_t size = H5Fget_file_image(file.getId(), nullptr, 0);
+  std::vector<unsigned char> image(size > 0 ? static_cast<std::size_t>(size) : 0);
+  if (size <= 0 || H5Fget_file_image(file.getId(), image.data(), image.size()) != size)
+    throw H5::FileIException("H5Fget_file_image", "cannot take the file's image");
+  return image;
+}
+
+void write_image(const std::vector<unsigned char>& image, const std::string& path) {
+  const std::string tmp = temp_path_for(path);
   const temp_file_guard guard(tmp);
   if (const int error = write_whole(tmp, image)) {
     std::remove(tmp.c_str());

@@ -1,6 +1,7 @@
 #pragma once
 // The study file (HDF5): the public format users script against. Layout documented in
 // docs/study-format.md; bump study_format_version when it changes incompatibly.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,17 @@ void check_writable(const std::string& path);
 // Writes the study to a temporary file beside `path` and renames it into place, so an
 // existing file is replaced whole or not at all.
 void write_study(const study& s, const std::string& path);
+
+// The machine a study ran on (study/machine.hpp), as attributes of `obj`: cpu, cores,
+// and with timings num_cpus, mhz_per_cpu, cpu_scaling_enabled (Google Benchmark's context).
+void write_machine(H5::H5Object& obj, const std::optional<timing_settings>& timing);
+
+// A file built in memory (HDF5's core driver, no backing store) and named after a
+// temporary path beside `path`; its image; and the image written to a temporary file
+// beside `path`, renamed into place when whole (as write_study writes).
+H5::H5File in_memory_file(const std::string& path);
+std::vector<unsigned char> file_image(H5::H5File& file);
+void write_image(const std::vector<unsigned char>& image, const std::string& path);
 
 // The `runs` table of a method's rows (docs/study-format.md); timing fields when timed.
 // A problem's declared parameters (core/parameter.hpp) as the /problems/<p>/parameters

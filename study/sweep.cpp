@@ -1,6 +1,7 @@
 #include "study/sweep.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <chrono>
@@ -60,6 +61,8 @@ void validate(const sweep_options& opts) {
         throw std::invalid_argument(
             fmt::format("frame rate {:g} Hz does not divide the fastest, {:g} Hz", hz, fastest));
   }
+  if (opts.shard_count < 1 || opts.shard_index < 0 || opts.shard_index >= opts.shard_count)
+    throw std::invalid_argument(fmt::format("shard {} of {} does not exist", opts.shard_index + 1, opts.shard_count));
   for (const auto* names : {&opts.problems, &opts.methods})
     for (size_t i = 0; i < names->size(); ++i)
       for (size_t j = 0; j < i; ++j)
@@ -199,8 +202,97 @@ method_study run_method(const problem_study& ps, const method_info& m, const swe
   return ms;
 }
 
-std::size_t sweep_parts(const sweep_options& opts) {
-  return (opts.problems.empty() ? problem_names().size() : opts.problems.size()) + 4;
+std::size_t sweep_parts(const sweep_options& opts) { return shard_problems(opts).size() + 4; }
+
+std::vector<std::string> selected_problems(const sweep_options& opts) {
+  return opts.problems.empty() ? problem_names() : opts.problems;
+}
+
+double sweep_cost(const std::string& problem, const sweep_options& opts) {
+  const auto p = configured_problem(problem, opts);
+  std::size_t methods = 0;
+  for (const auto& m : p->methods()) methods += opts.methods.empty() || contains(opts.methods, m.name);
+  const double ladder = static_cast<double>(opts.base_steps) * (std::ldexp(1.0, opts.levels) - 1.0);
+  return static_cast<double>(p->dim()) * ladder * static_cast<double>(methods);
+}
+
+std::vector<std::string> sweep_shard(const sweep_options& opts, int k, int n) {
+  if (n < 1 || k < 0 || k >= n) throw std::invalid_argument(fmt::format("shard {} of {} does not exist", k + 1, n));
+  const auto names = selected_problems(opts);
+  if (n == 1) return names;
+  std::vector<double> cost;
+  for (const auto& name : names) cost.push_back(sweep_cost(name, opts));
+  std::vector<std::size_t> order(names.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return cost[a] > cost[b]; });
+  std::vector<double> load(static_cast<std::size_t>(n), 0.0);
+  std::vector<std::size_t> mine;
+  for (std::size_t i : order) {
+    const auto least = static_cast<std::size_t>(std::min_element(load.begin(), load.end()) - load.begin());
+    load[least] += cost[i];
+    if (least == static_cast<std::size_t>(k)) mine.push_back(i);
+  }
+  std::sort(mine.begin(), mine.end());
+  std::vector<std::string> out;
+  for (std::size_t i : mine) out.push_back(names[i]);
+  return out;
+}
+
+std::vector<std::string> shard_problems(const sweep_options& opts) {
+  return sweep_shard(opts, opts.shard_index, opts.shard_count);
+}
+
+std::string describe_options(const sweep_options& o) {
+  const auto list = [](const auto& v) { return v.empty() ? std::string("all") : fmt::format("{}", fmt::join(v, ",")); };
+  std::vector<std::string> overrides;
+  for (const auto& [problem, params] : o.overrides)
+    for (const auto& [name, value] : params) overrides.push_back(fmt::format("{}.{}={}", problem, name, value));
+  std::vector<std::string> scans;
+  for (const auto& sc : o.scans) {
+    std::vector<std::string> axes;
+    for (const auto& a : sc.axes)
+      axes.push_back(fmt::format("{}={}:{}:{}{}", a.param, a.lo, a.hi, a.count, a.log ? ":log" : ""));
+    scans.push_back(fmt::format("{} {} at {} Hz, substeps {}, methods {}, tol {}",
+                                sc.name.empty() ? sc.problem : sc.name, fmt::join(axes, " x "), fmt::join(sc.hz, ","),
+                                fmt::join(sc.substeps, ","), list(sc.methods), sc.tol));
+  }
+  std::vector<std::string> energy;
+  for (const auto& e : o.energy.scenes) {
+    std::vector<std::string> params;
+    for (const auto& [name, value] : e.params) params.push_back(fmt::format("{}={}", name, value));
+    energy.push_back(fmt::format("{} {} steps a period{}{}", e.problem, e.steps_per_period, params.empty() ? "" : " ",
+                                 fmt::join(params, ",")));
+  }
+  const auto& ss = o.substeps;
+  const auto& lp = o.loop;
+  const auto& ch = o.challenge;
+  return fmt::format(
+      "selection: {}\nmethods: {}\noverrides: {}\nlevels: {}\nmax_levels: {}\nround_off_fall: {}\n"
+      "base_steps: {}\nsample_count: {}\ntolerances: {}\nreference tolerances: rtol {} atol {}\n"
+      "work budget: {} (adaptive steps {})\n"
+      "substeps: {}; problems {}; explicit {}; implicit {}; counts {}; frames {}\n"
+      "frame rates: {}; {} Hz; substeps {}\n"
+      "loop: {}; problems {}; methods {}; display {} Hz; physics {} Hz; reference {} Hz; jitter {} seed {}; "
+      "clamp {} s; stall {} s at {}; target {}; stated step cost {} ns\n"
+      "energy: {}; periods {}; samples a period {}; series points {}; bounded growth {}; lost {}; methods {}; "
+      "scenes {}\n"
+      "scans: {}\n"
+      "challenge: {}; {} Hz; xpbd substeps {}; horizon {} s; energy horizon {} s; competitors {}; small steps {} "
+      "at {} s",
+      list(selected_problems(o)), list(o.methods),
+      overrides.empty() ? "none" : fmt::format("{}", fmt::join(overrides, ",")), o.levels, o.max_levels,
+      o.round_off_fall, o.base_steps, o.sample_count, fmt::join(o.tolerances, ","), o.tol.rtol, o.tol.atol,
+      o.limits.work_budget, o.limits.max_steps, ss.enabled ? "on" : "off", list(ss.problems), list(ss.explicit_methods),
+      list(ss.implicit_methods), fmt::join(ss.counts, ","), ss.frames, o.frame_rates.enabled ? "on" : "off",
+      fmt::join(o.frame_rates.hz, ","), fmt::join(o.frame_rates.substeps, ","), lp.enabled ? "on" : "off",
+      list(lp.problems), list(lp.methods), fmt::join(lp.display_hz, ","), fmt::join(lp.physics_hz, ","),
+      lp.reference_display_hz, lp.jitter, lp.jitter_seed, lp.clamp_s, lp.stall_s, lp.stall_at_fraction, lp.target,
+      lp.stated_step_cost_ns, o.energy.enabled ? "on" : "off", o.energy.periods, o.energy.samples_per_period,
+      o.energy.series_points, o.energy.bounded_growth, o.energy.lost, list(o.energy.methods),
+      energy.empty() ? "none" : fmt::format("{}", fmt::join(energy, "; ")),
+      scans.empty() ? "none" : fmt::format("{}", fmt::join(scans, "; ")), ch.enabled ? "on" : "off", ch.hz,
+      ch.xpbd_substeps, ch.horizon, ch.energy_horizon, list(ch.competitors), fmt::join(ch.small_steps_counts, ","),
+      ch.small_steps_time);
 }
 
 namespace {
@@ -239,6 +331,11 @@ study run_sweep(const sweep_options& opts) {
   const auto start = std::chrono::steady_clock::now();
   study out;
   out.options = opts;
+  out.swept = true;
+  // This run's problems: the selection, or the shard's share of it. Every later part
+  // (substeps, frame rates, loop, energy, scans, challenge) takes only these problems, so
+  // that the shards of a study hold every part of it once.
+  const auto names = shard_problems(opts);
   const std::size_t parts = sweep_parts(opts);
   std::size_t done = 0;
   // The problems run on `jobs` threads (each problem's runs own their state: the
@@ -256,7 +353,6 @@ study run_sweep(const sweep_options& opts) {
     else
       std::fprintf(stderr, "%s\n", line.c_str());
   };
-  const auto names = opts.problems.empty() ? problem_names() : opts.problems;
   std::vector<problem_study> swept(names.size());
   parallel_indices(
       names.size(), sweep_jobs(opts, names.size()),
@@ -272,15 +368,14 @@ study run_sweep(const sweep_options& opts) {
   // The energy study on the selected problems and methods only.
   energy_options energy = opts.energy;
   energy.progress = opts.progress;
-  if (!opts.problems.empty())
-    std::erase_if(energy.scenes, [&](const energy_scene& e) { return !contains(opts.problems, e.problem); });
+  std::erase_if(energy.scenes, [&](const energy_scene& e) { return !contains(names, e.problem); });
   if (energy.methods.empty()) energy.methods = opts.methods;
   if (energy.scenes.empty()) energy.enabled = false;
   out.energy = run_energy_study(energy, opts.overrides);
   part_done();
   // The parameter scans of the selected problems, with the sweep's methods where named.
   for (scan_options sc : opts.scans) {
-    if (!opts.problems.empty() && !contains(opts.problems, sc.problem)) continue;
+    if (!contains(names, sc.problem)) continue;
     if (!opts.methods.empty()) {
       sc.methods.clear();
       for (const auto& m : make_problem(sc.problem)->methods())
@@ -301,8 +396,8 @@ study run_sweep(const sweep_options& opts) {
                        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
   }
   // The pendulum challenge is one scene, the challenge's own: run with n_pendulum at its defaults.
-  if (opts.challenge.enabled && (opts.problems.empty() || contains(opts.problems, std::string("n_pendulum"))) &&
-      !opts.overrides.contains("n_pendulum") && opts.methods.empty()) {
+  if (opts.challenge.enabled && contains(names, std::string("n_pendulum")) && !opts.overrides.contains("n_pendulum") &&
+      opts.methods.empty()) {
     const auto t0 = std::chrono::steady_clock::now();
     out.challenge = run_challenge(opts.challenge);
     if (opts.progress)

@@ -74,6 +74,10 @@ struct sweep_options {
   challenge_options challenge{};  // the pendulum challenge and Small Steps (study/challenge.hpp), with n_pendulum
   bool progress = false;          // one line per problem on stderr
   int jobs = 0;                   // threads the problems are swept on (0: one a core)
+  // --shard K/N: this run takes shard `shard_index` (0-based) of `shard_count`, a
+  // deterministic share of the selected problems balanced by their counted cost
+  // (sweep_shard), with every part of the study that belongs to those problems.
+  int shard_index = 0, shard_count = 1;
   // A caller's live progress: called after each problem and each later study (frame
   // rates, loop, energy) with the parts done and the total (sweep_parts); and where the
   // sweep's warnings go (a reference that disagrees), so that they do not land on a
@@ -81,6 +85,29 @@ struct sweep_options {
   std::function<void(std::size_t done, std::size_t total)> on_progress;
   std::function<void(const std::string&)> on_warning;
 };
+
+// The problems the options select, in the study's order: opts.problems, or every problem.
+std::vector<std::string> selected_problems(const sweep_options& opts);
+
+// The counted cost of sweeping a problem, computable without running it: its coordinates
+// x the fixed-step ladder's steps over the first `levels` levels (base_steps (2^levels -
+// 1)) x the methods that run on it (an adaptive method counted as one such ladder).
+double sweep_cost(const std::string& problem, const sweep_options& opts);
+
+// The selected problems of shard k of n (0-based), in the study's order: largest counted
+// cost first (ties in the study's order), each to the shard with the least cost so far
+// (ties to the lowest shard). Deterministic: every machine computes the same split, and a
+// shard may hold no problem (n above the selected problems).
+std::vector<std::string> sweep_shard(const sweep_options& opts, int k, int n);
+// The problems this run sweeps: sweep_shard(opts, opts.shard_index, opts.shard_count).
+std::vector<std::string> shard_problems(const sweep_options& opts);
+
+// The options that shape a study, one `name: value` line each (levels, ladders,
+// tolerances, work budget, methods, --set overrides, the substeps, frame-rate, loop,
+// energy, scan and challenge settings, the selection; not the shard): written to the
+// study file (root attribute `sweep_options`) so that `stepbench merge` joins only shards
+// of one study. Doubles in the shortest form that reads back exactly.
+std::string describe_options(const sweep_options& opts);
 
 // The threads run_sweep uses for `problems` problems (opts.jobs, 0: one a core).
 int sweep_jobs(const sweep_options& opts, std::size_t problems);
@@ -148,6 +175,7 @@ struct frame_rate_study {
 
 struct study {
   sweep_options options;
+  bool swept = false;  // made by run_sweep (a scan-only file is not): the file records the selection and shard
   std::vector<problem_study> problems;
   std::vector<substep_study> substeps;
   std::vector<frame_rate_study> frame_rates;

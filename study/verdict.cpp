@@ -131,8 +131,10 @@ std::string cost_text(const std::string& kind, double c) {
   return kind == "time_ns" ? format_time_ns(c) : fmt::format("{:.3g} evals", c);
 }
 
+}  // namespace
+
 // The findings: one sentence each, from the verdicts just computed and the studies'.
-std::vector<std::string> findings_of(const study& s, const verdict_tables& v) {
+std::vector<std::string> findings_of(const verdict_tables& v, const finding_inputs& in) {
   std::vector<std::string> out;
   const bool timed = v.cost_kind == "time_ns";
   // Equal error.
@@ -168,41 +170,34 @@ std::vector<std::string> findings_of(const study& s, const verdict_tables& v) {
     out.push_back(line);
   }
   // Implicit step against substeps.
-  for (const auto& st : s.substeps)
-    for (const auto& sv : substep_verdicts(st, s.timed.has_value()))
-      if (sv.implicit_method == "implicit_euler" && sv.explicit_method == "semi_implicit_euler") {
-        const int n = sv.substeps_at_equal_cost;
-        std::string line = fmt::format("{} (frame {:.3g} s): ", st.problem, st.frame_dt);
-        if (n == 0 && sv.cost_kind == "time_ns")
-          line +=
-              "no timed semi_implicit_euler run costs as little as one implicit_euler step (the substep counts "
-              "that diverge are not timed)";
-        else if (n == 0)
-          line += "even one semi_implicit_euler substep costs more than one implicit_euler step";
-        else if (!std::isfinite(sv.explicit_error))
-          line +=
-              fmt::format("one implicit_euler step costs as much as {} semi_implicit_euler substep{}, which diverge{}",
+  for (const auto& [problem, frame_dt, sv] : in.substeps) {
+    const int n = sv.substeps_at_equal_cost;
+    std::string line = fmt::format("{} (frame {:.3g} s): ", problem, frame_dt);
+    if (n == 0 && sv.cost_kind == "time_ns")
+      line +=
+          "no timed semi_implicit_euler run costs as little as one implicit_euler step (the substep counts "
+          "that diverge are not timed)";
+    else if (n == 0)
+      line += "even one semi_implicit_euler substep costs more than one implicit_euler step";
+    else if (!std::isfinite(sv.explicit_error))
+      line += fmt::format("one implicit_euler step costs as much as {} semi_implicit_euler substep{}, which diverge{}",
                           n, n == 1 ? "" : "s", n == 1 ? "s" : "");
-        else if (sv.explicit_error <= sv.implicit_error)
-          line += fmt::format(
-              "{} semi_implicit_euler substep{} cost as much as one implicit_euler step and are {:.2g}x "
-              "more accurate",
-              n, n == 1 ? "" : "s", sv.implicit_error / sv.explicit_error);
-        else
-          line += fmt::format(
-              "{} semi_implicit_euler substep{} cost as much as one implicit_euler step and are {:.2g}x "
-              "less accurate",
-              n, n == 1 ? "" : "s", sv.explicit_error / sv.implicit_error);
-        if (sv.substeps_to_match > 0) line += fmt::format("; {} substeps match its error", sv.substeps_to_match);
-        out.push_back(line + ".");
-      }
+    else if (sv.explicit_error <= sv.implicit_error)
+      line += fmt::format(
+          "{} semi_implicit_euler substep{} cost as much as one implicit_euler step and are {:.2g}x "
+          "more accurate",
+          n, n == 1 ? "" : "s", sv.implicit_error / sv.explicit_error);
+    else
+      line += fmt::format(
+          "{} semi_implicit_euler substep{} cost as much as one implicit_euler step and are {:.2g}x "
+          "less accurate",
+          n, n == 1 ? "" : "s", sv.explicit_error / sv.implicit_error);
+    if (sv.substeps_to_match > 0) line += fmt::format("; {} substeps match its error", sv.substeps_to_match);
+    out.push_back(line + ".");
+  }
   // Declared orders that do not hold.
   {
-    std::map<std::string, std::set<std::string>> broken;  // method -> problems
-    for (const auto& ps : s.problems)
-      for (const auto& ms : ps.methods)
-        if (ms.info.origin == method_origin::peer && ms.declared_order_holds == 0)
-          broken[ms.info.name].insert(std::string(ps.problem->name()));
+    const auto& broken = in.broken_orders;
     if (!broken.empty()) {
       std::string names;
       for (const auto& [m, ps] : broken)
@@ -234,7 +229,50 @@ std::vector<std::string> findings_of(const study& s, const verdict_tables& v) {
   return out;
 }
 
-}  // namespace
+finding_inputs finding_inputs_of(const study& s) {
+  finding_inputs in;
+  for (const auto& st : s.substeps)
+    for (const auto& sv : substep_verdicts(st, s.timed.has_value()))
+      if (sv.implicit_method == "implicit_euler" && sv.explicit_method == "semi_implicit_euler")
+        in.substeps.push_back({st.problem, st.frame_dt, sv});
+  for (const auto& ps : s.problems)
+    for (const auto& ms : ps.methods)
+      if (ms.info.origin == method_origin::peer && ms.declared_order_holds == 0)
+        in.broken_orders[ms.info.name].insert(std::string(ps.problem->name()));
+  return in;
+}
+
+finding_inputs read_finding_inputs(const H5::Group& root, const std::vector<std::string>& problems) {
+  finding_inputs in;
+  for (const auto& p : problems) {
+    if (h5::is_group(root, "substeps/" + p)) {
+      const H5::Group g = root.openGroup("substeps/" + p);
+      const double frame_dt = h5::double_attr(g, "frame_dt");
+      const auto t = h5::read_table(g.openDataSet("verdict"));
+      const auto &im = t.strings("implicit_method"), &em = t.strings("explicit_method"), &kind = t.strings("cost_kind"),
+                 &summary = t.strings("summary");
+      const auto ic = t.doubles("implicit_cost"), ie = t.doubles("implicit_error"), id = t.doubles("implicit_damping"),
+                 ec = t.doubles("explicit_cost"), ee = t.doubles("explicit_error"), ed = t.doubles("explicit_damping"),
+                 ctm = t.doubles("cost_to_match");
+      const auto &at_cost = t.ints("substeps_at_equal_cost"), &to_match = t.ints("substeps_to_match");
+      for (std::size_t i = 0; i < t.rows(); ++i)
+        if (im[i] == "implicit_euler" && em[i] == "semi_implicit_euler")
+          in.substeps.push_back(
+              {p, frame_dt,
+               substep_verdict{p, im[i], em[i], kind[i], ic[i], ie[i], id[i], static_cast<int>(at_cost[i]), ec[i],
+                               ee[i], ed[i], static_cast<int>(to_match[i]), ctm[i], summary[i]}});
+    }
+    if (h5::is_group(root, "problems/" + p + "/methods")) {
+      const H5::Group methods = root.openGroup("problems/" + p + "/methods");
+      for (const auto& m : h5::children(methods)) {
+        const H5::Group g = methods.openGroup(m);
+        if (h5::string_attr(g, "origin") == "peer" && h5::long_attr(g, "declared_order_holds") == 0)
+          in.broken_orders[m].insert(p);
+      }
+    }
+  }
+  return in;
+}
 
 verdict_tables compute_verdict(const study& s) {
   verdict_tables v;
@@ -300,7 +338,7 @@ verdict_tables compute_verdict(const study& s) {
       }
     }
   }
-  v.findings = findings_of(s, v);
+  v.findings = findings_of(v, finding_inputs_of(s));
   return v;
 }
 
@@ -576,13 +614,23 @@ std::string format_verdict_agreement(const verdict_agreement& a) {
 }
 
 verdict_tables read_verdict(const std::string& path) {
-  verdict_tables v;
   try {
     if (!H5::H5File::isHdf5(path)) throw std::runtime_error("not an HDF5 file");
     const H5::H5File file(path, H5F_ACC_RDONLY);
-    if (!h5::is_group(file, "verdict"))
+    return read_verdict(file);
+  } catch (const H5::Exception& e) {
+    throw std::runtime_error(fmt::format("cannot read the verdict of study file '{}': {}", path, e.getDetailMsg()));
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(fmt::format("cannot read the verdict of study file '{}': {}", path, e.what()));
+  }
+}
+
+verdict_tables read_verdict(const H5::Group& root) {
+  verdict_tables v;
+  {
+    if (!h5::is_group(root, "verdict"))
       throw std::runtime_error("it has no /verdict (written before format_version 4: run the study again)");
-    const H5::Group g = file.openGroup("verdict");
+    const H5::Group g = root.openGroup("verdict");
     v.cost_kind = h5::string_attr(g, "cost_kind");
     const std::string findings = h5::string_attr(g, "findings");
     for (std::size_t a = 0; a < findings.size();) {
@@ -628,10 +676,6 @@ verdict_tables read_verdict(const std::string& path) {
         v.frame_answers.push_back({problem[i], unit[i], method[i], hz[i], target[i], static_cast<int>(substeps[i]),
                                    err[i], cost[i], share[i]});
     }
-  } catch (const H5::Exception& e) {
-    throw std::runtime_error(fmt::format("cannot read the verdict of study file '{}': {}", path, e.getDetailMsg()));
-  } catch (const std::runtime_error& e) {
-    throw std::runtime_error(fmt::format("cannot read the verdict of study file '{}': {}", path, e.what()));
   }
   return v;
 }

@@ -19,9 +19,12 @@
 //  - Findings: a few sentences generated from these and the other studies' verdicts.
 #include <H5Cpp.h>
 
+#include <map>
+#include <set>
 #include <string>
 #include <vector>
 
+#include "study/substeps.hpp"
 #include "study/sweep.hpp"
 
 namespace stepbench {
@@ -80,6 +83,24 @@ struct verdict_tables {
 
 verdict_tables compute_verdict(const study& s);
 
+// What the findings are generated from besides the verdict tables, as a study holds it
+// and as its file does: `stepbench merge` generates a merged study's findings from the
+// merged file by the same code.
+struct substep_finding {
+  std::string problem;
+  double frame_dt = 0.0;
+  substep_verdict verdict;  // implicit_euler against semi_implicit_euler
+};
+struct finding_inputs {
+  std::vector<substep_finding> substeps;                       // in the study's problem order
+  std::map<std::string, std::set<std::string>> broken_orders;  // peer -> problems where its declared order fails
+};
+finding_inputs finding_inputs_of(const study& s);
+// From a study file's /substeps/<p>/verdict and /problems/<p>/methods, for `problems` in
+// that order.
+finding_inputs read_finding_inputs(const H5::Group& root, const std::vector<std::string>& problems);
+std::vector<std::string> findings_of(const verdict_tables& v, const finding_inputs& in);
+
 // /verdict and /frame_rates/<problem> (docs/study-format.md).
 void write_verdict(H5::Group& root, const study& s);
 
@@ -102,5 +123,6 @@ std::string format_verdict_agreement(const verdict_agreement& a);
 // Reads /verdict back from a study file (`stepbench advise --hz`); throws
 // std::runtime_error naming what is missing.
 verdict_tables read_verdict(const std::string& path);
+verdict_tables read_verdict(const H5::Group& root);  // the file's root; errors without the path
 
 }  // namespace stepbench

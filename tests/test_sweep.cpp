@@ -1,7 +1,10 @@
 // The study end to end: observed orders, exactness, every method (ours and the peers)
 // measured by the same code, and the references against the closed forms.
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/drive.hpp"
@@ -338,4 +341,63 @@ TEST(sweep, threads_do_not_change_a_row) {
       }
     }
   }
+}
+
+// --shard K/N (issue 20): the shards partition the selection, each in the study's order,
+// by the counted cost (coordinates x the fixed ladder's steps x methods), largest first to
+// the least-loaded shard: no shard exceeds another by more than the largest single cost.
+TEST(sweep_shard, balanced_by_counted_cost) {
+  sweep_options opts;
+  const auto names = selected_problems(opts);
+  ASSERT_EQ(names, problem_names());
+  const double ladder = 32.0 * (std::ldexp(1.0, opts.levels) - 1.0);
+  double largest = 0.0;
+  for (const auto& name : names) {
+    const auto p = make_problem(name);
+    EXPECT_EQ(sweep_cost(name, opts), static_cast<double>(p->dim()) * ladder * static_cast<double>(p->methods().size()))
+        << name;
+    largest = std::max(largest, sweep_cost(name, opts));
+  }
+  for (int n : {1, 2, 3, 5, static_cast<int>(names.size()) + 2}) {
+    std::vector<std::string> all;
+    std::vector<double> load;
+    for (int k = 0; k < n; ++k) {
+      const auto share = sweep_shard(opts, k, n);
+      EXPECT_EQ(share, sweep_shard(opts, k, n)) << "deterministic";
+      double cost = 0.0;
+      std::size_t at = 0;  // each share is in the selection's order
+      for (const auto& p : share) {
+        cost += sweep_cost(p, opts);
+        const auto it = std::find(names.begin() + static_cast<long>(at), names.end(), p);
+        ASSERT_NE(it, names.end()) << p << " out of order in shard " << k << " of " << n;
+        at = static_cast<std::size_t>(it - names.begin()) + 1;
+      }
+      load.push_back(cost);
+      all.insert(all.end(), share.begin(), share.end());
+    }
+    std::sort(all.begin(), all.end());
+    auto sorted = names;
+    std::sort(sorted.begin(), sorted.end());
+    EXPECT_EQ(all, sorted) << "every problem in exactly one of " << n << " shards";
+    const auto [lo, hi] = std::minmax_element(load.begin(), load.end());
+    EXPECT_LE(*hi - *lo, largest) << n << " shards";
+    if (n > static_cast<int>(names.size())) {
+      EXPECT_EQ(*lo, 0.0) << "a shard with no problem";
+    }
+  }
+  EXPECT_THROW(sweep_shard(opts, 3, 3), std::invalid_argument);
+}
+
+// The shell test's shares (tests/shard_test.sh): four cheap problems in three shards, by
+// cost dim x 32 x 255 x methods at --quick's 8 levels.
+TEST(sweep_shard, four_problems_in_three_shards) {
+  sweep_options opts;
+  opts.levels = opts.max_levels = 8;
+  opts.problems = {"constant_acceleration", "projectile", "damped_spring", "pendulum"};
+  std::vector<double> cost;
+  for (const auto& p : opts.problems) cost.push_back(sweep_cost(p, opts));
+  const auto costs = fmt::format("{}", fmt::join(cost, ", "));
+  EXPECT_EQ(sweep_shard(opts, 0, 3), std::vector<std::string>{"projectile"}) << costs;
+  EXPECT_EQ(sweep_shard(opts, 1, 3), (std::vector<std::string>{"constant_acceleration", "damped_spring"})) << costs;
+  EXPECT_EQ(sweep_shard(opts, 2, 3), std::vector<std::string>{"pendulum"}) << costs;
 }

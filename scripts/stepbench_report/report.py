@@ -159,11 +159,24 @@ def build(study, outdir, workers=2, problem=None, self_contained=False):
         f.write("\n")
 
 
+def machines(study):
+    """Each problem's machine, "<cpu> (<cores> cores)", when the study's problems ran on
+    more than one (shards merged by `stepbench merge`); {} when they ran on one. A file
+    without per-problem machines ran on the root's."""
+    a = study.attrs
+    m = {p.name: f"{p.attrs.get('cpu', a['cpu'])} ({p.attrs.get('cores', a['cores'])} cores)"
+         for p in study.problems}
+    return m if len(set(m.values())) > 1 else {}
+
+
 def headline(study):
     """The line under the title: the study, where and when it ran (the rest in the appendix)."""
     a = study.attrs
     how = f"timed ({a['benchmark_mode']})" if study.timed else "untimed (costs in force evaluations)"
-    return (f"Study `{os.path.basename(study.path)}`, {how}, {a['cpu']}, {a['created_utc']}, commit "
+    n = len(set(machines(study).values()))
+    where = (f"{n} machines ({a['cpu']}; each problem's in its section, and no time is compared across them)"
+             if n else a["cpu"])
+    return (f"Study `{os.path.basename(study.path)}`, {how}, {where}, {a['created_utc']}, commit "
             f"{a['git_commit']}; build and machine in the appendix.")
 
 
@@ -258,6 +271,10 @@ def _problem(doc, study, p, figs):
     params = ", ".join(_parameter(q) for q in p.parameters)
     doc.p(f"{pa['description']}. Horizon {fmt_num(pa['horizon'], 4)} s, position unit {p.unit}, truth: {truth}. "
           f"Parameters: {params}.")
+    if machine := machines(study).get(p.name):
+        doc.note(f"{p.name} ran{' and was timed' if study.timed else ''} on {machine}: this study's shards ran on "
+                 f"more than one machine, so its times are compared with one another only, never with another "
+                 "problem's.")
     if not int(pa["truth_trusted"]):
         doc.note(f"{p.name} has no trusted truth ({pa['truth_note']}): every error on it is NaN, every run is "
                  "marked failed, and it has no cheapest method or front.")

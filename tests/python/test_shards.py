@@ -27,3 +27,24 @@ def test_slurm_script_parses_and_shards():
     text = script.read_text()
     assert '--shard "${SLURM_ARRAY_TASK_ID}/${SLURM_ARRAY_TASK_COUNT}"' in text
     assert "#SBATCH" in text and "stepbench merge" in text
+
+
+def _study(cpus, timed=True):
+    """A stand-in for a merged study: its root attributes and each problem's machine."""
+    from types import SimpleNamespace
+    problems = [SimpleNamespace(name=p, attrs={"cpu": c, "cores": "2"}) for p, c in cpus.items()]
+    root = {"cpu": "; ".join(dict.fromkeys(cpus.values())), "cores": "2", "benchmark_mode": "quick",
+            "created_utc": "2026-12-02T00:00:00Z", "git_commit": "abc"}
+    return SimpleNamespace(attrs=root, problems=problems, timed=timed, path="merged.h5")
+
+
+def test_report_names_each_problems_machine_when_shards_ran_on_several():
+    import sys
+    sys.path.insert(0, str(ROOT / "scripts"))
+    from stepbench_report import report
+    one = _study({"pendulum": "AMD EPYC", "kepler": "AMD EPYC"})
+    assert report.machines(one) == {}
+    assert ", AMD EPYC, " in report.headline(one)
+    two = _study({"pendulum": "AMD EPYC", "kepler": "Intel Xeon"})
+    assert report.machines(two) == {"pendulum": "AMD EPYC (2 cores)", "kepler": "Intel Xeon (2 cores)"}
+    assert "2 machines (AMD EPYC; Intel Xeon; each problem's in its section" in report.headline(two)

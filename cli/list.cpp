@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <algorithm>
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -80,6 +81,26 @@ void print_list(const json& out) {
                : origin == method_origin::peer ? "peers"
                                                : "baseline (for scale, never recommended)",
                render_text(methods));
+    // Methods that run on only some problems (xpbd: the scenes with a constraint view;
+    // Odeint: a state size known at compile time), grouped by the problems they run on.
+    std::vector<std::pair<std::string, std::vector<std::string>>> limited;  // problems, methods
+    for (const auto& m : out["methods"]) {
+      if (m["origin"].get<std::string>() != to_string(origin)) continue;
+      const auto on = m["runs_on"].get<std::vector<std::string>>();
+      if (on.size() == out["problems"].size()) continue;
+      // Whichever is shorter: the problems it runs on, or those it does not.
+      std::vector<std::string> off;
+      for (const auto& p : out["problems"])
+        if (std::ranges::find(on, p["name"].get<std::string>()) == on.end()) off.push_back(p["name"]);
+      const std::string where = on.empty() ? std::string("runs on no problem")
+                                : on.size() <= off.size()
+                                    ? fmt::format("only on {}", fmt::join(on, ", "))
+                                    : fmt::format("on every problem but {}", fmt::join(off, ", "));
+      auto it = std::find_if(limited.begin(), limited.end(), [&](const auto& e) { return e.first == where; });
+      if (it == limited.end()) limited.push_back({where, {}}), it = limited.end() - 1;
+      it->second.push_back(m["name"].get<std::string>());
+    }
+    for (const auto& [where, names] : limited) fmt::print("  {}: {}\n", fmt::join(names, ", "), where);
   }
 }
 
@@ -122,6 +143,10 @@ int run_list(bool as_json) {
               {"capabilities", capabilities_json(m.traits)}};
     j["declared_order"] = std::isfinite(m.declared_order) ? json(m.declared_order) : json(nullptr);
     j["evals_per_step"] = std::isfinite(m.evals_per_step) ? json(m.evals_per_step) : json(nullptr);
+    json runs_on = json::array();
+    for (const auto& p : out["problems"])
+      if (std::ranges::find(p["methods"], json(m.name)) != p["methods"].end()) runs_on.push_back(p["name"]);
+    j["runs_on"] = runs_on;
     out["methods"].push_back(j);
   }
   if (as_json) {

@@ -53,7 +53,14 @@ assert caps["velocity_verlet"]["symplectic"] and caps["velocity_verlet"]["reuses
 assert not caps["rk4"]["symplectic"] and caps["cvode_bdf"]["error_estimate"], caps
 assert caps["implicit_midpoint"]["symplectic"] and caps["implicit_midpoint"]["needs_jacobian"], caps
 assert caps["rk45"]["dense_output"] and caps["rk45"]["reuses_last_force"], caps
+# Where each runs: xpbd only on the scenes with a constraint view; rk4 everywhere.
+on = {m["name"]: set(m["runs_on"]) for m in d["methods"]}
+views = {"pendulum", "n_pendulum", "stiff_spring", "damped_spring", "spring_chain"}
+assert on["xpbd"] == on["xpbd_iterations"] == views, on["xpbd"]
+assert on["rk4"] == names, on["rk4"]
 ' && ok || bad "list --json"
+"$bin" list | grep -q "^  xpbd, xpbd_iterations: only on damped_spring, pendulum, n_pendulum, stiff_spring, spring_chain$" && ok ||
+  bad "list: where xpbd runs"
 
 # n_pendulum's state is link angles; `run` prints what its errors are measured on, the
 # bobs' positions in m: the first bob sits on its 0.3 m circle, each next one 0.3 m on.

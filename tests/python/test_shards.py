@@ -48,3 +48,25 @@ def test_report_names_each_problems_machine_when_shards_ran_on_several():
     two = _study({"pendulum": "AMD EPYC", "kepler": "Intel Xeon"})
     assert report.machines(two) == {"pendulum": "AMD EPYC (2 cores)", "kepler": "Intel Xeon (2 cores)"}
     assert "2 machines (AMD EPYC; Intel Xeon; each problem's in its section" in report.headline(two)
+
+
+def test_study_workflow_shards_the_timed_study_then_merges():
+    doc = yaml.safe_load((ROOT / ".github/workflows/study-shards.yml").read_text())
+    jobs = doc["jobs"]
+    shards = jobs["shard"]["strategy"]["matrix"]["shard"]
+    assert shards == list(range(1, len(shards) + 1)) and len(shards) >= 2
+    runs = " ".join(step.get("run", "") for step in jobs["shard"]["steps"])
+    assert f"stepbench_bench ${{{{ inputs.bench }}}} --shard=${{{{ matrix.shard }}}}/{len(shards)}" in runs
+    assert jobs["merge"]["needs"] == "shard"
+    merge = " ".join(step.get("run", "") for step in jobs["merge"]["steps"])
+    assert "stepbench merge shards/study-*.h5 -o study.h5" in merge and "scripts/report study.h5" in merge
+
+
+def test_slurm_study_script_parses_and_shards():
+    script = ROOT / "scripts/slurm/study-array.sh"
+    subprocess.run(["bash", "-n", str(script)], check=True)
+    text = script.read_text()
+    assert '--shard="${SLURM_ARRAY_TASK_ID}/${SLURM_ARRAY_TASK_COUNT}"' in text
+    # One folder a shard: each writes its bench.json beside its study.
+    assert '--study_out="$out/study.h5"' in text and 'out="results/shards/study-${SLURM_ARRAY_TASK_ID}"' in text
+    assert "#SBATCH" in text and "stepbench merge results/shards/study-*/study.h5" in text

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <filesystem>
 #include <map>
 
 #include "cli/args.hpp"
@@ -24,8 +25,8 @@ struct merge_args {
 int run_study_merge(const merge_args& a) {
   const auto r = merge_studies(a.inputs, a.out, a.partial);
   if (!r.missing.empty())
-    fmt::print(stderr, "merge: {} of the {} selected problems are in no shard (--partial): {}\n", r.missing.size(),
-               r.missing.size() + r.problems.size(), fmt::join(r.missing, ", "));
+    fmt::print(stderr, "merge: {} of the {} selected problems {} in no shard (--partial): {}\n", r.missing.size(),
+               r.missing.size() + r.problems.size(), r.missing.size() == 1 ? "is" : "are", fmt::join(r.missing, ", "));
   if (!r.machines.empty()) {
     std::vector<std::string> parts;
     for (const auto& [machine, problems] : r.machines)
@@ -47,6 +48,12 @@ int run_merge(const merge_args& a) {
     for (std::size_t j = 0; j < i; ++j)
       if (a.inputs[i] == a.inputs[j])
         throw std::invalid_argument(fmt::format("merge: '{}' is named twice (overlapping shards)", a.inputs[i]));
+  // The output must not be one of the inputs (merging would overwrite a shard).
+  for (const auto& path : a.inputs) {
+    std::error_code ec;
+    if (path == a.out || std::filesystem::equivalent(path, a.out, ec))
+      throw std::invalid_argument(fmt::format("merge: the output '{}' is one of the shards; name another file", a.out));
+  }
   // One build: shards of different builds, formats or flags are not one study.
   const std::string build = file_build(a.inputs.front());
   for (const auto& path : a.inputs)

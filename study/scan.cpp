@@ -742,9 +742,11 @@ std::string file_build(const std::string& path) {
     if (!std::filesystem::exists(path)) throw std::runtime_error("no such file");
     if (!H5::H5File::isHdf5(path)) throw std::runtime_error("not an HDF5 file");
     const H5::H5File file(path, H5F_ACC_RDONLY);
-    return fmt::format("format_version {}, commit {}, {} build, flags {}", h5::long_attr(file, "format_version"),
-                       h5::string_attr(file, "git_commit"), h5::string_attr(file, "build_type"),
-                       h5::string_attr(file, "build_flags"));
+    // The compiler and the libraries too: another GSL or SUNDIALS is another truth.
+    return fmt::format("format_version {}, commit {}, {} build, flags {}, {}, {}",
+                       h5::long_attr(file, "format_version"), h5::string_attr(file, "git_commit"),
+                       h5::string_attr(file, "build_type"), h5::string_attr(file, "build_flags"),
+                       h5::string_attr(file, "compiler"), h5::string_attr(file, "dependencies"));
   } catch (const H5::Exception& e) {
     throw std::runtime_error(fmt::format("cannot read the build of '{}': {}", path, e.getDetailMsg()));
   } catch (const std::exception& e) {

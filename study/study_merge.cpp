@@ -269,8 +269,9 @@ study_merge_result merge_studies(const std::vector<std::string>& paths, const st
     for (long k = 0; k < first.count; ++k)
       if (!by_index.count(k)) absent.push_back(fmt::format("{}", k + 1));
     throw std::invalid_argument(
-        fmt::format("merge: {} of the {} selected problems are in no shard ({}){}; --partial merges what there is",
-                    result.missing.size(), selection.size(), fmt::join(result.missing, ", "),
+        fmt::format("merge: {} of the {} selected problems {} in no shard ({}){}; --partial merges what there is",
+                    result.missing.size(), selection.size(), result.missing.size() == 1 ? "is" : "are",
+                    fmt::join(result.missing, ", "),
                     absent.empty() ? ""
                                    : fmt::format(": shard{} {} of {} not given", absent.size() == 1 ? "" : "s",
                                                  fmt::join(absent, ", "), first.count)));
@@ -280,7 +281,14 @@ study_merge_result merge_studies(const std::vector<std::string>& paths, const st
   std::vector<unsigned char> image;
   try {
     H5::H5File dst = in_memory_file(out);
-    copy_attrs(first.file, dst);
+    // The root's build and machine from the lowest shard that holds a problem (a timed
+    // shard with none has no benchmark context: 0 CPUs at 0 MHz).
+    const shard_file* root = nullptr;
+    for (const auto& [index, s] : by_index)
+      if (!root && !s->problems.empty()) root = s;
+    copy_attrs((root ? *root : first).file, dst);
+    if (!result.missing.empty())
+      replace_attr(dst, "missing_problems", fmt::format("{}", fmt::join(result.missing, ",")));
     double wall = 0.0, bench_wall = 0.0;
     for (const auto& s : shards) wall += s.wall_seconds, bench_wall += s.benchmark_wall_seconds;
     result.wall_seconds = wall;
@@ -361,6 +369,14 @@ study_merge_result merge_studies(const std::vector<std::string>& paths, const st
       }
       if (machines.size() > 1) result.machines = machines;
       if (cpus.size() > 1) replace_attr(dst, "cpu", fmt::format("{}", fmt::join(cpus, "; ")));
+      // Frequency scaling on for any problem's timings is on for the study (the report warns).
+      if (has_attr(dst, "cpu_scaling_enabled")) {
+        long scaling = -1;
+        for (const auto& p : result.problems)
+          if (const H5::Group g = dst.openGroup("problems/" + p); has_attr(g, "cpu_scaling_enabled"))
+            scaling = std::max(scaling, h5::long_attr(g, "cpu_scaling_enabled"));
+        if (scaling >= 0) replace_attr(dst, "cpu_scaling_enabled", static_cast<int>(scaling));
+      }
     }
     image = file_image(dst);
     dst.close();

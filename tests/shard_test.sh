@@ -119,7 +119,11 @@ problems = {k: sorted(h5py.File(f"{sys.argv[1]}/s{k}.h5")["problems"]) for k in 
 open(f"{sys.argv[1]}/missing.txt", "w").write(", ".join(p for p in ["constant_acceleration", "projectile", "damped_spring", "pendulum"] if p in problems[2]))
 PY
 missing=$(cat "$work/missing.txt")
-expect_error "selected problems are in no shard ($missing): shard 2 of 3 not given; --partial" merge "$work/s1.h5" "$work/s3.h5" -o "$work/x.h5"
+expect_error "selected problems* \(is\|are\) in no shard ($missing): shard 2 of 3 not given; --partial" merge "$work/s1.h5" "$work/s3.h5" -o "$work/x.h5"
+# The output may not be one of the inputs: the shard is left as it was.
+sum_before=$(md5sum <"$work/s1.h5")
+expect_error "the output '.*s1.h5' is one of the shards" merge "$work/s1.h5" "$work/s2.h5" "$work/s3.h5" -o "$work/s1.h5"
+[ "$(md5sum <"$work/s1.h5")" = "$sum_before" ] && ok || bad "merge -o an input changed it"
 cp "$work/s2.h5" "$work/other_build.h5"
 /usr/bin/python3 -c '
 import h5py, sys
@@ -136,7 +140,7 @@ expect_error "is a study shard and .* a scan file" merge "$work/s1.h5" "$work/sc
 [ ! -e "$work/x.h5" ] && ok || bad "a refused merge wrote its file"
 # --partial merges what there is and names what is missing.
 "$bin" merge "$work/s1.h5" "$work/s3.h5" --partial -o "$work/partial.h5" 2>"$work/err" &&
-  grep -q "are in no shard (--partial): $missing" "$work/err" && ok || bad "merge --partial: $(cat "$work/err")"
+  grep -q "in no shard (--partial): $missing" "$work/err" && ok || bad "merge --partial: $(cat "$work/err")"
 /usr/bin/python3 - "$work/partial.h5" "$work/s1.h5" "$work/s3.h5" <<'PY' && ok || bad "the partial merge"
 import sys, h5py
 m = h5py.File(sys.argv[1])
@@ -144,6 +148,9 @@ have = sorted(sum((list(h5py.File(p)["problems"]) for p in sys.argv[2:]), []))
 assert sorted(m["problems"]) == have, (list(m["problems"]), have)
 assert m.attrs["selection"] == "constant_acceleration,projectile,damped_spring,pendulum"
 assert {p.decode() for p in m["verdict/equal_error"]["problem"]} == set(have)
+# The file names what no shard held.
+missing = [p for p in m.attrs["selection"].split(",") if p not in have]
+assert missing and m.attrs["missing_problems"] == ",".join(missing), (m.attrs.get("missing_problems"), missing)
 PY
 "$bin" sweep --problem projectile --quick --quiet --shard 2/2 --out "$work/empty.h5" 2>"$work/err" &&
   grep -q "0 problems: shard 2 of 2" "$work/err" && ok || bad "a shard with no problem: $(cat "$work/err")"

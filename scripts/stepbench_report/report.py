@@ -176,8 +176,12 @@ def headline(study):
     n = len(set(machines(study).values()))
     where = (f"{n} machines ({a['cpu']}; each problem's in its section, and no time is compared across them)"
              if n else a["cpu"])
+    partial = (f" A partial merge: {len(a['missing_problems'])} selected "
+               f"problem{'s' if len(a['missing_problems']) > 1 else ''} ({', '.join(a['missing_problems'])}) "
+               f"{'were' if len(a['missing_problems']) > 1 else 'was'} in no shard and {'are' if len(a['missing_problems']) > 1 else 'is'} "
+               f"absent from every table." if a.get("missing_problems") else "")
     return (f"Study `{os.path.basename(study.path)}`, {how}, {where}, {a['created_utc']}, commit "
-            f"{a['git_commit']}; build and machine in the appendix.")
+            f"{a['git_commit']}; build and machine in the appendix.{partial}")
 
 
 def document(study, figs, whole=True, scans=None):

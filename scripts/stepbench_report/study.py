@@ -466,6 +466,10 @@ class _Reader:
         if version < schema.FORMAT_VERSION:
             self.lacks = OLDER_FORMATS[version]
         attrs = self.need_attrs(f, ROOT_ATTRS)
+        # A study merged with --partial names the selected problems no shard held.
+        missing = f.attrs.get("missing_problems", "")
+        attrs["missing_problems"] = [p for p in (missing.decode() if isinstance(missing, bytes) else missing).split(",")
+                                     if p]
         self.need_value(f, "timing", int(attrs["timing"]), (0, 1))
         targets = np.atleast_1d(attrs["equal_error_targets"])
         absent = [t for t in SUMMARY_TARGETS if not np.isclose(targets, t, rtol=1e-9, atol=0).any()]

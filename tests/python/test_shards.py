@@ -1,9 +1,11 @@
-"""The schedulers a sharded scan runs on (issue 20): the GitHub Actions workflow is valid
-YAML with a matrix of shards and a merge job after them; the SLURM array script parses
-and passes each task its shard."""
+"""The schedulers sharded scans and studies run on (issue 20): the GitHub Actions
+workflows are valid YAML with a matrix of shards and a merge job after them; the SLURM
+array scripts parse and pass each task its shard; a merged study names its machines and
+what a partial merge lacks."""
 import pathlib
 import subprocess
 
+import h5py
 import yaml
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -70,3 +72,26 @@ def test_slurm_study_script_parses_and_shards():
     # One folder a shard: each writes its bench.json beside its study.
     assert '--study_out="$out/study.h5"' in text and 'out="results/shards/study-${SLURM_ARRAY_TASK_ID}"' in text
     assert "#SBATCH" in text and "stepbench merge results/shards/study-*/study.h5" in text
+
+
+def test_a_partial_merge_says_what_it_lacks(stepbench, tmp_path):
+    """A study merged with --partial names the problems no shard held (missing_problems),
+    and the report's headline says so; a whole merge says nothing of the kind."""
+    import sys
+    sys.path.insert(0, str(ROOT / "scripts"))
+    from stepbench_report import report, study as study_mod
+    problems = ["--problem", "constant_acceleration", "--problem", "projectile", "--problem", "falling_drag"]
+    for k in (1, 2, 3):
+        subprocess.run([stepbench, "sweep", *problems, "--quick", "--quiet", "--shard", f"{k}/3",
+                        "--out", str(tmp_path / f"s{k}.h5")], check=True, capture_output=True)
+    held = {k: list(h5py.File(tmp_path / f"s{k}.h5")["problems"]) for k in (1, 2, 3)}
+    subprocess.run([stepbench, "merge", str(tmp_path / "s1.h5"), str(tmp_path / "s3.h5"), "--partial",
+                    "-o", str(tmp_path / "partial.h5")], check=True, capture_output=True)
+    s = study_mod.load(str(tmp_path / "partial.h5"))
+    assert s.attrs["missing_problems"] == held[2] and held[2]
+    assert f"({', '.join(held[2])})" in report.headline(s) and "A partial merge" in report.headline(s)
+    subprocess.run([stepbench, "merge", *(str(tmp_path / f"s{k}.h5") for k in (1, 2, 3)),
+                    "-o", str(tmp_path / "whole.h5")], check=True, capture_output=True)
+    whole = study_mod.load(str(tmp_path / "whole.h5"))
+    assert "missing_problems" not in h5py.File(tmp_path / "whole.h5").attrs
+    assert whole.attrs["missing_problems"] == [] and "partial" not in report.headline(whole)

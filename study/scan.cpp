@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "core/measure.hpp"
+#include "study/balanced_share.hpp"
 #include "study/h5.hpp"
 #include "study/machine.hpp"
 #include "study/registry.hpp"
@@ -223,16 +224,7 @@ std::vector<std::size_t> scan_shard(const scan_options& opts, int k, int n) {
     for (std::size_t a = 0; a < opts.axes.size(); ++a) p->set(opts.axes[a].param, grid[i][a]);
     size[i] = p->validate().empty() ? static_cast<double>(p->dim()) : 1.0;
   }
-  std::stable_sort(all.begin(), all.end(), [&](std::size_t a, std::size_t b) { return size[a] > size[b]; });
-  std::vector<double> load(static_cast<std::size_t>(n), 0.0);
-  std::vector<std::size_t> out;
-  for (std::size_t i : all) {
-    const auto least = static_cast<std::size_t>(std::min_element(load.begin(), load.end()) - load.begin());
-    load[least] += size[i];
-    if (least == static_cast<std::size_t>(k)) out.push_back(i);
-  }
-  std::sort(out.begin(), out.end());
-  return out;
+  return balanced_share(size, k, n);
 }
 
 scan_result merge_scans(const std::vector<scan_result>& shards, bool partial, std::vector<std::size_t>& missing) {

@@ -157,33 +157,40 @@ void join_table(const std::vector<shard_file>& shards, H5::Group& dst, const std
     if (group.timed_only && !parts.front().has(std::string(group.fields.front().name))) continue;
     for (const auto& f : group.fields) {
       const std::string field(f.name);
+      // The field's values in the merged order, from each part's column (looked up once a part).
+      const auto gather = [&]<class T, class Column>(const std::vector<const Column*>& columns) {
+        std::vector<T> v;
+        v.reserve(rows.size());
+        for (const auto& [r, k, i] : rows) v.push_back(static_cast<T>((*columns[k])[i]));
+        return v;
+      };
+      const auto columns_of = [&](auto read) {
+        std::vector<std::remove_cvref_t<decltype(&read(parts.front()))>> out;
+        for (const auto& p : parts) out.push_back(&read(p));
+        return out;
+      };
       switch (f.type) {
         case schema::field_type::f64: {
-          std::vector<std::vector<double>> cols;
-          for (const auto& p : parts) cols.push_back(p.doubles(field));
-          std::vector<double> v;
-          for (const auto& [r, k, i] : rows) v.push_back(cols[k][i]);
-          t.add(field, std::move(v));
+          std::vector<std::vector<double>> copies;  // doubles() returns a copy: read each part once
+          std::vector<const std::vector<double>*> cols;
+          for (const auto& p : parts) copies.push_back(p.doubles(field));
+          for (const auto& c : copies) cols.push_back(&c);
+          t.add(field, gather.template operator()<double>(cols));
           break;
         }
-        case schema::field_type::i64: {
-          std::vector<std::int64_t> v;
-          for (const auto& [r, k, i] : rows) v.push_back(parts[k].ints(field)[i]);
-          t.add(field, std::move(v));
-          break;
-        }
+        case schema::field_type::i64:
         case schema::field_type::i8: {
-          std::vector<std::int8_t> v;
-          for (const auto& [r, k, i] : rows) v.push_back(static_cast<std::int8_t>(parts[k].ints(field)[i]));
-          t.add(field, std::move(v));
+          const auto cols = columns_of([&](const h5::table_data& p) -> const auto& { return p.ints(field); });
+          if (f.type == schema::field_type::i64)
+            t.add(field, gather.template operator()<std::int64_t>(cols));
+          else
+            t.add(field, gather.template operator()<std::int8_t>(cols));
           break;
         }
-        case schema::field_type::str: {
-          std::vector<std::string> v;
-          for (const auto& [r, k, i] : rows) v.push_back(parts[k].strings(field)[i]);
-          t.add(field, std::move(v));
+        case schema::field_type::str:
+          t.add(field, gather.template operator()<std::string>(
+                           columns_of([&](const h5::table_data& p) -> const auto& { return p.strings(field); })));
           break;
-        }
       }
     }
   }

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "core/drive.hpp"
+#include "study/balanced_share.hpp"
 #include "study/machine.hpp"
 #include "study/substeps.hpp"
 #include "study/verdict.hpp"
@@ -222,17 +223,7 @@ std::vector<std::string> sweep_shard(const sweep_options& opts, int k, int n) {
   if (n == 1) return names;
   std::vector<double> cost;
   for (const auto& name : names) cost.push_back(sweep_cost(name, opts));
-  std::vector<std::size_t> order(names.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return cost[a] > cost[b]; });
-  std::vector<double> load(static_cast<std::size_t>(n), 0.0);
-  std::vector<std::size_t> mine;
-  for (std::size_t i : order) {
-    const auto least = static_cast<std::size_t>(std::min_element(load.begin(), load.end()) - load.begin());
-    load[least] += cost[i];
-    if (least == static_cast<std::size_t>(k)) mine.push_back(i);
-  }
-  std::sort(mine.begin(), mine.end());
+  const auto mine = balanced_share(cost, k, n);
   std::vector<std::string> out;
   for (std::size_t i : mine) out.push_back(names[i]);
   return out;

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "cli/args.hpp"
@@ -19,6 +20,7 @@ namespace {
 
 struct scan_args {
   std::string problem, hz_text, dt_text, substeps_text, tol_text = "1e-3", name, out = "results/scan.h5";
+  std::string reference_budget_text, work_budget_text;
   std::vector<std::string> params, sets, methods;
   int jobs = 0;
   std::string shard;  // K/N
@@ -88,6 +90,18 @@ int run_scan_command(const scan_args& a) {
     }
   }
   o.tol = parse_number(a.tol_text, "--tol");
+  if (!a.work_budget_text.empty()) {
+    o.limits.work_budget = parse_number(a.work_budget_text, "--work-budget");
+    if (!(o.limits.work_budget > 0.0))
+      throw std::invalid_argument(fmt::format("--work-budget {} is not positive", o.limits.work_budget));
+  }
+  if (!a.reference_budget_text.empty()) {
+    o.reference_budget = a.reference_budget_text == "inf" ? std::numeric_limits<double>::infinity()
+                                                          : parse_number(a.reference_budget_text, "--reference-budget");
+    if (!(o.reference_budget > 0.0))
+      throw std::invalid_argument(fmt::format(
+          "--reference-budget {} is not positive (inf: run the references everywhere)", o.reference_budget));
+  }
   if (!a.shard.empty()) {
     const auto shard = parse_shard(a.shard);
     o.shard_index = shard.index;
@@ -150,6 +164,12 @@ command add_scan(CLI::App& app) {
                   "fixed-step methods to run (repeatable; default: our fixed-step methods)");
   sub->add_option("--tol", a->tol_text, "the error tolerance in the problem's unit, err_pos_max")
       ->capture_default_str();
+  sub->add_option("--work-budget", a->work_budget_text,
+                  "skip a run whose estimated work (steps x force evaluations a step x coordinates) is over this "
+                  "(default 2^25, about 0.1 s of force work)");
+  sub->add_option("--reference-budget", a->reference_budget_text,
+                  "run the references at a point only when their predicted work (coordinates x w_max T) is at most "
+                  "this; elsewhere runs are judged on stability alone (default 2e6; inf: everywhere)");
   sub->add_option("--set", a->sets, "fix another parameter, problem.name=value (repeatable)");
   sub->add_option("--name", a->name, "the scan's group under /scan (default: the problem's name)");
   sub->add_option("--jobs", a->jobs, "threads over the grid points (0: one a core)")->check(CLI::NonNegativeNumber);

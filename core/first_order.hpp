@@ -51,25 +51,32 @@ int coupling_bandwidth(const M& m) {
   return static_cast<int>(m.rows()) - 1;
 }
 
-// The references' step budget between two of `outputs` output times. Stiffness: an
-// explicit solver needs steps of about 1 / w_max (its stability limit is a few units of
-// w h), so the budget is at least 20 w_max T / outputs, with w_max bounded by
-// Gershgorin's theorem on dF/dx / m at the start (problems with a Jacobian; 0 otherwise),
-// and at least 2e5. Size: a run may not spend more than 4e9 coordinate evaluations of f
-// (13 evaluations a step for rk8pd), so a problem too large for a reference fails in
-// bounded time (minutes at most) with the solver's message. At least 1000.
+// The fastest natural frequency of the motion at the start, bounded by Gershgorin's
+// theorem on dF/dx / m: w_max <= sqrt(max_i sum_j |dF_i/dx_j| / m) (rad/s). Problems with
+// a Jacobian; 0 otherwise (nothing is known about their stiffness).
 template <problem P>
-long reference_step_budget(const P& p, int outputs) {
-  double w_max = 0.0;
+double fastest_frequency(const P& p) {
   if constexpr (has_jacobian<P>) {
     auto dfdx = p.make_jacobian(), dfdv = p.make_jacobian();
     const auto s0 = p.initial();
     p.jacobian(0.0, s0.x, s0.v, dfdx, dfdv);
     std::vector<double> row_sum(static_cast<std::size_t>(p.dim()), 0.0);
     for_each_entry(dfdx, [&](int i, int, double v) { row_sum[static_cast<std::size_t>(i)] += std::abs(v); });
-    w_max = std::sqrt(*std::max_element(row_sum.begin(), row_sum.end()) / p.mass());
+    return std::sqrt(*std::max_element(row_sum.begin(), row_sum.end()) / p.mass());
+  } else {
+    return 0.0;
   }
-  const double stiff = 20.0 * w_max * p.horizon() / outputs;
+}
+
+// The references' step budget between two of `outputs` output times. Stiffness: an
+// explicit solver needs steps of about 1 / w_max (its stability limit is a few units of
+// w h), so the budget is at least 20 w_max T / outputs (w_max: fastest_frequency), and
+// at least 2e5. Size: a run may not spend more than 4e9 coordinate evaluations of f
+// (13 evaluations a step for rk8pd), so a problem too large for a reference fails in
+// bounded time (minutes at most) with the solver's message. At least 1000.
+template <problem P>
+long reference_step_budget(const P& p, int outputs) {
+  const double stiff = 20.0 * fastest_frequency(p) * p.horizon() / outputs;
   const double size_cap = 4e9 / (13.0 * 2.0 * p.dim() * outputs);
   return static_cast<long>(std::max(1000.0, std::min(std::max(2e5, stiff), size_cap)));
 }

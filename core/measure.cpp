@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 
 namespace stepbench {
@@ -180,6 +181,13 @@ void truth_from_references(const problem_instance& problem, truth_table& t, cons
 
 }  // namespace
 
+double predicted_reference_work(const problem_instance& problem, double horizon) {
+  double w = problem.fastest_frequency();
+  if (!(w > 0.0) && std::isfinite(problem.period()) && problem.period() > 0.0)
+    w = 2.0 * std::numbers::pi / problem.period();
+  return 2.0 * problem.dim() * std::max(1.0, w * horizon);
+}
+
 truth_table build_truth(const problem_instance& problem, std::span<const double> times, const truth_options& opts) {
   truth_table t;
   t.times.assign(times.begin(), times.end());
@@ -187,6 +195,20 @@ truth_table build_truth(const problem_instance& problem, std::span<const double>
   const bool closed = opts.use_closed_form && problem.has_closed_form();
   if (!closed && !opts.run_references)
     throw std::invalid_argument(fmt::format("problem {}: no closed form and references disabled", problem.name()));
+  if (opts.run_references && !closed && !times.empty()) {
+    const double predicted = predicted_reference_work(problem, times.back());
+    if (predicted > opts.reference_budget) {
+      // Not run: nothing to compare, so no truth; the runs are judged on stability alone.
+      t.trusted = false;
+      t.source = "none";
+      t.note = fmt::format(
+          "references not run: their predicted work, {:.3g} ({} coordinates x w_max T = {:.3g} rad), is over the "
+          "reference budget of {:.3g}",
+          predicted, 2 * problem.dim(), problem.fastest_frequency() * times.back(), opts.reference_budget);
+      t.y.assign(t.times.size(), std::vector<double>(2 * problem.dim(), std::numeric_limits<double>::quiet_NaN()));
+      return t;
+    }
+  }
   if (opts.run_references) t.references = run_references(problem, times, opts);
   std::vector<reference_check*> ok;
   for (auto& r : t.references)
@@ -235,9 +257,23 @@ run_metrics measure(const problem_instance& problem, const run_result& run, cons
     return all_nan();
   }
   if (!truth.trusted) {
+    // No truth to measure the error against, but a blow-up needs none: positions past
+    // (blowup_factor + 1) times the initial state's extent are the run's own growth (the
+    // truth-based test below, |x - x_true| > blowup_factor x amplitude, on a motion that
+    // stays within its initial extent; a problem starting at the origin is not judged).
+    const double extent = norm_part(problem.observed(problem.initial()), 0, observed_dim);
+    double reach = 0.0;
+    for (const auto& y : run.sample_y) reach = std::max(reach, norm_part(problem.observed(y), 0, observed_dim));
+    all_nan();
+    if (extent > 0.0 && !(reach <= (blowup_factor + 1.0) * extent)) {
+      m.diverged = true;
+      m.note = fmt::format("position {:.3g} exceeds {:g} times the initial extent {:.3g} (no trusted truth here)",
+                           reach, blowup_factor + 1.0, extent);
+      return m;
+    }
     m.failed = true;
     m.note = "no trusted truth: " + truth.note;
-    return all_nan();
+    return m;
   }
   if (run.sample_t.size() != truth.times.size())
     throw std::logic_error("measure: the run's samples do not match the truth's times");

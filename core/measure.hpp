@@ -9,6 +9,7 @@
 // no two references agree within the limit, the problem has no trusted truth: every
 // error is NaN and the reason is recorded, rather than measuring against a solver that
 // may be wrong.
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -60,7 +61,21 @@ struct truth_options {
   // Global error of a tolerance-controlled solver runs 10-1000 times its local
   // tolerance; 1e4 * rtol leaves room for that and still catches a broken reference.
   double agreement_limit_factor = 1e4;
+  // The references run only when their predicted work (predicted_reference_work) is at
+  // most this; above it the truth is "none", not trusted, and the note says why (a scan
+  // point whose references would take hours; the sweep keeps the default: no limit).
+  double reference_budget = std::numeric_limits<double>::infinity();
 };
+
+// What the references' work grows as: the state's coordinates (first-order: 2 x dim)
+// times the radians the fastest mode turns over the horizon, w_max T (at least 1; w_max
+// from problem.fastest_frequency(), else 2 pi / period(), else 0). Resolving every mode to
+// the references' 1e-13 takes a number of steps a radian of it: on spring_chain at 64 and
+// 256 masses, k_s 1e5, 3 to 22 steps a radian for each of the four, and their summed time
+// grows as this estimate, about 6 us a unit on one core (about 1000 evaluations of one
+// coordinate's force: reference_work_in_evaluations).
+inline constexpr double reference_work_in_evaluations = 1000.0;
+double predicted_reference_work(const problem_instance& problem, double horizon);
 
 // Builds the truth at `times` (increasing, > 0). Throws std::runtime_error only when
 // the closed form itself is not finite (parameters out of range).

@@ -60,6 +60,9 @@ class problem_instance {
   // The exact contacts up to t_end; throws std::logic_error for a problem without them.
   virtual bool has_exact_contacts() const = 0;
   virtual exact_contact_list exact_contacts(double t_end) const = 0;
+  // The fastest natural frequency at the start (rad/s), a Gershgorin bound from the force
+  // Jacobian (core/first_order.hpp fastest_frequency); 0 for a problem without one.
+  virtual double fastest_frequency() const = 0;
   // The first-order form y' = [v; F/m] for the reference solvers.
   virtual ode_system ode() const = 0;
 

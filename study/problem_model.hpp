@@ -142,6 +142,7 @@ class problem_model final : public problem_instance {
     const auto s = p_.initial();
     return flatten(s.x, s.v);
   }
+  double fastest_frequency() const override { return stepbench::fastest_frequency(p_); }
   ode_system ode() const override {
     ode_system sys = make_ode_system(p_);
     if constexpr (stepbench::has_contacts<P>) {

@@ -254,6 +254,7 @@ void write_scans(H5::H5File& file, const std::vector<scan_result>& scans) {
     attr(g, "reference_rtol", o.ref_tol.rtol);
     attr(g, "reference_atol", o.ref_tol.atol);
     attr(g, "work_budget", o.limits.work_budget);
+    attr(g, "reference_budget", o.reference_budget);
     attr(g, "wall_seconds", sc.wall_seconds);
     attr(g, "grid_points", static_cast<long>(sc.grid_points));
     attr(g, "shard_index", o.shard_index);

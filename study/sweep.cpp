@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "core/drive.hpp"
+#include "core/measure.hpp"
 #include "study/balanced_share.hpp"
 #include "study/machine.hpp"
 #include "study/substeps.hpp"
@@ -214,7 +215,9 @@ double sweep_cost(const std::string& problem, const sweep_options& opts) {
   std::size_t methods = 0;
   for (const auto& m : p->methods()) methods += opts.methods.empty() || contains(opts.methods, m.name);
   const double ladder = static_cast<double>(opts.base_steps) * (std::ldexp(1.0, opts.levels) - 1.0);
-  return static_cast<double>(p->dim()) * ladder * static_cast<double>(methods);
+  // The references run on every problem (checked against a closed form where there is one).
+  return static_cast<double>(p->dim()) * ladder * static_cast<double>(methods) +
+         reference_work_in_evaluations * predicted_reference_work(*p, p->horizon());
 }
 
 std::vector<std::string> sweep_shard(const sweep_options& opts, int k, int n) {

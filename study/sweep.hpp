@@ -91,7 +91,9 @@ std::vector<std::string> selected_problems(const sweep_options& opts);
 
 // The counted cost of sweeping a problem, computable without running it: its coordinates
 // x the fixed-step ladder's steps over the first `levels` levels (base_steps (2^levels -
-// 1)) x the methods that run on it (an adaptive method counted as one such ladder).
+// 1)) x the methods that run on it (an adaptive method counted as one such ladder), plus
+// its reference solves' predicted work (core/measure.hpp predicted_reference_work, in
+// coordinate evaluations: x reference_work_in_evaluations).
 double sweep_cost(const std::string& problem, const sweep_options& opts);
 
 // The selected problems of shard k of n (0-based), in the study's order: largest counted

@@ -9,8 +9,11 @@
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <numbers>
 
+#include "core/measure.hpp"
+#include "study/registry.hpp"
 #include "study/scan.hpp"
 #include "study/study_file.hpp"
 #include "study/sweep.hpp"
@@ -155,8 +158,13 @@ TEST(scan, shards_merge_to_the_unsharded_scan) {
   std::sort(seen.begin(), seen.end());
   ASSERT_EQ(seen.size(), 9u);
   for (std::size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], i) << "each point in exactly one shard";
-  // Balanced by size: the 16-mass points (the largest) go to different shards.
-  for (const auto& s : shards) EXPECT_EQ(s.points.size(), 3u);
+  // Balanced by size, the references' predicted work most of it (it grows as masses^1.5
+  // k_s^0.5): the stiffest 16-mass rope, the largest by far, has a shard to itself.
+  std::size_t alone = 0;
+  for (const auto& s : shards)
+    for (const auto& p : s.points)
+      if (p.values == std::vector<double>{16, 1e4}) alone += s.points.size() == 1;
+  EXPECT_EQ(alone, 1u);
   std::vector<std::size_t> missing;
   const scan_result merged = merge_scans({shards[2], shards[0], shards[1]}, false, missing);
   EXPECT_TRUE(missing.empty());
@@ -363,4 +371,74 @@ TEST(scan, a_failing_progress_report_does_not_end_the_scan) {
   EXPECT_EQ(reports, 3);
   EXPECT_EQ(s.points.size(), 3u);
   EXPECT_EQ(s.runs.size(), 3u);
+}
+
+// The references' predicted work (core/measure.hpp): first-order coordinates x w_max T,
+// w_max the Gershgorin bound of dF/dx / m. On the rope at rest length, a middle mass's
+// row of dF/dx along the rope is -2 k_s on the diagonal and k_s to each neighbour, so the
+// bound is sqrt(4 k_s / m) = 2 sqrt(k_s / m) exactly (a chain's highest mode is just below it).
+TEST(scan, the_references_predicted_work_is_coordinates_times_w_max_t) {
+  auto p = make_problem("spring_chain");
+  p->set("masses", 64);
+  p->set("k_s", 1e4);
+  const double m = 1.0 / 64.0, w = 2.0 * std::sqrt(1e4 / m);
+  EXPECT_NEAR(p->fastest_frequency(), w, 1e-9 * w);
+  EXPECT_NEAR(predicted_reference_work(*p, 0.5), 2.0 * 192 * w * 0.5, 1e-9 * 192 * w);
+  // No Jacobian, a period: w = 2 pi / period; neither: at least one radian.
+  auto pendulum = make_problem("pendulum");
+  ASSERT_TRUE(std::isfinite(pendulum->period()));
+  EXPECT_NEAR(predicted_reference_work(*pendulum, 3.0),
+              2.0 * pendulum->dim() * std::max(1.0, 2.0 * std::numbers::pi / pendulum->period() * 3.0), 1e-12);
+}
+
+// Over the reference budget the references are not run: the point has no trusted truth
+// and says why, and its runs are judged on stability alone. Stability needs no truth: the
+// runs that diverge with the references' truth are those that diverge without it, and
+// every other run completes (none "failed" for the missing truth).
+TEST(scan, over_the_reference_budget_a_point_is_judged_on_stability) {
+  scan_options o;
+  o.problem = "spring_chain";
+  o.axes = {parse_scan_axis("spring_chain.masses=8:64:2:log", "spring_chain"),
+            parse_scan_axis("spring_chain.k_s=1e2:1e4:2:log", "spring_chain")};
+  o.hz = {60};
+  o.substeps = {1, 4};
+  o.reference_budget = std::numeric_limits<double>::infinity();
+  const scan_result with = run_scan(o);
+  o.reference_budget = 1.0;
+  const scan_result without = run_scan(o);
+  ASSERT_EQ(with.runs.size(), without.runs.size());
+  for (const auto& p : with.points) EXPECT_TRUE(p.trusted) << p.note;
+  std::size_t diverged = 0, completed = 0;
+  for (const auto& p : without.points) {
+    EXPECT_FALSE(p.trusted);
+    EXPECT_EQ(p.truth_source, "none");
+    EXPECT_EQ(p.note.rfind("references not run: their predicted work", 0), 0u) << p.note;
+    EXPECT_NE(p.note.find("over the reference budget of 1"), std::string::npos) << p.note;
+  }
+  for (std::size_t i = 0; i < with.runs.size(); ++i) {
+    const auto &a = with.runs[i].row.metrics, &b = without.runs[i].row.metrics;
+    ASSERT_EQ(with.runs[i].method, without.runs[i].method);
+    EXPECT_EQ(a.diverged, b.diverged) << without.runs[i].method << " at point " << with.runs[i].point << ": " << a.note
+                                      << " / " << b.note;
+    EXPECT_FALSE(b.failed) << b.note;
+    if (b.completed()) {
+      ++completed;
+      EXPECT_TRUE(std::isnan(b.err_pos_max));
+      EXPECT_EQ(b.note, "completed; no trusted truth at this point to measure its error");
+    }
+    diverged += b.diverged;
+  }
+  EXPECT_GT(diverged, 0u);  // euler at one step a 60 Hz frame on the stiffer ropes
+  EXPECT_GT(completed, 0u);
+  // The answer: stability over every point, no tolerance claim without a truth.
+  const scan_answer a = answer_scan(without, 1.0);
+  EXPECT_EQ(a.untrusted, 4u);
+  for (const auto& c : a.choices) EXPECT_EQ(c.method, "") << "nothing is within a tolerance without a truth";
+  const scan_answer b = answer_scan(with, 1.0);
+  ASSERT_EQ(a.breaks.size(), b.breaks.size());
+  for (std::size_t i = 0; i < a.breaks.size(); ++i)
+    EXPECT_EQ(a.breaks[i].where, b.breaks[i].where) << a.breaks[i].method;
+  EXPECT_NE(format_scan_answer(a).find("4 of 4 points have no trusted truth: their runs are judged on stability alone"),
+            std::string::npos)
+      << format_scan_answer(a);
 }

@@ -215,7 +215,7 @@ def document(study, figs, whole=True, scans=None):
 # uses), each where the file has it.
 SCAN_FILE_KEYS = ["version", "git_commit", "compiler", "build_type", "build_flags", "dependencies", "created_utc",
                   "cpu", "cores", "format_version", "wall_seconds"]
-SCAN_ATTR_KEYS = ["work_budget", "reference_rtol", "reference_atol", "wall_seconds"]
+SCAN_ATTR_KEYS = ["work_budget", "reference_budget", "reference_rtol", "reference_atol", "wall_seconds"]
 
 
 def _scan_title(scan):

@@ -4,16 +4,21 @@
 Every number is the study file's. The runs, the cheapest run at each point and rate
 (`best`) and the range answer were computed by stepbench (study/scan.cpp; `stepbench
 advise --scan FILE --tol X` prints the range answer); nothing here ranks or chooses. The
-report reads the runs at one step a frame (substeps == 1) for the map of each method, and
-`best` as it is for the map of the cheapest method. The one piece of arithmetic is the
-stiff spring's theory overlay: the k_s at which omega dt equals each method's oscillator
-limit from /stability/limits (`theory`), k_s = mass_kg (limit * hz)^2.
+report reads the runs at one step a frame (substeps == 1) for the map of each method (one
+axis: a row per method; two axes: a small map per method, a figure per rate), and `best`
+as it is for the map of the cheapest method. The one piece of arithmetic is the stiff
+spring's theory overlay: the k_s at which omega dt equals each method's oscillator limit
+from /stability/limits (`theory`), k_s = mass_kg (limit * hz)^2.
 
 A scan need not hold every point of its grid: a shard file (`scan --shard K/N`) holds its
 share, a `merge --partial` holds the points of the shards merged. Point numbers are the
-grid's. A point not in the file, a point whose truth is not trusted (points.trusted 0)
-and a run skipped for the work budget (runs.skipped) are drawn as such (hatched) and take
-no part in any statement here: not stable, not unstable, never the cheapest.
+grid's. A point not in the file and a run skipped for the work budget (runs.skipped) are
+drawn as such (hatched) and take no part in any statement here: not stable, not unstable,
+never the cheapest. A point whose truth is not trusted (points.trusted 0; its references
+may not have been run, over the scan's `reference_budget`) is judged on stability alone,
+as stepbench judges it: a run there that diverged or failed did not complete (UNSTABLE), a
+run that completed is stable (STABLE_NO_TRUTH, hatched: no error to colour it by); its
+error, the tolerance and the cheapest run are not judged there.
 
 The study reader (study.py) predates the scans and does not hold them; load() reads
 /scan through the same checked reader (study._Reader: need_attrs, need_table)."""
@@ -36,16 +41,24 @@ SPRING_AXIS = "k_s"
 SPRING_MASS = "mass_kg"
 SPRING_DEFAULT_MASS = 1.0
 
-# What a cell of the maps shows (one_step_grid, best_grid). Only OK, UNSTABLE, CHOSEN and
-# NONE are statements about a run; the others say why there is none to make.
+# What a cell of the maps shows (one_step_grid, best_grid). Only OK, UNSTABLE,
+# STABLE_NO_TRUTH, CHOSEN and NONE are statements about a run; the others say why there is
+# none to make.
 OK = 0  # the run completed: coloured by its error
-UNSTABLE = 1  # the run diverged or failed
+UNSTABLE = 1  # the run diverged or failed (at a point with a trusted truth or without)
 SKIPPED = 2  # the run was not taken: its estimated work exceeds the scan's work budget
 NO_RUN = 3  # the point was measured, but the scan has no such run
-UNTRUSTED = 4  # the point's truth is not trusted (points.trusted 0): nothing is judged there
+UNTRUSTED = 4  # the point's truth is not trusted (points.trusted 0) and there is no run to judge; in
+#                best_grid: no cheapest there (no error, so no tolerance)
 MISSING = 5  # the point is not in the file (another shard's, or a shard not merged)
 CHOSEN = 6  # best_grid: `best` names a run
 NONE = 7  # best_grid: no run taken at the point and rate is within tol
+STABLE_NO_TRUTH = 8  # the run completed at a point without a trusted truth: stable, its error not measured
+# A stepbench before the scans judged stability without a truth stored such a completed run
+# as failed, with this note (core/measure.cpp, measure); it did complete.
+OLD_NO_TRUTH_NOTE = "no trusted truth: "
+# The start of a point's note when its references were not run (over `reference_budget`).
+NO_REFERENCES_NOTE = "references not run"
 
 
 @dataclass
@@ -252,28 +265,35 @@ def load(path):
 # --- what the figures and tables show -------------------------------------------------------------
 
 def one_step_grid(scan, hz, methods=None):
-    """The map of one rate at one step a frame, one axis only: (log10 err_pos_max, state),
-    each methods x points. state: OK (the run completed; err its error), UNSTABLE (it
-    diverged or failed), SKIPPED (not taken: over the work budget), NO_RUN (no such run),
-    UNTRUSTED (the point's truth is not trusted: its runs are not judged), MISSING (the
-    file does not hold the point). err is NaN but where OK."""
+    """The map of one rate at one step a frame: (log10 err_pos_max, state), each methods x
+    grid points (the point number; for two axes, reshape a row to scan.shape). state: OK
+    (the run completed at a point with a trusted truth; err its error), UNSTABLE (it
+    diverged or failed, truth or not), STABLE_NO_TRUTH (it completed at a point without a
+    trusted truth: stable, no error to measure), SKIPPED (not taken: over the work budget),
+    NO_RUN (no such run at a trusted point), UNTRUSTED (no such run at a point without a
+    trusted truth: nothing to judge), MISSING (the file does not hold the point). err is
+    NaN but where OK. A run that an older stepbench stored as failed only for the missing
+    truth (note OLD_NO_TRUTH_NOTE; it had completed) is STABLE_NO_TRUTH too."""
     methods = scan.methods if methods is None else methods
-    n = scan.shape[0]
+    n = scan.grid_points
     err = np.full((len(methods), n), np.nan)
     state = np.full((len(methods), n), NO_RUN)
     state[:, ~scan.held] = MISSING
-    state[:, scan.held & ~scan.trusted] = UNTRUSTED
     trusted = scan.trusted
+    state[:, scan.held & ~trusted] = UNTRUSTED
     rows = scan.runs[(scan.runs["hz"] == hz) & (scan.runs["substeps"] == 1)]
     done = schema.completed(rows)
     row_of = {m: k for k, m in enumerate(methods)}
     for r, ok in zip(rows, done):
         k = row_of.get(r["method"])
         i = int(r["point"])
-        if k is None or not trusted[i]:
+        if k is None:
             continue
         if r["skipped"]:
             state[k, i] = SKIPPED
+        elif not trusted[i]:
+            old = bool(r["failed"]) and not r["diverged"] and str(r["note"]).startswith(OLD_NO_TRUTH_NOTE)
+            state[k, i] = STABLE_NO_TRUTH if ok or old else UNSTABLE
         elif not ok:
             state[k, i] = UNSTABLE
         else:
@@ -283,14 +303,18 @@ def one_step_grid(scan, hz, methods=None):
     return err, state
 
 
+JUDGED = (OK, UNSTABLE, STABLE_NO_TRUTH)  # the states that say whether the run completed
+
+
 def boundary(scan, hz, method):
-    """Where `method` stops completing at one step a frame, judged on the points that
-    say: (the first axis value whose run diverged or failed, None if none did; the number
-    of points before it (or in all, when None) that say nothing: not in the file, truth
-    not trusted, run skipped or absent; the number of points judged, OK or UNSTABLE)."""
+    """Where `method` stops completing at one step a frame (one axis), judged on the points
+    that say: (the first axis value whose run diverged or failed, None if none did; the
+    number of points before it (or in all, when None) that say nothing: not in the file,
+    run skipped or absent; the number of points judged, OK, STABLE_NO_TRUTH or UNSTABLE: a
+    point without a trusted truth says whether the run completed, though not its error)."""
     _, state = one_step_grid(scan, hz, [method])
     state = state[0]
-    judged = (state == OK) | (state == UNSTABLE)
+    judged = np.isin(state, JUDGED)
     hits = np.flatnonzero(state == UNSTABLE)
     upto = hits[0] if len(hits) else len(state)
     unknown = int(np.sum(~judged[:upto]))
@@ -374,10 +398,10 @@ def best_grid(scan, hz):
     """`best` at one rate on the grid, each of the grid's shape ((n, 1) for one axis):
     (method, substeps, state, skipped). method "" but where state is CHOSEN; state NONE
     where no run taken meets the tolerance, SKIPPED where no run was taken (each over the
-    work budget), UNTRUSTED where the point's truth is not trusted (whatever `best` says
-    there is not shown: stepbench's range answer leaves those points out too), MISSING
-    where the file does not hold the point; skipped: the runs at the point and rate not
-    taken for the work budget."""
+    work budget), UNTRUSTED where the point's truth is not trusted (no error is measured
+    there, so no run is within the tolerance and none is the cheapest; whatever `best` says
+    there is not shown), MISSING where the file does not hold the point; skipped: the runs
+    at the point and rate not taken for the work budget."""
     shape = scan.shape if len(scan.axes) == 2 else (scan.shape[0], 1)
     method = np.full(shape, "", dtype=object)
     substeps = np.zeros(shape, int)
@@ -475,10 +499,14 @@ def unjudged_text(scan, hz):
 # --- the figures --------------------------------------------------------------------------------
 
 def figure_names(scan):
-    """The figure files of a scan: the map per method (one axis only) and the cheapest map."""
-    names = {"best": f"scan_{scan.name}_cheapest.png"}
+    """The figure files of a scan, in the order the section shows them: the map per method
+    at one step a frame (one axis: one figure, "one_step"; two axes: a figure per rate,
+    "one_step_<k>" for the k-th of scan.rates) and the cheapest map ("best")."""
     if len(scan.axes) == 1:
-        names["one_step"] = f"scan_{scan.name}_one_step.png"
+        names = {"one_step": f"scan_{scan.name}_one_step.png"}
+    else:
+        names = {f"one_step_{k}": f"scan_{scan.name}_one_step_{hz:g}hz.png" for k, hz in enumerate(scan.rates)}
+    names["best"] = f"scan_{scan.name}_cheapest.png"
     return names
 
 
@@ -522,9 +550,14 @@ def _text_colour(colour):
 
 MAX_WIDTH_IN = 13.8  # 1380 px at the report's 100 dpi
 
-# The cells that say nothing about a run, hatched: (face, hatch colour, hatch).
+# The cells with no error to colour them by, hatched: (face, hatch colour, hatch). All but
+# STABLE_NO_TRUTH (the run completed, its error not measured) say nothing about a run.
 HATCHED = {SKIPPED: ("white", "#2f6fb0", "\\\\\\\\"), UNTRUSTED: ("#fff2cc", "#b86e00", "...."),
-           MISSING: ("0.9", "0.45", "////")}
+           MISSING: ("0.9", "0.45", "////"), STABLE_NO_TRUTH: ("#e4f2dc", "#3d7f35", "---")}
+# Their legend entries in the maps at one step a frame (one_step_figure, maps_figure).
+ONE_STEP_LABELS = {STABLE_NO_TRUTH: "completed; no truth here\n(stable, error not measured)",
+                   SKIPPED: "skipped: over the work budget\n(not run, not judged)",
+                   UNTRUSTED: "no truth and no run here\n(not judged)"}
 
 
 def _hatched_cell(ax, x0, x1, y0, y1, state):
@@ -533,6 +566,14 @@ def _hatched_cell(ax, x0, x1, y0, y1, state):
     face, ink, hatch = HATCHED[state]
     ax.add_patch(Rectangle((x0, y0), x1 - x0, y1 - y0, facecolor=face, edgecolor=ink, hatch=hatch, linewidth=0))
     ax.add_patch(Rectangle((x0, y0), x1 - x0, y1 - y0, fill=False, edgecolor="white", linewidth=0.6))
+
+
+def _hatched_legend(scan, shown, handles, labels):
+    """The legend entries of the hatched states `shown` in a map at one step a frame."""
+    for state in (STABLE_NO_TRUTH, SKIPPED, UNTRUSTED, MISSING):
+        if state in shown:
+            handles.append(_hatched_handle(state))
+            labels.append(ONE_STEP_LABELS.get(state, f"{scan.missing_label}\n(not judged)"))
 
 
 def _hatched_handle(state):
@@ -564,12 +605,21 @@ def coverage_text(scan):
     return ""
 
 
+def _error_range(grids):
+    """The colour scale of the maps at one step a frame: whole decades around every error
+    in `grids` ((err, state) each)."""
+    finite = np.concatenate([g[0][np.isfinite(g[0])] for g in grids]) if grids else np.array([])
+    vmin, vmax = (math.floor(finite.min()), math.ceil(finite.max())) if len(finite) else (-16, 0)
+    return (vmin - 1, vmax) if vmin == vmax else (vmin, vmax)
+
+
 def one_step_figure(scan, stability, mass, path):
     """A panel per frame rate: x the scan's axis, a row per method, each cell coloured by
     log10 of the max position error of the run at one step a frame, grey with a black x
-    where it diverged or failed, hatched where there is nothing to judge (HATCHED: a
-    point not in the file, whole columns; a point whose truth is not trusted; a run not
-    taken for the work budget); for the stiff spring over k_s, a red bar in each method's
+    where it diverged or failed, hatched where there is no error to colour it by (HATCHED:
+    a run that completed at a point without a trusted truth; a point not in the file,
+    whole columns; a point without a trusted truth and no run; a run not taken for the
+    work budget); for the stiff spring over k_s, a red bar in each method's
     row at the k_s where omega dt is its oscillator limit (theory)."""
     from . import figures  # matplotlib, only when drawing
     plt, Line2D = figures.plt, figures.Line2D
@@ -578,10 +628,7 @@ def one_step_figure(scan, stability, mass, path):
     methods = scan.methods
     rates = scan.rates
     grids = [one_step_grid(scan, hz, methods) for hz in rates]
-    finite = np.concatenate([g[0][np.isfinite(g[0])] for g in grids]) if grids else np.array([])
-    vmin, vmax = (math.floor(finite.min()), math.ceil(finite.max())) if len(finite) else (-16, 0)
-    if vmin == vmax:
-        vmin -= 1
+    vmin, vmax = _error_range(grids)
     limits = theory_limits(scan, stability, mass) if has_theory(scan, stability) else {}
     ncols = min(2, len(rates))
     nrows = math.ceil(len(rates) / ncols)
@@ -604,7 +651,7 @@ def one_step_figure(scan, stability, mass, path):
                 markeredgewidth=1.4)
         for i in np.flatnonzero(~scan.held):  # a point not in the file: its whole column
             _hatched_cell(ax, x_edges[i], x_edges[i + 1], y_edges[0], y_edges[-1], MISSING)
-        for k, i in zip(*np.nonzero((state == UNTRUSTED) | (state == SKIPPED))):
+        for k, i in zip(*np.nonzero(np.isin(state, (UNTRUSTED, SKIPPED, STABLE_NO_TRUTH)))):
             _hatched_cell(ax, x_edges[i], x_edges[i + 1], y_edges[k], y_edges[k + 1], state[k, i])
         for k, m in enumerate(methods):
             if m in limits:
@@ -643,16 +690,122 @@ def one_step_figure(scan, stability, mass, path):
     if NO_RUN in shown:
         handles.append(Patch(facecolor="white", edgecolor="0.5"))
         labels.append("white: no run")
-    for state, label in ((SKIPPED, "skipped: over the work budget\n(not run, not judged)"),
-                         (UNTRUSTED, "truth not trusted\n(not judged)"),
-                         (MISSING, f"{scan.missing_label}\n(not judged)")):
-        if state in shown:
-            handles.append(_hatched_handle(state))
-            labels.append(label)
+    _hatched_legend(scan, shown, handles, labels)
     fig.legend(handles, labels, loc="upper left", bbox_to_anchor=(0.81 if ncols > 1 else 0.75, 0.45),
                frameon=False, fontsize=8.5)
     figures._save(fig, path)
     return grids
+
+
+def _tick_text(v):
+    """A grid value as a short tick label: 8, 512, 0.25, 1e5, 3.2e4."""
+    v = float(v)
+    decade = v > 0 and float(f"{v:.0e}") == v and v >= 1e3  # 1e3, not 1000, beside 1e4
+    text = f"{v:.4g}" if v == 0 or (1e-3 <= abs(v) < 1e4 and not decade) else f"{v:.2g}"
+    return text.replace("e+0", "e").replace("e+", "e").replace("e-0", "e-")
+
+
+def _value_ticks(axis, values, most=6):
+    """Ticks at the grid values (every k-th when there are more than `most`), no minor ones."""
+    from matplotlib.ticker import NullLocator
+    step = max(1, math.ceil(len(values) / most))
+    shown = list(values[::step])
+    axis.set_ticks(shown)
+    axis.set_ticklabels([_tick_text(v) for v in shown])
+    axis.set_minor_locator(NullLocator())
+
+
+MAP_COLUMNS = 5  # the panels a row of maps_figure, at most
+MAP_PANEL_IN = 2.35  # a panel's width and height, inches
+
+
+def maps_figure(scan, hz, path):
+    """A scan of two axes at one rate: a small map per method at one step a frame, x the
+    first axis, y the second, each cell coloured by log10 of the run's max position error
+    on one colour scale for every rate of the scan (its figures compare), grey with a
+    black x where the run diverged or failed, hatched where there is no error to colour it
+    by (HATCHED, as in one_step_figure), white where there is no such run. Returns the
+    grid drawn, (err, state), each methods x grid points."""
+    from . import figures
+    plt = figures.plt
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+    methods = scan.methods
+    grids = [one_step_grid(scan, r, methods) for r in scan.rates]
+    vmin, vmax = _error_range(grids)
+    err, state = grids[scan.rates.index(hz)]
+    ncols = max(1, min(MAP_COLUMNS, len(methods)))
+    nrows = max(1, math.ceil(len(methods) / ncols))
+    shown = set(state.ravel().tolist())
+    entries = sum(1 for x in (UNSTABLE, NO_RUN, STABLE_NO_TRUTH, SKIPPED, UNTRUSTED, MISSING) if x in shown)
+    right = 1.3  # the colour bar and its label
+    width = ncols * MAP_PANEL_IN + 0.7 + right
+    legend_cols = max(1, min(entries, int((width - right) // 2.4)))
+    bottom = 0.6 + 0.42 * math.ceil(entries / legend_cols)  # the axis label and the legend
+    narrow = ncols < 4  # the title on two lines
+    top = 0.75 + (0.25 if narrow else 0)  # the title
+    height = nrows * MAP_PANEL_IN + bottom + top
+    fig, axes = plt.subplots(nrows, ncols, figsize=(width, height), squeeze=False)
+    fig.subplots_adjust(left=0.7 / width, right=1 - right / width, bottom=bottom / height, top=1 - top / height,
+                        wspace=0.08, hspace=0.22)
+    x_edges, y_edges = _edges(scan.values[0], scan.log[0]), _edges(scan.values[1], scan.log[1])
+    xs, ys = np.meshgrid(scan.values[0], scan.values[1], indexing="ij")
+    grey = ListedColormap(["0.72"])
+    mesh = None
+    for k, (ax, m) in enumerate(zip(axes.flat, methods)):
+        e, st = err[k].reshape(scan.shape), state[k].reshape(scan.shape)  # [i, j]: first axis i
+        ax.grid(False)
+        mesh = ax.pcolormesh(x_edges, y_edges, np.ma.masked_invalid(np.where(st == OK, e, np.nan)).T, cmap="viridis",
+                             vmin=vmin, vmax=vmax, shading="flat")
+        unstable = st == UNSTABLE
+        ax.pcolormesh(x_edges, y_edges, np.ma.masked_where(~unstable, np.ones_like(e)).T, cmap=grey, shading="flat")
+        ax.plot(xs[unstable], ys[unstable], linestyle="none", marker="x", color="black", markersize=7,
+                markeredgewidth=1.5)
+        for i, j in zip(*np.nonzero(np.isin(st, tuple(HATCHED)))):
+            _hatched_cell(ax, x_edges[i], x_edges[i + 1], y_edges[j], y_edges[j + 1], st[i, j])
+        if scan.log[0]:
+            ax.set_xscale("log")
+        if scan.log[1]:
+            ax.set_yscale("log")
+        ax.set_xlim(x_edges[0], x_edges[-1])
+        ax.set_ylim(y_edges[0], y_edges[-1])
+        _value_ticks(ax.xaxis, scan.values[0])
+        _value_ticks(ax.yaxis, scan.values[1])
+        ax.tick_params(labelsize=8)
+        ax.set_title(m, fontsize=9.5, pad=3)
+        if k + ncols < len(methods):  # a panel below: its labels say it
+            ax.tick_params(labelbottom=False)
+        else:
+            ax.set_xlabel(scan.axes[0], fontsize=9)
+        if k % ncols:
+            ax.tick_params(labelleft=False)
+        else:
+            ax.set_ylabel(scan.axes[1], fontsize=9)
+    for ax in list(axes.flat)[len(methods):]:
+        ax.set_axis_off()
+    cover = coverage_text(scan)
+    fig.suptitle(f"Scan {scan.name} ({scan.problem}) at {hz:g} Hz, one step a frame (dt = {1e3 / hz:.3g} ms)"
+                 + ("\n" if narrow else ": ") + "max position error per method" + (f" ({cover})" if cover else ""),
+                 fontsize=12, y=1 - 0.2 / height, va="top")
+    top_edge = 1 - top / height
+    cax = fig.add_axes([1 - (right - 0.25) / width, top_edge - 0.55 * (top_edge - bottom / height), 0.16 / width,
+                        0.55 * (top_edge - bottom / height)])
+    cax.grid(False)
+    cb = fig.colorbar(mesh, cax=cax)
+    cb.set_label(f"log10 max position error [{scan.unit}]\n(one scale for every rate)", fontsize=9)
+    handles, labels = [], []
+    if UNSTABLE in shown:
+        handles.append(Patch(facecolor="0.72", edgecolor="none"))
+        labels.append("grey with x: did not complete\n(diverged, failed)")
+    if NO_RUN in shown:
+        handles.append(Patch(facecolor="white", edgecolor="0.5"))
+        labels.append("white: no run")
+    _hatched_legend(scan, shown, handles, labels)
+    if handles:
+        fig.legend(handles, labels, loc="lower center", bbox_to_anchor=(0.5 * (1 - right / width), 0.0),
+                   ncol=legend_cols, frameon=False, fontsize=9)
+    figures._save(fig, path)
+    return err, state
 
 
 def best_figure(scan, styles, path):
@@ -685,7 +838,7 @@ def best_figure(scan, styles, path):
         for ax in axes[len(rates):]:
             ax.set_axis_off()
     small = 7 if (not two and scan.shape[0] <= 16) or (two and max(scan.shape) <= 8) else 6
-    hatched_label = {MISSING: "not run" if not scan.is_shard else "other shard", UNTRUSTED: "untrusted",
+    hatched_label = {MISSING: "not run" if not scan.is_shard else "other shard", UNTRUSTED: "no truth",
                      SKIPPED: "skipped"}
 
     def label(state, m, n, skipped):
@@ -743,7 +896,8 @@ def best_figure(scan, styles, path):
         labels[-1] += "\n(in a cell: xN, N substeps a frame)"
     shown = set(np.concatenate([g[2].ravel() for g in grids]).tolist()) if grids else set()
     for state, text in ((SKIPPED, "every run over the work budget\n(skipped, not judged)"),
-                        (UNTRUSTED, "truth not trusted\n(not judged)"), (MISSING, f"{scan.missing_label}")):
+                        (UNTRUSTED, "no trusted truth: error not\nmeasured, no cheapest here"),
+                        (MISSING, f"{scan.missing_label}")):
         if state in shown:
             handles.append(_hatched_handle(state))
             labels.append(text)
@@ -760,6 +914,8 @@ def draw(scan, which, study, styles, path):
     if which == "one_step":
         problem = next((p for p in study.problems if p.name == scan.problem), None)
         one_step_figure(scan, study.stability, spring_mass(scan, problem), path)
+    elif which.startswith("one_step_"):
+        maps_figure(scan, scan.rates[int(which[len("one_step_"):])], path)
     else:
         best_figure(scan, styles, path)
 
@@ -827,14 +983,7 @@ def _coverage_paragraph(scan):
                      "hatched in the maps as \"not run (missing shard)\" and take no part in any statement below: "
                      "not stable, not unstable, never the cheapest.")
     if scan.untrusted:
-        bad = scan.points[scan.points["trusted"] == 0]
-        first = bad[np.argmin(bad["point"])]
-        where = ", ".join(f"{a} = {float(v[i]):.3g}" for a, v, i in
-                          zip(scan.axes, scan.values, np.unravel_index(int(first["point"]), scan.shape)))
-        note = f" (at {where}: {first['note']})" if str(first["note"]) else ""
-        parts.append(f"{scan.untrusted} of the {held} points {'has' if scan.untrusted == 1 else 'have'} no trusted "
-                     f"truth{note}: hatched as \"truth not trusted\"; their runs are neither stable nor unstable "
-                     "here, and what `best` says there is not shown (stepbench's range answer leaves them out too).")
+        parts.append(_untrusted_text(scan))
     skipped = scan.runs[scan.runs["skipped"] != 0]
     if len(skipped):
         one = int(np.sum(skipped["substeps"] == 1))
@@ -845,6 +994,38 @@ def _coverage_paragraph(scan):
                      + (f"at one step a frame ({one} of them) it is hatched as \"skipped\", and " if one else "")
                      + "`best` chooses among the runs taken.")
     return " ".join(parts)
+
+
+def _untrusted_text(scan):
+    """The points without a trusted truth, in words: how many, why (the first one's note;
+    how many for the reference budget), and what is judged there: stability, not the
+    error, so neither the tolerance nor the cheapest."""
+    bad = scan.points[scan.points["trusted"] == 0]
+    first = bad[np.argmin(bad["point"])]
+    where = ", ".join(f"{a} = {float(v[i]):.3g}" for a, v, i in
+                      zip(scan.axes, scan.values, np.unravel_index(int(first["point"]), scan.shape)))
+    note = f" (at {where}: {first['note']})" if str(first["note"]) else ""
+    n = len(bad)
+    text = (f"{n} of the {len(scan.points)} points {'has' if n == 1 else 'have'} no trusted truth{note}.")
+    over = int(sum(str(x).startswith(NO_REFERENCES_NOTE) for x in bad["note"]))
+    if over:
+        budget = scan.attrs.get("reference_budget")
+        text += (f" {'At it' if n == 1 else ('At all of them' if over == n else f'At {over} of them')} the "
+                 "references were not run, their predicted work over the scan's reference budget"
+                 + (f" of {float(budget):.3g}" if budget is not None else "") + " (`reference_budget`).")
+    ran = np.isin(bad["point"], scan.runs["point"])
+    if ran.any():
+        text += (" Stability is judged there, as stepbench judges it: a run that diverged or failed did not "
+                 "complete (grey with an x); one that completed is stable (hatched green, \"completed; no truth "
+                 "here\"). The error is not measured there, so neither the tolerance nor the cheapest run is "
+                 "judged: `best` names none (stepbench's range answer asks for stability at every point and the "
+                 "tolerance at the points with a truth).")
+    if not ran.all():
+        k = int(np.sum(~ran))
+        who = ("It has no run" if n == 1 else "None of them has a run" if k == n
+               else f"{k} of them {'has' if k == 1 else 'have'} no run")
+        text += f" {who} (hatched as \"no truth and no run here\"): nothing is judged there."
+    return text
 
 
 def _one_scan(doc, study, figs, scan):
@@ -862,8 +1043,7 @@ def _one_scan(doc, study, figs, scan):
     if len(scan.axes) == 1:
         _one_step_part(doc, study, figs, scan, names["one_step"])
     else:
-        doc.p("A scan of two axes: the maps per method at one step a frame are not drawn (a grid per method and "
-              "rate would not be readable); the cheapest-run map below has a panel per frame rate.")
+        _maps_part(doc, figs, scan, names)
     doc.h(4, f"Scan {scan.name}: the cheapest run within tolerance")
     if names["best"] in figs:
         doc.img(f"fig/{names['best']}", f"the cheapest run within tolerance over the scan {scan.name}")
@@ -885,6 +1065,27 @@ def _one_scan(doc, study, figs, scan):
                       f"`stepbench advise --scan FILE --tol {scan.tol:g}`.")
 
 
+def _maps_part(doc, figs, scan, names):
+    """A scan of two axes at one step a frame: a figure per rate, a small map per method."""
+    grids = [one_step_grid(scan, hz) for hz in scan.rates]
+    shown = set(np.concatenate([g[1].ravel() for g in grids]).tolist())
+    doc.h(4, f"Scan {scan.name}: one step a frame")
+    text = (f"A figure per frame rate, a map per method: x {scan.axes[0]}, y {scan.axes[1]}; each cell the log10 of "
+            "the max position error of the run at one step a frame (substeps = 1), on one colour scale for every "
+            "rate; grey with an x where the run did not complete (diverged or failed).")
+    if STABLE_NO_TRUTH in shown:
+        text += (" Hatched green: the run completed where the point has no trusted truth (stable there; its error "
+                 "not measured).")
+    if shown - {OK, UNSTABLE, STABLE_NO_TRUTH}:
+        text += " Other hatching: nothing to judge (the legend says why); white: no such run."
+    doc.p(text)
+    for k, hz in enumerate(scan.rates):
+        name = names[f"one_step_{k}"]
+        if name in figs:
+            doc.img(f"fig/{name}", f"max position error at one step a frame at {hz:g} Hz, a map per method, over "
+                                   f"the scan {scan.name}")
+
+
 def _one_step_part(doc, study, figs, scan, name):
     axis = scan.axes[0]
     theory = has_theory(scan, study.stability)
@@ -892,12 +1093,16 @@ def _one_step_part(doc, study, figs, scan, name):
     mass = spring_mass(scan, problem)
     limits = theory_limits(scan, study.stability, mass) if theory else {}
     grids = [one_step_grid(scan, hz) for hz in scan.rates]
-    gaps = any(((state != OK) & (state != UNSTABLE)).any() for _, state in grids)
+    shown = set(np.concatenate([g[1].ravel() for g in grids]).tolist())
+    gaps = bool(shown - set(JUDGED))
     doc.h(4, f"Scan {scan.name}: one step a frame")
     text = ("Cells: log10 of the max position error of the run at one step a frame (substeps = 1); grey with an x "
             "where the run did not complete (diverged or failed).")
+    if STABLE_NO_TRUTH in shown:
+        text += (" Hatched green: the run completed where the point has no trusted truth (stable there; its error "
+                 "not measured).")
     if gaps:
-        text += " Hatched: nothing to judge (the legend says why); white: no such run."
+        text += " Other hatching: nothing to judge (the legend says why); white: no such run."
     if theory:
         text += (f" Red bars: each explicit method's oscillator stability limit y_max = omega dt from "
                  f"/stability/limits (theory), at k_s = m (y_max hz)^2 with m = {mass:g} kg; the damped spring "

@@ -109,7 +109,13 @@ def test_outputs_exist_and_images_resolve(reports, shape):
     with h5py.File(study, "r") as f:
         problems = list(f["problems"])
         energy = {p for p in problems if f["problems"][p].attrs["has_energy"] == 1}
-        scan_names = list(f["scan"]) if "scan" in f else []
+        # The scans' figures: the map per method at one step a frame (one figure for one
+        # axis; a figure per rate for two) and the cheapest map (docs/study-format.md, /scan).
+        scans = []
+        for name, g in (f["scan"].items() if "scan" in f else ()):
+            two = len(str(g.attrs["axes"]).split(",")) == 2
+            scans += ([f"scan_{name}_one_step_{hz:g}hz.png" for hz in np.atleast_1d(g.attrs["hz"])] if two
+                      else [f"scan_{name}_one_step.png"]) + [f"scan_{name}_cheapest.png"]
         challenge = {"pendulum_challenge.png"} if "challenge" in f else set()  # a full sweep of n_pendulum
     assert "kepler" in problems and "bouncing_balls" in problems
     for p in problems:
@@ -120,8 +126,6 @@ def test_outputs_exist_and_images_resolve(reports, shape):
         "stability_regions.png", "energy_long_runs.png", "loop_shown_error.png", "substeps_equal_cost.png"}
     drawn = set(os.path.basename(i) for i in images)
     assert expected <= drawn
-    # The scans' two figures each, where the study holds scans (/scan; docs/study-format.md).
-    scans = [f"scan_{name}_{kind}.png" for name in scan_names for kind in ("one_step", "cheapest")]
     assert challenge <= drawn
     assert drawn - expected <= {f"energy_drift_{p}.png" for p in energy} | set(scans) | challenge
     assert {"energy_drift_pendulum.png", "energy_drift_kepler.png"} <= drawn

@@ -360,7 +360,8 @@ def test_a_shard_file_says_which_share_it_holds(gaps_report):
 def test_untrusted_points_are_not_judged(gaps_report):
     """The sliding block lubricated: where the lecture's table lacks the pair's
     coefficient, stepbench records the point untrusted and runs nothing there. The report
-    says how many, judges none of them, and counts no method stable over them."""
+    says how many, judges none of them (no run: not even stability), and counts no method
+    stable over them."""
     from stepbench_report import scan as scan_section
     study, folder, files = gaps_report
     _, points, runs, best = scan_group(files / "lub.h5")
@@ -368,6 +369,7 @@ def test_untrusted_points_are_not_judged(gaps_report):
     assert 0 < len(untrusted) < len(points)
     part = scan_part(report_text(folder), "lub")
     assert f"{len(untrusted)} of the {len(points)} points have no trusted truth" in part
+    assert "None of them has a run (hatched as \"no truth and no run here\"): nothing is judged there." in part
     s = load_scan(study, "lub")
     _, state = scan_section.one_step_grid(s, 60.0)
     assert (state[:, untrusted] == scan_section.UNTRUSTED).all()
@@ -384,10 +386,12 @@ def test_untrusted_points_are_not_judged(gaps_report):
     assert (bstate[untrusted, 0] == scan_section.UNTRUSTED).all() and not any(method[untrusted, 0])
 
 
-def test_an_untrusted_point_with_runs_is_not_judged(scan_files, tmp_path):
-    """A point whose references disagreed has runs but no trusted truth: here the merged
-    scan's point 5 marked so (trusted 0, as stepbench writes it). Its diverged runs are not
-    failures, its completed ones not stable, and `best` there is not shown."""
+def test_an_untrusted_point_with_runs_is_judged_on_stability(scan_files, tmp_path):
+    """A point without a trusted truth (references that disagree, or not run over the
+    reference budget) still has runs: here the merged scan's point 5 marked so (trusted 0,
+    its completed runs' errors NaN, as stepbench writes them). Its diverged runs did not
+    complete, its completed ones are stable with no error shown, and `best` there is not
+    shown: no error, so no tolerance."""
     from stepbench_report import scan as scan_section
     import shutil
     path = tmp_path / "untrusted.h5"
@@ -397,20 +401,185 @@ def test_an_untrusted_point_with_runs_is_not_judged(scan_files, tmp_path):
         p["trusted"][p["point"] == 5] = 0
         f["scan/stiff_spring/points"][...] = p
         runs = f["scan/stiff_spring/runs"][()]
+        runs["err_pos_max"][(runs["point"] == 5)] = np.nan
+        f["scan/stiff_spring/runs"][...] = runs
     at5 = runs[(runs["point"] == 5) & (runs["substeps"] == 1)]
-    assert (at5["diverged"] != 0).any() and (at5["completed"] != 0).any()  # both kinds, to be left out
+    assert (at5["diverged"] != 0).any() and (at5["completed"] != 0).any()  # both kinds
     from stepbench_report import study as study_reader
     with h5py.File(path) as f:
         s = next(x for x in scan_section.read(study_reader._Reader(str(path), f), f) if x.name == "stiff_spring")
     for hz in s.rates:
         err, state = scan_section.one_step_grid(s, hz)
-        assert (state[:, 5] == scan_section.UNTRUSTED).all() and np.isnan(err[:, 5]).all()
+        mine = at5[at5["hz"] == hz]
+        for r in mine:
+            k = s.methods.index(text(r["method"]))
+            assert state[k, 5] == (scan_section.STABLE_NO_TRUTH if r["completed"] else scan_section.UNSTABLE), r
+        assert np.isnan(err[:, 5]).all()
         method, _, bstate, _ = scan_section.best_grid(s, hz)
         assert bstate[5, 0] == scan_section.UNTRUSTED and method[5, 0] == ""
         assert sum(c for _, _, c, _ in scan_section.best_summary(s, hz)) == len(s.points) - 1
-        for m in s.methods:
-            first, _, _ = scan_section.boundary(s, hz, m)
-            assert first != s.values[0][5]
+        for r in mine:  # a run that diverged at 5 and nowhere before it: the boundary is point 5's value
+            m = text(r["method"])
+            k = s.methods.index(m)
+            first, _, judged = scan_section.boundary(s, hz, m)
+            earlier = np.flatnonzero(state[k, :5] == scan_section.UNSTABLE)
+            if r["diverged"] and not len(earlier):
+                assert first == s.values[0][5], m
+            assert judged == int(np.isin(state[k], scan_section.JUDGED).sum()) == len(s.points), m
+
+
+# --- scans made here, row by row: the states of the maps, without stepbench ------------------------
+
+def made_scan(axes, values, trusted, runs, notes=None, attrs=None):
+    """A Scan as scan.read() returns it: `axes` and per axis its `values` (log axes); points
+    0 .. N-1 with `trusted` (0/1 each) and `notes`; `runs` (point, hz, method, state, err),
+    state one of "ok", "diverged", "failed", "skipped", "old" (what a stepbench before the
+    stability-only points wrote for a run that completed without a truth: failed, with the
+    note "no trusted truth: ..."). `best` names no run."""
+    from stepbench_report import scan as scan_section
+    shape = [len(v) for v in values]
+    n = int(np.prod(shape))
+    notes = notes or [""] * n
+    points = np.zeros(n, dtype=[("point", "i8"), ("trusted", "i1"), ("truth_source", "O"), ("horizon", "f8"),
+                                ("pos_scale", "f8"), ("note", "O")])
+    points["point"] = np.arange(n)
+    points["trusted"] = trusted
+    points["truth_source"] = ["closed_form" if t else "none" for t in trusted]
+    points["horizon"] = 60
+    points["pos_scale"] = 1.0
+    points["note"] = notes
+    rows = np.zeros(len(runs), dtype=[(f, "O" if f in ("method", "note") else "f8" if f in ("hz", "dt", "err_pos_max")
+                                       else "i8" if f in ("point", "substeps", "steps", "force_evals",
+                                                          "newton_iterations") else "i1")
+                                      for f in scan_section.RUN_FIELDS])
+    for row, (point, hz, method, kind, err) in zip(rows, runs):
+        row["point"], row["hz"], row["method"], row["substeps"], row["dt"] = point, hz, method, 1, 1 / hz
+        row["diverged"] = kind == "diverged"
+        row["failed"] = kind in ("failed", "old")
+        row["skipped"] = kind == "skipped"
+        row["completed"] = kind == "ok"
+        row["err_pos_max"] = err if kind == "ok" else np.nan
+        row["note"] = {"old": "no trusted truth: the references disagree", "diverged": "non-finite state"}.get(kind, "")
+    best = np.zeros(len({(r[0], r[1]) for r in runs}), dtype=[("point", "i8"), ("hz", "f8"), ("method", "O"),
+                                                                ("substeps", "i8"), ("err_pos_max", "f8"),
+                                                                ("force_evals_per_frame", "f8")])
+    for b, (point, hz) in zip(best, sorted({(r[0], r[1]) for r in runs})):
+        b["point"], b["hz"], b["method"] = point, hz, ""
+    a = {"problem": "spring_chain", "unit": "m", "tol": 1e-3, "axes": ",".join(axes),
+         "axis_lo": [v[0] for v in values], "axis_hi": [v[-1] for v in values], "axis_count": shape,
+         "axis_log": [1] * len(axes), "hz": sorted({r[1] for r in runs}), "substeps": [1], "fixed_params": "",
+         "fixed_values": np.zeros(0), "methods": ",".join(dict.fromkeys(r[2] for r in runs)), "grid_points": n,
+         **(attrs or {})}
+    return scan_section.Scan("made", a, list(axes), [np.asarray(v, float) for v in values], points, rows, best)
+
+
+BUDGET_NOTE = ("references not run: their predicted work, 4.1e+05 (128 coordinates x w_max T = 3.2e3 rad), is over "
+               "the reference budget of 2e+05")
+
+
+def test_an_untrusted_points_runs_say_whether_they_completed():
+    """At a point without a trusted truth, a run that diverged or failed is UNSTABLE, one
+    that completed is STABLE_NO_TRUTH (also as an older stepbench wrote it: failed for the
+    truth alone), a skipped one SKIPPED; no error is shown there, the boundary counts them
+    as judged, and `best` stays UNTRUSTED."""
+    from stepbench_report import scan as scan_section
+    s = made_scan(["masses"], [[8, 64, 512, 4096]], [1, 1, 0, 0], [
+        (0, 60.0, "a", "ok", 1e-4), (1, 60.0, "a", "ok", 2e-3), (2, 60.0, "a", "ok", 0.5),  # an error: not shown
+        (3, 60.0, "a", "diverged", 0),
+        (0, 60.0, "b", "ok", 1e-5), (1, 60.0, "b", "ok", 1e-5), (2, 60.0, "b", "old", 0), (3, 60.0, "b", "failed", 0),
+        (0, 60.0, "c", "ok", 1e-5), (1, 60.0, "c", "diverged", 0), (2, 60.0, "c", "skipped", 0)],
+        notes=["", "", BUDGET_NOTE, BUDGET_NOTE], attrs={"reference_budget": 2e5})
+    err, state = scan_section.one_step_grid(s, 60.0)
+    S, U, OK = scan_section.STABLE_NO_TRUTH, scan_section.UNSTABLE, scan_section.OK
+    np.testing.assert_array_equal(state, [[OK, OK, S, U], [OK, OK, S, U],
+                                          [OK, U, scan_section.SKIPPED, scan_section.UNTRUSTED]])
+    assert np.isnan(err[:, 2:]).all() and np.isfinite(err[:, :2][state[:, :2] == OK]).all()
+    assert scan_section.boundary(s, 60.0, "a") == (4096.0, 0, 4)  # judged at the untrusted points too
+    assert scan_section.boundary(s, 60.0, "c") == (64.0, 0, 2)
+    assert scan_section.boundary_text(s, 60.0, "a") == "4.1e+03"
+    _, _, bstate, _ = scan_section.best_grid(s, 60.0)
+    assert (bstate[2:, 0] == scan_section.UNTRUSTED).all()  # no error there: no cheapest
+    words = scan_section._coverage_paragraph(s)
+    assert "2 of the 4 points have no trusted truth (at masses = 512: references not run" in words
+    assert "At all of them the references were not run, their predicted work over the scan's reference budget of " \
+           "2e+05 (`reference_budget`)." in words
+    assert "Stability is judged there" in words and "neither stable nor unstable" not in words
+    assert "no run (hatched" not in words  # each untrusted point has runs (c's none at point 3: its cell says so)
+
+
+def test_a_file_without_reference_budget_is_read_as_before():
+    """An older scan (no `reference_budget` attribute): the budget's sentence names no value."""
+    from stepbench_report import scan as scan_section
+    s = made_scan(["k_s"], [[1e2, 1e3]], [1, 0], [(0, 60.0, "a", "ok", 1e-4), (1, 60.0, "a", "ok", 0.1)],
+                  notes=["", BUDGET_NOTE])
+    words = scan_section._coverage_paragraph(s)
+    assert "At it the references were not run, their predicted work over the scan's reference budget " \
+           "(`reference_budget`)." in words
+    assert "no run (hatched" not in words
+
+
+def test_untrusted_points_without_runs_are_not_judged():
+    """A point that was not run at all (its parameters invalid: no truth, no run) says
+    nothing, and the paragraph says so once."""
+    from stepbench_report import scan as scan_section
+    s = made_scan(["k_s"], [[1e2, 1e3, 1e4]], [1, 0, 0], [(0, 60.0, "a", "ok", 1e-4), (1, 60.0, "a", "ok", 0.1)],
+                  notes=["", BUDGET_NOTE, "not run: k_s is out of range"])
+    _, state = scan_section.one_step_grid(s, 60.0)
+    assert state.tolist() == [[scan_section.OK, scan_section.STABLE_NO_TRUTH, scan_section.UNTRUSTED]]
+    words = scan_section._coverage_paragraph(s)
+    assert "At 1 of them the references were not run" in words and "Stability is judged there" in words
+    assert "1 of them has no run (hatched as \"no truth and no run here\")" in words
+    s = made_scan(["k_s"], [[1e2, 1e3, 1e4]], [1, 0, 0], [(0, 60.0, "a", "ok", 1e-4)],
+                  notes=["", "not run: bad", "not run: bad"])
+    words = scan_section._coverage_paragraph(s)
+    assert "None of them has a run" in words and "Stability is judged there" not in words
+
+
+def test_a_two_axis_scan_has_a_map_per_method_and_rate(monkeypatch):
+    """Two axes: a figure per rate of small maps, one per method, x the first axis and y
+    the second; a cell per grid point, coloured by the run's error where it completed at
+    a trusted point, grey with an x where it diverged or failed, hatched green where it
+    completed without a truth; one colour scale for every rate."""
+    from stepbench_report import figures
+    from stepbench_report import scan as scan_section
+    masses, ks = [8, 64, 512], [1e2, 1e3]
+    runs = []
+    for hz in (60.0, 120.0):
+        for p in range(6):
+            i, j = divmod(p, 2)
+            runs.append((p, hz, "a", "diverged" if (i, j) == (2, 1) else "ok", 10.0 ** -(p + 1) * (hz / 60) ** 2))
+            runs.append((p, hz, "b", "ok", 1e-3))
+    s = made_scan(["masses", "k_s"], [masses, ks], [1, 1, 1, 1, 0, 0], runs, notes=[""] * 4 + [BUDGET_NOTE] * 2)
+    names = scan_section.figure_names(s)
+    assert names == {"one_step_0": "scan_made_one_step_60hz.png", "one_step_1": "scan_made_one_step_120hz.png",
+                     "best": "scan_made_cheapest.png"}
+    kept = []
+    monkeypatch.setattr(figures, "_save", lambda fig, path, tight=True: kept.append(fig))
+    err, state = scan_section.maps_figure(s, 120.0, "unused.png")
+    (fig,) = kept
+    panels = [ax for ax in fig.axes if ax.get_title()]
+    assert [ax.get_title() for ax in panels] == ["a", "b"]
+    a = state[0].reshape(s.shape)
+    assert a[2, 1] == scan_section.UNSTABLE and a[2, 0] == scan_section.STABLE_NO_TRUTH
+    assert (a[:2] == scan_section.OK).all()
+    x_edges, y_edges = scan_section._edges(s.values[0], True), scan_section._edges(s.values[1], True)
+    for ax, st in zip(panels, state):
+        colour = ax.collections[0]  # the errors, (ks x masses)
+        mask = colour.get_array().mask.reshape(len(ks), len(masses))
+        np.testing.assert_array_equal(~mask, (st.reshape(s.shape) == scan_section.OK).T)
+        hatched = {(p.get_x(), p.get_y()) for p in ax.patches if p.get_hatch() == "---"}
+        assert hatched == {(x_edges[2], y_edges[0])} | ({(x_edges[2], y_edges[1])} if ax.get_title() == "b" else set())
+    assert "masses" in panels[0].get_xlabel() and panels[0].get_ylabel() == "k_s"
+    # One colour scale for both rates: the 60 Hz errors are in it.
+    lo, hi = panels[0].collections[0].get_clim()
+    assert lo <= np.log10(1e-4) and hi >= np.log10(1e-3 * 4)
+    # The section: the figures, and no word that per-method maps are left out.
+    from stepbench_report import render
+    doc = render.Doc("t")
+    scan_section._maps_part(doc, set(names.values()), s, names)
+    md = render.markdown(doc)
+    assert "fig/scan_made_one_step_60hz.png" in md and "fig/scan_made_one_step_120hz.png" in md
+    assert "Hatched green" in md and "not be readable" not in md
 
 
 def test_skipped_runs_are_neither_failures_nor_stable(gaps_report):

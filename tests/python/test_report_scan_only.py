@@ -221,3 +221,60 @@ def test_a_scan_file_with_limits_gets_the_overlay(scan_files, plain_study, tmp_p
     assert shown["rk4"]["oscillator limit omega dt"] == f"{row['theory']:.4g}"
     assert shown["rk4"]["60 Hz: k_s at the limit"] == f"{1.0 * (row['theory'] * 60.0) ** 2:.3g}"
     assert sorted(os.listdir(out / "fig")) == sorted(os.path.basename(i) for i in FIGURES)  # no stability figure
+
+
+CHAIN = ["--problem", "spring_chain", "--param", "spring_chain.masses=8:16:2:log", "--param",
+         "spring_chain.k_s=1e2:1e3:2:log", "--hz", "60,120", "--substeps", "1,2", "--method", "rk4", "--method",
+         "semi_implicit_euler", "--method", "implicit_euler"]
+
+
+def test_a_two_axis_scan_has_a_map_per_method(stepbench, tmp_path):
+    """A scan of two axes (the rope over masses x k_s): a figure per rate with a map per
+    method at one step a frame, whose cells are the file's runs; with a reference budget
+    that leaves some points without references (where this stepbench has the option),
+    their completed runs are stable with no error and their diverged ones not completed,
+    and the page says why those points have no truth."""
+    import sys
+    from test_report import ROOT
+    sys.path.insert(0, os.path.join(ROOT, "scripts"))
+    from stepbench_report import scan as scan_section
+    from stepbench_report import study as study_reader
+    budget = "--reference-budget" in run([stepbench, "scan", "--help"]).stdout
+    path = tmp_path / "chain.h5"
+    p = run([stepbench, "scan", *CHAIN, *(["--reference-budget", "2e3"] if budget else []), "--out", str(path),
+             "--quiet"], timeout=300)
+    assert p.returncode == 0, p.stderr
+    out = tmp_path / "report"
+    p = run([PYTHON, REPORT, str(path), "--out", str(out), "--jobs", "2"], timeout=180)
+    assert p.returncode == 0, p.stderr
+    md = report_text(out)
+    figs = re.findall(r"!\[[^\]]*\]\((fig/[^)]+\.png)\)", md)
+    assert figs == ["fig/scan_spring_chain_one_step_60hz.png", "fig/scan_spring_chain_one_step_120hz.png",
+                    "fig/scan_spring_chain_cheapest.png"]
+    from matplotlib import image
+    for img in figs:
+        pixels = image.imread(out / img)
+        assert pixels.shape[1] <= 1400 and pixels[..., :3].std() > 0.05, img
+    assert "A figure per frame rate, a map per method: x masses, y k_s" in md and "not be readable" not in md
+    with h5py.File(path) as f:
+        s = next(iter(scan_section.read(study_reader._Reader(str(path), f), f)))
+        g = f["scan/spring_chain"]
+        points, runs = g["points"][()], g["runs"][()]
+        has_budget = "reference_budget" in g.attrs
+    trusted = dict(zip(points["point"].tolist(), points["trusted"].tolist()))
+    for hz in (60.0, 120.0):
+        err, state = scan_section.one_step_grid(s, hz)
+        assert state.shape == (3, 4)
+        for r in runs[(runs["hz"] == hz) & (runs["substeps"] == 1)]:
+            k, i = s.methods.index(text(r["method"])), int(r["point"])
+            if r["diverged"] or r["failed"]:
+                assert state[k, i] == scan_section.UNSTABLE
+            elif not trusted[i]:
+                assert state[k, i] == scan_section.STABLE_NO_TRUTH and np.isnan(err[k, i])
+            else:
+                assert state[k, i] == scan_section.OK and err[k, i] == pytest.approx(np.log10(r["err_pos_max"]))
+    untrusted = [text(n) for n in points["note"][points["trusted"] == 0]]
+    if budget and untrusted:
+        assert has_budget and all(n.startswith("references not run") for n in untrusted)
+        assert "the references were not run, their predicted work over the scan's reference budget of 2e+03" in md
+        assert "Stability is judged there" in md

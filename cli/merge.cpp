@@ -37,7 +37,7 @@ int run_study_merge(const merge_args& a) {
                r.machines.size(), fmt::join(parts, "; "));
   }
   fmt::print(stderr, "merge: {} of {} from {}\n", count_of(static_cast<long long>(r.problems.size()), "problem"),
-             r.problems.size() + r.missing.size(), count_of(static_cast<long long>(a.inputs.size()), "shard"));
+             r.problems.size() + r.missing.size(), count_of(static_cast<long long>(r.shards), "shard"));
   fmt::print(stderr, "wrote {}\n", a.out);
   return 0;
 }

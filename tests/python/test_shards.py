@@ -76,7 +76,8 @@ def test_slurm_study_script_parses_and_shards():
 
 def test_a_partial_merge_says_what_it_lacks(stepbench, tmp_path):
     """A study merged with --partial names the problems no shard held (missing_problems),
-    and the report's headline says so; a whole merge says nothing of the kind."""
+    and the report's headline says so; a whole merge, or the partial one merged with the
+    shard it lacks, says nothing of the kind."""
     import sys
     sys.path.insert(0, str(ROOT / "scripts"))
     from stepbench_report import report, study as study_mod
@@ -95,3 +96,11 @@ def test_a_partial_merge_says_what_it_lacks(stepbench, tmp_path):
     whole = study_mod.load(str(tmp_path / "whole.h5"))
     assert "missing_problems" not in h5py.File(tmp_path / "whole.h5").attrs
     assert whole.attrs["missing_problems"] == [] and "partial" not in report.headline(whole)
+    # The partial merge names its shards; merged with the one it lacks, it is whole.
+    assert list(h5py.File(tmp_path / "partial.h5").attrs["merged_shards"]) == [0, 2]
+    subprocess.run([stepbench, "merge", str(tmp_path / "partial.h5"), str(tmp_path / "s2.h5"),
+                    "-o", str(tmp_path / "completed.h5")], check=True, capture_output=True)
+    attrs = h5py.File(tmp_path / "completed.h5").attrs
+    assert not {"missing_problems", "merged_shards", "merged_shard_count"} & set(attrs)
+    completed = study_mod.load(str(tmp_path / "completed.h5"))
+    assert completed.attrs["missing_problems"] == [] and "partial" not in report.headline(completed)

@@ -247,7 +247,8 @@ bool is_study_file(const std::string& path) {
 
 held_shards held_shards_of(const std::string& path) { return read_shard(path).held; }
 
-study_merge_result merge_studies(const std::vector<std::string>& paths, const std::string& out, bool partial) {
+study_merge_result merge_studies(const std::vector<std::string>& paths, const std::string& out, bool partial,
+                                 const std::function<void()>& before_write) {
   H5::Exception::dontPrint();
   std::vector<shard_file> shards;
   for (const auto& path : paths) shards.push_back(read_shard(path));
@@ -422,6 +423,7 @@ study_merge_result merge_studies(const std::vector<std::string>& paths, const st
   } catch (const H5::Exception& e) {
     throw std::runtime_error(fmt::format("cannot merge into '{}': HDF5: {}", out, e.getDetailMsg()));
   }
+  if (before_write) before_write();
   write_image(image, out);
   return result;
 }

@@ -8,6 +8,7 @@
 // problems, are generated again from the joined file by the code that wrote them
 // (study/verdict.hpp). A timed study keeps the machine of each problem on /problems/<p>.
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -46,6 +47,9 @@ struct study_merge_result {
 // differs, both values) or timing settings; a shard given twice; a problem in two shards;
 // selected problems no shard holds, unless `partial`. A partial merge records the shards it
 // holds (`merged_shards`), so a later merge with the missing shards completes the study.
-study_merge_result merge_studies(const std::vector<std::string>& paths, const std::string& out, bool partial);
+// `before_write`, when given, runs once the merge is checked and built, before anything
+// is written: what it throws leaves `out` as it was.
+study_merge_result merge_studies(const std::vector<std::string>& paths, const std::string& out, bool partial,
+                                 const std::function<void()>& before_write = {});
 
 }  // namespace stepbench

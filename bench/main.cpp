@@ -26,6 +26,7 @@
 #include "bench/progress.hpp"
 #include "bench/scaling.hpp"
 #include "bench/timings.hpp"
+#include "study/bench_merge.hpp"
 #include "study/registry.hpp"
 #include "study/study_file.hpp"
 #include "study/sweep.hpp"
@@ -133,6 +134,9 @@ int main(int argc, char** argv) {
     sopts.shard_index = opts.shard_index;
     sopts.shard_count = opts.shard_count;
     validate(sopts);  // before any output: one line and exit 2 on a bad name or value
+    // A shard's JSON names its shard, as `stepbench merge --bench` checks against its study.
+    if (sopts.shard_count > 1)
+      benchmark::AddCustomContext(bench_shard_key, fmt::format("{}/{}", sopts.shard_index + 1, sopts.shard_count));
     bench::progress_line progress("stepbench_bench", !opts.list_only);
     const auto start = std::chrono::steady_clock::now();
     // A shard sweeps and times only its share of the problems (study/sweep.hpp sweep_shard).

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "study/bench_merge.hpp"
 #include "study/registry.hpp"
 
 namespace stepbench::bench {
@@ -76,7 +77,9 @@ void register_scaling(const std::vector<std::string>& problems) {
   }
   // 2^25 doubles (256 MiB) an array: far beyond every cache of the machines here; and the
   // size of one vector of the 65536-mass chain's state (3 x 65536 doubles).
-  benchmark::RegisterBenchmark("stream/triad", triad)
+  // Of the machine, not a problem: every shard with a scaling family runs it, and `stepbench
+  // merge --bench` keeps each shard's (study/bench_merge.hpp).
+  benchmark::RegisterBenchmark(std::string(stream_triad_benchmark).c_str(), triad)
       ->ArgName("doubles")
       ->Arg(1L << 25)
       ->Arg(3L * 65536)

@@ -1,6 +1,7 @@
 // `stepbench merge`: joins the shards of a study run with `sweep --shard K/N` or
 // `stepbench_bench --shard=K/N` (study/study_merge.hpp merge_studies), or of scans run with
-// `scan --shard K/N` (study/scan.hpp merge_scans), on one machine or many, into one file.
+// `scan --shard K/N` (study/scan.hpp merge_scans), on one machine or many, into one file;
+// with --bench, the timed shards' Google Benchmark JSON too (study/bench_merge.hpp).
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -9,6 +10,7 @@
 
 #include "cli/args.hpp"
 #include "cli/commands.hpp"
+#include "study/bench_merge.hpp"
 #include "study/scan.hpp"
 #include "study/study_file.hpp"
 #include "study/study_merge.hpp"
@@ -20,10 +22,20 @@ struct merge_args {
   std::vector<std::string> inputs;
   std::string out;
   bool partial = false;
+  std::vector<std::string> bench;  // each study file's Google Benchmark JSON, in the same order
+  std::string bench_out;
 };
 
 int run_study_merge(const merge_args& a) {
-  const auto r = merge_studies(a.inputs, a.out, a.partial);
+  // The benchmark JSON is joined once the study merge is checked and built, and written
+  // after the study (as stepbench_bench writes them): a refusal writes neither.
+  bench_join_result joined;
+  const auto r = merge_studies(a.inputs, a.out, a.partial, [&] {
+    if (a.bench.empty()) return;
+    joined = join_bench_json(a.bench, a.inputs);
+    check_writable(a.bench_out);
+  });
+  if (!a.bench.empty()) write_image(std::vector<unsigned char>(joined.text.begin(), joined.text.end()), a.bench_out);
   if (!r.missing.empty())
     fmt::print(stderr, "merge: {} of the {} selected problems {} in no shard (--partial): {}\n", r.missing.size(),
                r.missing.size() + r.problems.size(), r.missing.size() == 1 ? "is" : "are", fmt::join(r.missing, ", "));
@@ -37,8 +49,11 @@ int run_study_merge(const merge_args& a) {
                r.machines.size(), fmt::join(parts, "; "));
   }
   fmt::print(stderr, "merge: {} of {} from {}\n", count_of(static_cast<long long>(r.problems.size()), "problem"),
-             r.problems.size() + r.missing.size(), count_of(static_cast<long long>(a.inputs.size()), "shard"));
-  fmt::print(stderr, "wrote {}\n", a.out);
+             r.problems.size() + r.missing.size(), count_of(static_cast<long long>(r.shards), "shard"));
+  if (!a.bench.empty())
+    fmt::print(stderr, "merge: {} of {} into {}\n", count_of(static_cast<long long>(joined.benchmarks), "benchmark"),
+               count_of(static_cast<long long>(joined.shards), "shard"), a.bench_out);
+  fmt::print(stderr, "wrote {}{}\n", a.out, a.bench.empty() ? "" : " and " + a.bench_out);
   return 0;
 }
 
@@ -48,12 +63,26 @@ int run_merge(const merge_args& a) {
     for (std::size_t j = 0; j < i; ++j)
       if (a.inputs[i] == a.inputs[j])
         throw std::invalid_argument(fmt::format("merge: '{}' is named twice (overlapping shards)", a.inputs[i]));
-  // The output must not be one of the inputs (merging would overwrite a shard).
-  for (const auto& path : a.inputs) {
+  // No output may be one of the inputs (merging would overwrite a shard), nor both one file.
+  const auto same = [](const std::string& x, const std::string& y) {
     std::error_code ec;
-    if (path == a.out || std::filesystem::equivalent(path, a.out, ec))
-      throw std::invalid_argument(fmt::format("merge: the output '{}' is one of the shards; name another file", a.out));
+    return x == y || std::filesystem::equivalent(x, y, ec);
+  };
+  std::vector<std::string> outputs{a.out};
+  if (!a.bench_out.empty()) outputs.push_back(a.bench_out);
+  for (const auto& out : outputs) {
+    for (const auto* paths : {&a.inputs, &a.bench})
+      for (const auto& path : *paths)
+        if (same(path, out))
+          throw std::invalid_argument(
+              fmt::format("merge: the output '{}' is one of the shards; name another file", out));
   }
+  if (outputs.size() == 2 && same(a.out, a.bench_out))
+    throw std::invalid_argument(fmt::format("merge: -o and --bench-out both name '{}'; name two files", a.out));
+  for (std::size_t i = 0; i < a.bench.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (a.bench[i] == a.bench[j])
+        throw std::invalid_argument(fmt::format("merge: '{}' is named twice (overlapping shards)", a.bench[i]));
   // One build: shards of different builds, formats or flags are not one study.
   const std::string build = file_build(a.inputs.front());
   for (const auto& path : a.inputs)
@@ -69,6 +98,8 @@ int run_merge(const merge_args& a) {
                                               a.inputs[0], study_shard[0] ? "study shard" : "scan file", a.inputs[i],
                                               study_shard[i] ? "study shard" : "scan file"));
   if (study_shard[0]) return run_study_merge(a);
+  if (!a.bench.empty())
+    throw std::invalid_argument("merge: --bench joins the benchmark JSON of timed study shards; these are scan files");
   std::map<std::string, std::vector<scan_result>> by_name;
   for (const auto& path : a.inputs)
     for (auto& s : read_scans(path)) by_name[s.options.name].push_back(std::move(s));
@@ -104,9 +135,19 @@ command add_merge(CLI::App& app) {
   sub->add_option("inputs", a->inputs, "the shard files")->required();
   sub->add_option("-o,--out", a->out, "the merged file")->required();
   sub->add_flag("--partial", a->partial, "merge even when some problems (or grid points) are in no shard (says which)");
+  auto* bench = sub->add_option("--bench", a->bench,
+                                "the Google Benchmark JSON of each timed study shard (`stepbench_bench "
+                                "--benchmark_out=F --benchmark_out_format=json`, or the bench.json beside its study), "
+                                "one for each shard file and in the same order, after the shard files");
+  auto* bench_out = sub->add_option("--bench-out", a->bench_out,
+                                    "the joined benchmark JSON (compare.py reads it): the shards' benchmarks in shard "
+                                    "order, each naming its shard, and every shard's context (its machine)");
+  bench->needs(bench_out);
+  bench_out->needs(bench);
   sub->footer(
       "exit codes: 0 merged; 1 a file unreadable or unwritable; 2 shards that overlap, miss problems or points "
-      "(without --partial), differ in build, format or options, or mix study and scan shards\n");
+      "(without --partial), differ in build, format or options, or mix study and scan shards; benchmark JSON files "
+      "not one for each shard file, of other shards than theirs, or with a benchmark in two shards\n");
   return {sub, [a] { return run_merge(*a); }};
 }
 

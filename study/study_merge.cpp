@@ -90,7 +90,7 @@ void copy_object(const H5::H5File& src, H5::H5File& dst, const std::string& path
 struct shard_file {
   std::string path;
   H5::H5File file;
-  long index = 0, count = 1;
+  held_shards held;
   std::string selection, options;
   std::vector<std::pair<std::string, std::string>> timing;  // the timing settings, as text
   std::vector<std::string> problems;
@@ -102,8 +102,20 @@ shard_file open_shard(const std::string& path) {
   s.path = path;
   s.file.openFile(path, H5F_ACC_RDONLY);
   const auto& f = s.file;
-  s.index = h5::long_attr(f, "shard_index");
-  s.count = h5::long_attr(f, "shard_count");
+  // A partial merge holds the shards it was merged from; a shard or a whole study its own.
+  if (has_attr(f, "merged_shards")) {
+    s.held.indices = h5::int_array_attr(f, "merged_shards");
+    s.held.count = h5::long_attr(f, "merged_shard_count");
+  } else {
+    s.held.indices = {h5::long_attr(f, "shard_index")};
+    s.held.count = h5::long_attr(f, "shard_count");
+  }
+  std::set<long> seen;
+  for (long k : s.held.indices)
+    if (k < 0 || k >= s.held.count || !seen.insert(k).second)
+      throw std::runtime_error(fmt::format("it says it holds shard {} of {}", k + 1, s.held.count));
+  if (s.held.indices.empty()) throw std::runtime_error("its merged_shards is empty");
+  std::sort(s.held.indices.begin(), s.held.indices.end());
   s.selection = h5::string_attr(f, "selection");
   s.options = h5::string_attr(f, "sweep_options");
   s.wall_seconds = h5::double_attr(f, "wall_seconds");
@@ -117,7 +129,20 @@ shard_file open_shard(const std::string& path) {
     s.benchmark_wall_seconds = h5::double_attr(f, "benchmark_wall_seconds");
   }
   if (h5::is_group(f, "problems")) s.problems = h5::children(f.openGroup("problems"));
+  s.held.problems = s.problems.size();
   return s;
+}
+
+// open_shard with its errors as one line naming the file.
+shard_file read_shard(const std::string& path) {
+  H5::Exception::dontPrint();
+  try {
+    return open_shard(path);
+  } catch (const H5::Exception& e) {
+    throw std::runtime_error(fmt::format("cannot read study shard '{}': {}", path, e.getDetailMsg()));
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(fmt::format("cannot read study shard '{}': {}", path, e.what()));
+  }
 }
 
 // The first line where two `sweep_options` texts differ, from each.
@@ -220,18 +245,13 @@ bool is_study_file(const std::string& path) {
   }
 }
 
-study_merge_result merge_studies(const std::vector<std::string>& paths, const std::string& out, bool partial) {
+held_shards held_shards_of(const std::string& path) { return read_shard(path).held; }
+
+study_merge_result merge_studies(const std::vector<std::string>& paths, const std::string& out, bool partial,
+                                 const std::function<void()>& before_write) {
   H5::Exception::dontPrint();
   std::vector<shard_file> shards;
-  for (const auto& path : paths) {
-    try {
-      shards.push_back(open_shard(path));
-    } catch (const H5::Exception& e) {
-      throw std::runtime_error(fmt::format("cannot read study shard '{}': {}", path, e.getDetailMsg()));
-    } catch (const std::runtime_error& e) {
-      throw std::runtime_error(fmt::format("cannot read study shard '{}': {}", path, e.what()));
-    }
-  }
+  for (const auto& path : paths) shards.push_back(read_shard(path));
   const auto& first = shards.front();
   // One study: the same selection, shard count, options and timing settings.
   for (const auto& s : shards) {
@@ -240,7 +260,8 @@ study_merge_result merge_studies(const std::vector<std::string>& paths, const st
                                               first.path, a, s.path, b));
     };
     if (s.selection != first.selection) differ("selection of problems", first.selection, s.selection);
-    if (s.count != first.count) differ("shard count", fmt::format("{}", first.count), fmt::format("{}", s.count));
+    if (s.held.count != first.held.count)
+      differ("shard count", fmt::format("{}", first.held.count), fmt::format("{}", s.held.count));
     if (s.options != first.options) {
       const auto [a, b] = first_difference(first.options, s.options);
       differ("options", a, b);
@@ -257,9 +278,10 @@ study_merge_result merge_studies(const std::vector<std::string>& paths, const st
   std::map<long, const shard_file*> by_index;
   std::map<std::string, const shard_file*> owner;
   for (const auto& s : shards) {
-    if (auto [it, fresh] = by_index.emplace(s.index, &s); !fresh)
-      throw std::invalid_argument(fmt::format("merge: '{}' and '{}' are both shard {} of {} (overlapping shards)",
-                                              it->second->path, s.path, s.index + 1, s.count));
+    for (long k : s.held.indices)
+      if (auto [it, fresh] = by_index.emplace(k, &s); !fresh)
+        throw std::invalid_argument(fmt::format("merge: '{}' and '{}' both hold shard {} of {} (overlapping shards)",
+                                                it->second->path, s.path, k + 1, s.held.count));
     for (const auto& p : s.problems) {
       if (std::find(selection.begin(), selection.end(), p) == selection.end())
         throw std::invalid_argument(
@@ -270,10 +292,11 @@ study_merge_result merge_studies(const std::vector<std::string>& paths, const st
     }
   }
   study_merge_result result;
+  result.shards = by_index.size();
   for (const auto& p : selection) (owner.count(p) ? result.problems : result.missing).push_back(p);
   if (!result.missing.empty() && !partial) {
     std::vector<std::string> absent;
-    for (long k = 0; k < first.count; ++k)
+    for (long k = 0; k < first.held.count; ++k)
       if (!by_index.count(k)) absent.push_back(fmt::format("{}", k + 1));
     throw std::invalid_argument(
         fmt::format("merge: {} of the {} selected problems {} in no shard ({}){}; --partial merges what there is",
@@ -281,7 +304,7 @@ study_merge_result merge_studies(const std::vector<std::string>& paths, const st
                     fmt::join(result.missing, ", "),
                     absent.empty() ? ""
                                    : fmt::format(": shard{} {} of {} not given", absent.size() == 1 ? "" : "s",
-                                                 fmt::join(absent, ", "), first.count)));
+                                                 fmt::join(absent, ", "), first.held.count)));
   }
   check_writable(out);
 
@@ -294,8 +317,18 @@ study_merge_result merge_studies(const std::vector<std::string>& paths, const st
     for (const auto& [index, s] : by_index)
       if (!root && !s->problems.empty()) root = s;
     copy_attrs((root ? *root : first).file, dst);
-    if (!result.missing.empty())
+    // A partial merge names what it lacks and the shards it holds, so that merging it with
+    // the missing shards completes the study; a whole merge is shard 0 of 1 and no more.
+    if (!result.missing.empty()) {
       replace_attr(dst, "missing_problems", fmt::format("{}", fmt::join(result.missing, ",")));
+      std::vector<int> held;
+      for (const auto& [k, s] : by_index) held.push_back(static_cast<int>(k));
+      replace_attr(dst, "merged_shards", held);
+      replace_attr(dst, "merged_shard_count", first.held.count);
+    } else {
+      for (const char* name : {"missing_problems", "merged_shards", "merged_shard_count"})
+        if (has_attr(dst, name)) dst.removeAttr(name);
+    }
     double wall = 0.0, bench_wall = 0.0;
     for (const auto& s : shards) wall += s.wall_seconds, bench_wall += s.benchmark_wall_seconds;
     result.wall_seconds = wall;
@@ -390,6 +423,7 @@ study_merge_result merge_studies(const std::vector<std::string>& paths, const st
   } catch (const H5::Exception& e) {
     throw std::runtime_error(fmt::format("cannot merge into '{}': HDF5: {}", out, e.getDetailMsg()));
   }
+  if (before_write) before_write();
   write_image(image, out);
   return result;
 }

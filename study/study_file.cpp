@@ -255,6 +255,9 @@ void write_scans(H5::H5File& file, const std::vector<scan_result>& scans) {
     attr(g, "reference_atol", o.ref_tol.atol);
     attr(g, "work_budget", o.limits.work_budget);
     attr(g, "reference_budget", o.reference_budget);
+    // The range answer at the scan's tolerance, as `scan` and `advise --scan` print it:
+    // computed here, once, so the report and the README quote it rather than redo it.
+    attr(g, "range_answer", format_scan_answer(answer_scan(sc, o.tol)));
     attr(g, "wall_seconds", sc.wall_seconds);
     attr(g, "grid_points", static_cast<long>(sc.grid_points));
     attr(g, "shard_index", o.shard_index);

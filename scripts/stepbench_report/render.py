@@ -39,6 +39,10 @@ class Doc:
     def note(self, text):
         self.blocks.append(("note", text))
 
+    def pre(self, text):
+        """Text as printed by stepbench, kept line for line (a fenced block in Markdown)."""
+        self.blocks.append(("pre", str(text).rstrip("\n")))
+
     def items(self, lines):
         """A bullet list."""
         self.blocks.append(("items", [str(x) for x in lines]))
@@ -106,6 +110,8 @@ def markdown(doc, for_html=False):
             out += ["> " + b[1], ""]
         elif kind == "items":
             out += [f"- {line}" for line in b[1]] + [""]
+        elif kind == "pre":
+            out += ([f"<pre>{esc(b[1])}</pre>"] if for_html else ["```", b[1], "```"]) + [""]
         elif kind == "table":
             _, headers, rows, caption, cls = b
             if caption:

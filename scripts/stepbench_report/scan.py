@@ -1031,6 +1031,11 @@ def _untrusted_text(scan):
 def _one_scan(doc, study, figs, scan):
     names = figure_names(scan)
     doc.h(3, f"Scan {scan.name}: {scan.problem} over {', '.join(scan.axes)}")
+    answer = scan.attrs.get("range_answer")
+    if answer is not None:
+        doc.p(f"The range answer at the scan's tolerance, as `stepbench advise --scan FILE --tol {scan.tol:g}` "
+              "prints it (stepbench computed it when it wrote the scan):")
+        doc.pre(_text(answer))
     fixed = ", ".join(f"{k} = {v:g}" for k, v in scan.fixed.items())
     trusted = int(np.sum(scan.points["trusted"] != 0))
     doc.p(f"{_axis_text(scan)}; at {', '.join(f'{hz:g}' for hz in scan.rates)} Hz with "
@@ -1138,3 +1143,7 @@ def _one_step_part(doc, study, figs, scan, name):
                                   "completed at every point):" if not gaps else
               f"Where each method stops completing at one step a frame ({axis}; diverged or failed, on the points "
               "measured; none: it completed at each of them):")
+
+
+def _text(v):
+    return v.decode() if isinstance(v, bytes) else str(v)

@@ -350,6 +350,15 @@ def results_doc(study, command):
     if getattr(study, "challenge", None) is not None:
         from . import challenge
         challenge.answer(doc, study.challenge)
+    answers = _range_answers(study)
+    if answers:
+        doc.h(2, "A scene's range")
+        doc.p("The range answer of each scan of the study at its tolerance, as `stepbench advise --scan FILE --tol X` "
+              "prints it: the cheapest method and substeps that stay stable and within the tolerance over the whole "
+              "range at each rate, and where each method diverges at one step a frame.")
+        for name, text in answers:
+            doc.h(3, f"Scan {name}")
+            doc.pre(text)
     return doc
 
 
@@ -391,7 +400,23 @@ def readme_block(study, command):
     if orders:
         lines[-2:-2] = ["", "**xpbd's observed order** over the substep ladder (the study's fit, its levels in "
                         "brackets): " + "; ".join(orders) + "."]
+    answers = _range_answers(study)
+    if answers:
+        from . import range_answer
+        block = ["", "**A scene's range** (the full study's scans; `stepbench advise --scan FILE --tol X` at another "
+                 "tolerance, every rate and map in the report):"]
+        for _, text in answers:
+            block += ["", "```", range_answer.brief_answer(text), "```"]
+        lines[-2:-2] = block
     return "\n".join(lines)
+
+
+def _range_answers(study):
+    from . import range_answer
+    try:
+        return range_answer.range_answers(study.path)
+    except (OSError, KeyError):
+        return []
 
 
 def xpbd_orders(study):

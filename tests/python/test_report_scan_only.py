@@ -278,3 +278,30 @@ def test_a_two_axis_scan_has_a_map_per_method(stepbench, tmp_path):
         assert has_budget and all(n.startswith("references not run") for n in untrusted)
         assert "the references were not run, their predicted work over the scan's reference budget of 2e+03" in md
         assert "Stability is judged there" in md
+
+
+def test_the_range_answer_is_stored_and_quoted(scan_files, reports, stepbench):
+    """The range answer is computed by stepbench when it writes the scan (`range_answer`),
+    equal to what `advise --scan` prints at the scan's tolerance, and the report opens the
+    scan's section with it, verbatim; the README's cut keeps the choices and the 60 Hz lines."""
+    import sys
+    sys.path.insert(0, os.path.join(os.path.dirname(REPORT)))
+    from stepbench_report import range_answer as scan_mod
+    path, out = reports["whole"]
+    with h5py.File(path) as f:
+        stored = f["scan/stiff_spring"].attrs["range_answer"]
+        stored = stored.decode() if isinstance(stored, bytes) else stored
+        tol = float(f["scan/stiff_spring"].attrs["tol"])
+    advised = run([stepbench, "advise", "--scan", str(path), "--tol", repr(tol)])
+    # Exit 3: no method holds over the whole range at some rate (docs/commands.md).
+    assert advised.returncode in (0, 3), advised.stderr
+    assert advised.stdout == stored
+    assert "rk4" in stored and "60 Hz" in stored
+    text = report_text(out)
+    for line in stored.strip().split("\n"):
+        assert line.strip() in text, line
+    assert scan_mod.range_answers(str(path)) == [("stiff_spring", stored)]
+    brief = scan_mod.brief_answer(stored + "  120 Hz  rk4                    stable everywhere\n")
+    assert "120 Hz  rk4" not in brief and "At one step a 60 Hz frame" in brief
+    assert [l for l in brief.split("\n") if l.startswith("  60 Hz  ")] == \
+        [l for l in stored.split("\n") if l.startswith("  60 Hz  ")]

@@ -377,7 +377,11 @@ study run_sweep(const sweep_options& opts) {
       if (sc.methods.empty()) continue;
     }
     sc.ref_tol = opts.tol;
+    // The sweep's limits, but the tighter work budget: a default scan may set its own
+    // (the rope's, study/scan.cpp default_scans), and a sweep's --work-budget still binds.
+    const double scan_budget = sc.limits.work_budget;
     sc.limits = opts.limits;
+    sc.limits.work_budget = std::min(scan_budget, opts.limits.work_budget);
     sc.jobs = opts.jobs;
     if (auto it = opts.overrides.find(sc.problem); it != opts.overrides.end())
       for (const auto& [name, value] : it->second)

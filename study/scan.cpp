@@ -342,7 +342,8 @@ std::vector<scan_options> default_scans(bool quick) {
   // 512 at the softest; the rest of the range to 4096 masses is judged on stability. The
   // runs' work budget is a quarter of the default (2^23 coordinate force evaluations, about
   // 2.5e-2 s of force work a run): at 4096 masses a run of more than 680 evaluations is
-  // skipped, which keeps the scan near 35 s on two cores (the 60 s for all three).
+  // skipped, which keeps the scan at 27 s on two cores in the full study (the 60 s
+  // for all three).
   scan_options chain;
   chain.problem = "spring_chain";
   chain.limits.work_budget = 1 << 23;

@@ -46,13 +46,16 @@ concept has_constraint_view = requires(const P& p, const typename P::vec& x, typ
 
 // The largest |C| / rest length over the constraints: how far the links are from their
 // lengths (for a compliant constraint, its stretch).
+// The distance a constraint holds: from its particle a (or its anchor) to particle b.
+inline double constraint_length(const particle_system& s, const distance_constraint& c) {
+  const Eigen::Vector3d pa = c.a < 0 ? c.anchor : Eigen::Vector3d(s.x.col(c.a));
+  return (s.x.col(c.b) - pa).norm();
+}
+
 inline double constraint_violation(const particle_system& s) {
   double worst = 0.0;
-  for (const auto& c : s.constraints) {
-    const Eigen::Vector3d pa = c.a < 0 ? c.anchor : Eigen::Vector3d(s.x.col(c.a));
-    const double stretch = (s.x.col(c.b) - pa).norm() - c.rest_length;
-    worst = std::max(worst, std::abs(stretch) / c.rest_length);
-  }
+  for (const auto& c : s.constraints)
+    worst = std::max(worst, std::abs(constraint_length(s, c) - c.rest_length) / c.rest_length);
   return worst;
 }
 

@@ -105,13 +105,8 @@ double xpbd_link_error(const n_pendulum& p, double hz, int substeps, double hori
 // |C_j(a) - C_j(b)| / L_j, the largest over the constraints (same particles and constraints).
 double link_error(const particle_system& a, const particle_system& b) {
   double worst = 0.0;
-  for (const auto& c : a.constraints) {
-    auto len = [&](const particle_system& s) {
-      const Eigen::Vector3d pa = c.a < 0 ? c.anchor : Eigen::Vector3d(s.x.col(c.a));
-      return (s.x.col(c.b) - pa).norm();
-    };
-    worst = std::max(worst, std::abs(len(a) - len(b)) / c.rest_length);
-  }
+  for (const auto& c : a.constraints)
+    worst = std::max(worst, std::abs(constraint_length(a, c) - constraint_length(b, c)) / c.rest_length);
   return worst;
 }
 

@@ -209,6 +209,44 @@ std::vector<std::string> findings_of(const verdict_tables& v, const finding_inpu
       out.push_back("Every library method's observed order matches its declared order where it can be fitted.");
     }
   }
+  // xpbd's stability and energy over its dt ladder (at a 60 Hz frame, the substep
+  // ladder): the claim that rigid links stay stable at every substep count, and
+  // XPBD's projection only removing energy, as the study's own runs show them.
+  {
+    std::string parts;
+    for (const auto& [problem, runs] : in.xpbd_ladders) {
+      int ran = 0, stable = 0, diverged = 0, failed = 0;
+      const ladder_run *coarsest = nullptr, *finest = nullptr;
+      double highest_drift = -std::numeric_limits<double>::infinity(), worst_constraint = nan;
+      for (const auto& r : runs) {
+        if (r.skipped) continue;
+        ++ran;
+        diverged += r.diverged;
+        failed += r.failed && !r.diverged;
+        if (!row_completed(r.diverged, r.failed, r.skipped)) continue;
+        ++stable;
+        if (!coarsest || r.dt > coarsest->dt) coarsest = &r;
+        if (!finest || r.dt < finest->dt) finest = &r;
+        highest_drift = std::fmax(highest_drift, r.energy_drift);
+        worst_constraint = std::fmax(worst_constraint, r.constraint_violation);
+      }
+      std::string part = fmt::format("{} stable at {} of the {} dt it ran", problem, stable, ran);
+      if (coarsest)
+        part += fmt::format(" ({} to {})", format_time_ns(coarsest->dt * 1e9), format_time_ns(finest->dt * 1e9));
+      if (diverged > 0) part += fmt::format(", diverged at {}", diverged);
+      if (failed > 0) part += fmt::format(", failed at {}", failed);
+      if (coarsest && std::isfinite(highest_drift))
+        part += fmt::format(", energy drift {:.2g} at the coarsest and {:.2g} at the finest (never above {:.2g})",
+                            coarsest->energy_drift, finest->energy_drift, highest_drift);
+      if (coarsest && std::isfinite(worst_constraint)) part += fmt::format(", |C|/L within {:.2g}", worst_constraint);
+      parts += (parts.empty() ? "" : "; ") + part;
+    }
+    if (!parts.empty())
+      out.push_back(fmt::format(
+          "xpbd over its dt ladder (energy drift: against the truth's energy, of the problem's energy scale; |C|/L: "
+          "the largest relative length error of a rigid link, the stretch of a spring): {}.",
+          parts));
+  }
   // Stability at 60 Hz, one step a frame.
   {
     std::map<std::string, std::vector<std::string>> unstable;  // problem -> methods
@@ -239,6 +277,16 @@ finding_inputs finding_inputs_of(const study& s) {
     for (const auto& ms : ps.methods)
       if (ms.info.origin == method_origin::peer && ms.declared_order_holds == 0)
         in.broken_orders[ms.info.name].insert(std::string(ps.problem->name()));
+  for (const auto& ps : s.problems)
+    for (const auto& ms : ps.methods) {
+      if (ms.info.name != "xpbd") continue;
+      ladder_finding f{std::string(ps.problem->name()), {}};
+      for (const auto& r : ms.rows) {
+        const auto& m = r.metrics;
+        f.runs.push_back({r.param, m.diverged, m.failed, m.skipped, m.energy_drift, m.constraint_violation_max});
+      }
+      in.xpbd_ladders.push_back(std::move(f));
+    }
   return in;
 }
 
@@ -268,6 +316,18 @@ finding_inputs read_finding_inputs(const H5::Group& root, const std::vector<std:
         const H5::Group g = methods.openGroup(m);
         if (h5::string_attr(g, "origin") == "peer" && h5::long_attr(g, "declared_order_holds") == 0)
           in.broken_orders[m].insert(p);
+      }
+      if (h5::is_group(methods, "xpbd")) {
+        const auto t = h5::read_table(methods.openGroup("xpbd").openDataSet("runs"));
+        const auto dt = t.doubles("param"), drift = t.doubles("energy_drift");
+        // A study written before the field reads as NaN (as study_reader.cpp does).
+        const auto constraint = t.has("constraint_violation_max") ? t.doubles("constraint_violation_max")
+                                                                  : std::vector<double>(t.rows(), nan);
+        const auto &diverged = t.ints("diverged"), &failed = t.ints("failed"), &skipped = t.ints("skipped");
+        ladder_finding f{p, {}};
+        for (std::size_t i = 0; i < t.rows(); ++i)
+          f.runs.push_back({dt[i], diverged[i] != 0, failed[i] != 0, skipped[i] != 0, drift[i], constraint[i]});
+        in.xpbd_ladders.push_back(std::move(f));
       }
     }
   }

@@ -91,9 +91,21 @@ struct substep_finding {
   double frame_dt = 0.0;
   substep_verdict verdict;  // implicit_euler against semi_implicit_euler
 };
+// xpbd's runs over a problem's dt ladder (coarse to fine, as the study stores them): what
+// the finding on its stability and energy reads.
+struct ladder_run {
+  double dt = 0.0;
+  bool diverged = false, failed = false, skipped = false;
+  double energy_drift = 0.0, constraint_violation = 0.0;
+};
+struct ladder_finding {
+  std::string problem;
+  std::vector<ladder_run> runs;
+};
 struct finding_inputs {
   std::vector<substep_finding> substeps;                       // in the study's problem order
   std::map<std::string, std::set<std::string>> broken_orders;  // peer -> problems where its declared order fails
+  std::vector<ladder_finding> xpbd_ladders;                    // in the study's problem order
 };
 finding_inputs finding_inputs_of(const study& s);
 // From a study file's /substeps/<p>/verdict and /problems/<p>/methods, for `problems` in

@@ -10,6 +10,7 @@
 #include "core/drive.hpp"
 #include "default_study.hpp"
 #include "study/sweep.hpp"
+#include "study/verdict.hpp"
 
 using namespace stepbench;
 using stepbench::test_support::default_study;
@@ -245,6 +246,43 @@ TEST(sweep, divergence_follows_the_stability_limit) {
         EXPECT_FALSE(row.metrics.diverged) << p.problem->name() << "/" << ms.info.name << " " << row.param;
     }
   }
+}
+
+// xpbd on rigid links (pendulum, n_pendulum: compliance 0) is stable at every dt of its
+// ladder, from a frame or coarser down to round-off, and never gains energy (a projection
+// only removes it); the study's finding on xpbd says so from the same rows.
+TEST(sweep, xpbd_is_stable_on_rigid_links_at_every_dt_and_the_finding_says_so) {
+  const study& s = default_study();
+  const auto v = compute_verdict(s);
+  const auto finding = std::find_if(v.findings.begin(), v.findings.end(),
+                                    [](const std::string& f) { return f.starts_with("xpbd over its dt ladder"); });
+  ASSERT_NE(finding, v.findings.end());
+  int problems = 0;
+  for (const auto& ps : s.problems) {
+    const auto it =
+        std::find_if(ps.methods.begin(), ps.methods.end(), [](const method_study& m) { return m.info.name == "xpbd"; });
+    if (it == ps.methods.end()) continue;
+    ++problems;
+    int ran = 0, stable = 0;
+    for (const auto& row : it->rows) {
+      ran += !row.metrics.skipped;
+      stable += row.metrics.completed();
+    }
+    EXPECT_NE(finding->find(fmt::format("{} stable at {} of the {} dt it ran", ps.problem->name(), stable, ran)),
+              std::string::npos)
+        << *finding;
+    const auto name = ps.problem->name();
+    if (name != "pendulum" && name != "n_pendulum") continue;
+    EXPECT_GE(ran, 8) << name;
+    EXPECT_EQ(stable, ran) << name;
+    EXPECT_GE(it->rows.front().param, (1.0 - 1e-9) / 60.0) << name << ": the ladder starts at a frame or coarser";
+    for (const auto& row : it->rows) {
+      if (row.metrics.completed()) {
+        EXPECT_LE(row.metrics.energy_drift, 1e-12) << name << " dt " << row.param;
+      }
+    }
+  }
+  EXPECT_EQ(problems, 5);  // the scenes with a constraint view
 }
 
 // The fixed-step ladder runs on past `levels` to each method's round-off where the work

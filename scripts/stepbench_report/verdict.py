@@ -400,6 +400,9 @@ def readme_block(study, command):
     if orders:
         lines[-2:-2] = ["", "**xpbd's observed order** over the substep ladder (the study's fit, its levels in "
                         "brackets): " + "; ".join(orders) + "."]
+    ladder = xpbd_ladder_finding(v)
+    if ladder:
+        lines[-2:-2] = ["", "**xpbd's stability and energy** (a finding of the study, verbatim): " + ladder]
     answers = _range_answers(study)
     if answers:
         from . import range_answer
@@ -417,6 +420,14 @@ def _range_answers(study):
         return range_answer.range_answers(study.path)
     except (OSError, KeyError):
         return []
+
+
+XPBD_LADDER_FINDING = "xpbd over its dt ladder"  # how study/verdict.cpp's finding on xpbd's runs opens
+
+
+def xpbd_ladder_finding(v):
+    """The finding on xpbd's stability and energy over its ladder, as stored; None without one."""
+    return next((f for f in v.findings if f.startswith(XPBD_LADDER_FINDING)), None)
 
 
 def xpbd_orders(study):

@@ -671,6 +671,12 @@ def test_markdown_and_readme(reports, tmp_path):
     assert "| problem | error 1e-4 | error 1e-8 | 60 Hz, error 1e-4 |" in block
     assert "| pendulum (rad) | " in block
     assert all(w in block for w in where) and str(study) in block
+    # xpbd's stability and energy: the study's own finding, verbatim (study/verdict.cpp).
+    with h5py.File(study, "r") as f:
+        findings = text(f["verdict"].attrs["findings"]).split("\n")
+    ladder = [x for x in findings if x.startswith("xpbd over its dt ladder")]
+    assert len(ladder) == 1 and "pendulum stable at " in ladder[0]
+    assert f"**xpbd's stability and energy** (a finding of the study, verbatim): {ladder[0]}" in block
     # Run again: the same file (only the block is ever rewritten).
     before = readme.read_text()
     assert subprocess.run(command, capture_output=True, text=True, timeout=60, cwd=tmp_path).returncode == 0

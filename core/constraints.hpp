@@ -44,14 +44,14 @@ concept has_constraint_view = requires(const P& p, const typename P::vec& x, typ
   {p.from_particles(s, out, out)};
 };
 
-// The largest |C| / rest length over the constraints: how far the links are from their
-// lengths (for a compliant constraint, its stretch).
 // The distance a constraint holds: from its particle a (or its anchor) to particle b.
 inline double constraint_length(const particle_system& s, const distance_constraint& c) {
   const Eigen::Vector3d pa = c.a < 0 ? c.anchor : Eigen::Vector3d(s.x.col(c.a));
   return (s.x.col(c.b) - pa).norm();
 }
 
+// The largest |C| / rest length over the constraints: how far the links are from their
+// lengths (for a compliant constraint, its stretch).
 inline double constraint_violation(const particle_system& s) {
   double worst = 0.0;
   for (const auto& c : s.constraints)

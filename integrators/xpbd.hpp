@@ -89,11 +89,11 @@ struct xpbd_method {
             // substep ladder), stable at every substep count on rigid links and dissipative
             // there (tests/test_xpbd.cpp: rigid_*_is_stable_at_every_substep_count).
             .description = small_steps ? "XPBD small steps: one constraint pass a substep (Macklin et al. 2019); "
-                                         "rigid links stable at every substep count, energy never grows"
+                                         "rigid links: stable at every substep count, energy never above its start"
                                        : "XPBD: " + std::to_string(Iterations) +
                                              " constraint passes a step, lambda accumulated (Macklin et al. 2016); "
-                                             "the design Small Steps argues against; rigid links stable at every "
-                                             "step count, energy never grows",
+                                             "the design Small Steps argues against; rigid links: stable at every "
+                                             "step count, energy never above its start",
             .origin = method_origin::ours,
             .declared_order = 1.0,
             .evals_per_step = static_cast<double>(Iterations),

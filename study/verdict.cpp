@@ -230,12 +230,15 @@ std::vector<std::string> findings_of(const verdict_tables& v, const finding_inpu
         highest_drift = std::fmax(highest_drift, r.energy_drift);
         worst_constraint = std::fmax(worst_constraint, r.constraint_violation);
       }
-      std::string part = fmt::format("{} stable at {} of the {} dt it ran", problem, stable, ran);
+      if (ran == 0) continue;  // every rung over the work budget: nothing to say of it
+      std::string part = fmt::format("{} ran without diverging at {} of the {} dt it ran", problem, stable, ran);
       if (coarsest)
         part += fmt::format(" ({} to {})", format_time_ns(coarsest->dt * 1e9), format_time_ns(finest->dt * 1e9));
       if (diverged > 0) part += fmt::format(", diverged at {}", diverged);
       if (failed > 0) part += fmt::format(", failed at {}", failed);
-      if (coarsest && std::isfinite(highest_drift))
+      // A merged file may lack a drift (NaN): say only the numbers the runs have.
+      if (coarsest && std::isfinite(highest_drift) && std::isfinite(coarsest->energy_drift) &&
+          std::isfinite(finest->energy_drift))
         part += fmt::format(", energy drift {:.2g} at the coarsest and {:.2g} at the finest (never above {:.2g})",
                             coarsest->energy_drift, finest->energy_drift, highest_drift);
       if (coarsest && std::isfinite(worst_constraint)) part += fmt::format(", |C|/L within {:.2g}", worst_constraint);

@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 #include "core/drive.hpp"
 #include "default_study.hpp"
@@ -268,11 +270,33 @@ TEST(sweep, xpbd_is_stable_on_rigid_links_at_every_dt_and_the_finding_says_so) {
       ran += !row.metrics.skipped;
       stable += row.metrics.completed();
     }
-    EXPECT_NE(finding->find(fmt::format("{} stable at {} of the {} dt it ran", ps.problem->name(), stable, ran)),
-              std::string::npos)
-        << *finding;
+    // The scene's part of the finding: after "): " (the first scene) or "; " (the others),
+    // so that "pendulum" does not match the end of "n_pendulum"; it runs to the next "; ".
+    const auto head =
+        fmt::format("{} ran without diverging at {} of the {} dt it ran", ps.problem->name(), stable, ran);
+    auto at = finding->find("): " + head);
+    if (at == std::string::npos) at = finding->find("; " + head);
+    ASSERT_NE(at, std::string::npos) << head << " not in: " << *finding;
+    const auto begin = finding->find(head, at);
+    const auto part = finding->substr(begin, finding->find("; ", begin) - begin);
     const auto name = ps.problem->name();
     if (name != "pendulum" && name != "n_pendulum") continue;
+    EXPECT_EQ(part.find(", diverged at"), std::string::npos) << part;
+    EXPECT_EQ(part.find(", failed at"), std::string::npos) << part;
+    // The drifts it prints (coarsest, finest, largest) are never above round-off on rigid
+    // links (the same bound as the rows' below).
+    const auto drift = part.find(", energy drift ");
+    ASSERT_NE(drift, std::string::npos) << part;
+    double coarsest = 0, finest = 0, largest = 0;
+    ASSERT_EQ(
+        std::sscanf(part.c_str() + drift, ", energy drift %lf at the coarsest and %lf at the finest (never above %lf)",
+                    &coarsest, &finest, &largest),
+        3)
+        << part;
+    EXPECT_LE(coarsest, 1e-12) << part;
+    EXPECT_LE(finest, 1e-12) << part;
+    EXPECT_LE(largest, 1e-12) << part;
+    EXPECT_GE(largest, std::max(coarsest, finest)) << part;
     EXPECT_GE(ran, 8) << name;
     EXPECT_EQ(stable, ran) << name;
     EXPECT_GE(it->rows.front().param, (1.0 - 1e-9) / 60.0) << name << ": the ladder starts at a frame or coarser";

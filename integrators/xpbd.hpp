@@ -85,15 +85,16 @@ struct xpbd_method {
   static method_info describe() {
     const bool small_steps = Iterations == 1;
     return {.name = small_steps ? "xpbd" : "xpbd_iterations",
-            // What `stepbench list` says of its behaviour: first order (the study's fit over the
-            // substep ladder), stable at every substep count on rigid links and dissipative
-            // there (tests/test_xpbd.cpp: rigid_*_is_stable_at_every_substep_count).
+            // What `stepbench list` says of its behaviour on rigid links, as far as it was
+            // tried: 1 to 500 substeps a 60 Hz frame for 10 s, energy checked at every step
+            // (tests/test_xpbd.cpp: rigid_*_is_stable_at_every_substep_count).
             .description = small_steps ? "XPBD small steps: one constraint pass a substep (Macklin et al. 2019); "
-                                         "rigid links: stable at every substep count, energy never above its start"
+                                         "rigid links: stable, energy never above its start, at every substep "
+                                         "count tried (1 to 500 a frame)"
                                        : "XPBD: " + std::to_string(Iterations) +
                                              " constraint passes a step, lambda accumulated (Macklin et al. 2016); "
-                                             "the design Small Steps argues against; rigid links: stable at every "
-                                             "step count, energy never above its start",
+                                             "the design Small Steps argues against; rigid links: stable, energy "
+                                             "never above its start, at every step count tried (1 to 500 a frame)",
             .origin = method_origin::ours,
             .declared_order = 1.0,
             .evals_per_step = static_cast<double>(Iterations),

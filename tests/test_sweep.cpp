@@ -6,10 +6,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
+#include <limits>
 #include <string>
+#include <vector>
 
 #include "core/drive.hpp"
+#include "core/work_precision.hpp"
 #include "default_study.hpp"
 #include "study/sweep.hpp"
 #include "study/verdict.hpp"
@@ -250,10 +252,45 @@ TEST(sweep, divergence_follows_the_stability_limit) {
   }
 }
 
-// xpbd on rigid links (pendulum, n_pendulum: compliance 0) is stable at every dt of its
-// ladder, from a frame or coarser down to round-off, and never gains energy (a projection
-// only removes it); the study's finding on xpbd says so from the same rows.
-TEST(sweep, xpbd_is_stable_on_rigid_links_at_every_dt_and_the_finding_says_so) {
+// The part of the xpbd finding for one scene, as its rows give it: a second writing of
+// study/verdict.cpp's sentence, from the rows (coarse to fine), so that a swapped
+// coarsest and finest, a min for a max or a miscount shows.
+static std::string expected_xpbd_part(const std::string& problem, const std::vector<method_row>& rows) {
+  int ran = 0, completed = 0, diverged = 0, failed = 0;
+  double dt_max = 0, dt_min = INFINITY, largest = -INFINITY, worst = NAN;
+  const method_row *coarsest = nullptr, *finest = nullptr;
+  for (const auto& row : rows) {
+    const auto& m = row.metrics;
+    if (m.skipped) continue;
+    ++ran;
+    dt_max = std::max(dt_max, row.param);
+    dt_min = std::min(dt_min, row.param);
+    diverged += m.diverged;
+    failed += m.failed && !m.diverged;
+    if (!m.completed()) continue;
+    ++completed;
+    if (!coarsest) coarsest = &row;
+    finest = &row;
+    largest = std::fmax(largest, m.energy_drift);
+    worst = std::fmax(worst, m.constraint_violation_max);
+  }
+  auto part = fmt::format("{} completed {} of the {} dt it ran ({} to {})", problem, completed, ran,
+                          format_time_ns(dt_max * 1e9), format_time_ns(dt_min * 1e9));
+  if (diverged > 0) part += fmt::format(", diverged at {}", diverged);
+  if (failed > 0) part += fmt::format(", failed at {}", failed);
+  if (coarsest)
+    part += fmt::format(", final energy drift {:.2g} at {} and {:.2g} at {} (largest {:.2g})",
+                        coarsest->metrics.energy_drift, format_time_ns(coarsest->param * 1e9),
+                        finest->metrics.energy_drift, format_time_ns(finest->param * 1e9), largest);
+  if (std::isfinite(worst)) part += fmt::format(", |C|/L within {:.2g}", worst);
+  return part;
+}
+
+// xpbd on rigid links (pendulum, n_pendulum: compliance 0) completes at every dt of its
+// ladder, from a frame or coarser down to round-off, and ends every run with no energy
+// gained (a projection only removes it; tests/test_xpbd.cpp checks every step of the
+// run); the study's finding on xpbd says what the rows say, scene by scene.
+TEST(sweep, xpbd_completes_on_rigid_links_at_every_dt_and_the_finding_says_so) {
   const study& s = default_study();
   const auto v = compute_verdict(s);
   const auto finding = std::find_if(v.findings.begin(), v.findings.end(),
@@ -265,40 +302,22 @@ TEST(sweep, xpbd_is_stable_on_rigid_links_at_every_dt_and_the_finding_says_so) {
         std::find_if(ps.methods.begin(), ps.methods.end(), [](const method_study& m) { return m.info.name == "xpbd"; });
     if (it == ps.methods.end()) continue;
     ++problems;
-    int ran = 0, stable = 0;
+    const auto name = std::string(ps.problem->name());
+    // The scene's part: after "): " (the first scene) or "; " (the others), so that
+    // "pendulum" does not match the end of "n_pendulum", and up to the next "; " or ".".
+    const auto part = expected_xpbd_part(name, it->rows);
+    EXPECT_TRUE(finding->find("): " + part + ";") != std::string::npos ||
+                finding->find("; " + part + ";") != std::string::npos ||
+                finding->find("; " + part + ".") != std::string::npos)
+        << part << "\nnot in: " << *finding;
+    if (name != "pendulum" && name != "n_pendulum") continue;
+    int ran = 0, completed = 0;
     for (const auto& row : it->rows) {
       ran += !row.metrics.skipped;
-      stable += row.metrics.completed();
+      completed += row.metrics.completed();
     }
-    // The scene's part of the finding: after "): " (the first scene) or "; " (the others),
-    // so that "pendulum" does not match the end of "n_pendulum"; it runs to the next "; ".
-    const auto head =
-        fmt::format("{} ran without diverging at {} of the {} dt it ran", ps.problem->name(), stable, ran);
-    auto at = finding->find("): " + head);
-    if (at == std::string::npos) at = finding->find("; " + head);
-    ASSERT_NE(at, std::string::npos) << head << " not in: " << *finding;
-    const auto begin = finding->find(head, at);
-    const auto part = finding->substr(begin, finding->find("; ", begin) - begin);
-    const auto name = ps.problem->name();
-    if (name != "pendulum" && name != "n_pendulum") continue;
-    EXPECT_EQ(part.find(", diverged at"), std::string::npos) << part;
-    EXPECT_EQ(part.find(", failed at"), std::string::npos) << part;
-    // The drifts it prints (coarsest, finest, largest) are never above round-off on rigid
-    // links (the same bound as the rows' below).
-    const auto drift = part.find(", energy drift ");
-    ASSERT_NE(drift, std::string::npos) << part;
-    double coarsest = 0, finest = 0, largest = 0;
-    ASSERT_EQ(
-        std::sscanf(part.c_str() + drift, ", energy drift %lf at the coarsest and %lf at the finest (never above %lf)",
-                    &coarsest, &finest, &largest),
-        3)
-        << part;
-    EXPECT_LE(coarsest, 1e-12) << part;
-    EXPECT_LE(finest, 1e-12) << part;
-    EXPECT_LE(largest, 1e-12) << part;
-    EXPECT_GE(largest, std::max(coarsest, finest)) << part;
     EXPECT_GE(ran, 8) << name;
-    EXPECT_EQ(stable, ran) << name;
+    EXPECT_EQ(completed, ran) << name;
     EXPECT_GE(it->rows.front().param, (1.0 - 1e-9) / 60.0) << name << ": the ladder starts at a frame or coarser";
     for (const auto& row : it->rows) {
       if (row.metrics.completed()) {
@@ -307,6 +326,37 @@ TEST(sweep, xpbd_is_stable_on_rigid_links_at_every_dt_and_the_finding_says_so) {
     }
   }
   EXPECT_EQ(problems, 5);  // the scenes with a constraint view
+}
+
+// The finding's branches the default study does not reach: diverged and failed rungs
+// counted apart from the completed (and the dt range over all that ran), a NaN drift or
+// constraint error (a merged file without them) left unsaid, a scene whose every rung was
+// skipped left out, and no finding at all without xpbd runs.
+TEST(sweep, xpbd_finding_counts_diverged_failed_and_skipped_runs) {
+  const verdict_tables none{};
+  finding_inputs in;
+  const auto xpbd_finding = [&] {
+    const auto fs = findings_of(none, in);
+    const auto f = std::find_if(fs.begin(), fs.end(),
+                                [](const std::string& s) { return s.starts_with("xpbd over its dt ladder"); });
+    return f == fs.end() ? std::string() : *f;
+  };
+  EXPECT_EQ(xpbd_finding(), "");
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  // dt, diverged, failed, skipped, energy_drift, constraint_violation
+  in.xpbd_ladders.push_back({"rope",
+                             {{0.1, true, true, false, nan, nan},
+                              {0.05, false, true, false, nan, nan},
+                              {0.025, false, false, false, -0.5, 0.25},
+                              {0.0125, false, false, false, 0.1, 0.0625},
+                              {0.00625, false, false, false, -0.25, 0.03125},
+                              {0.003125, false, false, true, 0.0, 0.0}}});
+  in.xpbd_ladders.push_back({"skipped", {{0.1, false, false, true, 0.0, 0.0}}});
+  in.xpbd_ladders.push_back({"merged", {{0.1, false, false, false, nan, nan}}});
+  EXPECT_EQ(xpbd_finding().substr(xpbd_finding().find("): ") + 3),
+            "rope completed 3 of the 5 dt it ran (100 ms to 6.25 ms), diverged at 1, failed at 1, final energy drift "
+            "-0.5 at 25 ms and -0.25 at 6.25 ms (largest 0.1), |C|/L within 0.25; merged completed 1 of the 1 dt it "
+            "ran (100 ms to 100 ms).");
 }
 
 // The fixed-step ladder runs on past `levels` to each method's round-off where the work

@@ -18,7 +18,7 @@
 #include <string>
 
 #include "bench/scaling.hpp"
-#include "study/registry.hpp"
+#include "registry/registry.hpp"
 
 namespace stepbench::bench {
 namespace {

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "registry/registry.hpp"
 #include "study/bench_merge.hpp"
-#include "study/registry.hpp"
 
 namespace stepbench::bench {
 namespace {

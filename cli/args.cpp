@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "core/number.hpp"
-#include "study/registry.hpp"
+#include "registry/registry.hpp"
 
 namespace stepbench {
 

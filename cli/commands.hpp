@@ -3,6 +3,7 @@
 // returns the function that runs it; main() dispatches and turns exceptions into one
 // line and an exit code (2 bad usage: std::invalid_argument; 1 anything else).
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -31,6 +32,11 @@ command add_energy(CLI::App& app);
 command add_schema(CLI::App& app);
 command add_scan(CLI::App& app);
 command add_merge(CLI::App& app);
+
+// A measured number as JSON: null where it is not finite (JSON has no NaN).
+inline nlohmann::json number_or_null(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
 
 // The range answer of a scan as JSON (`scan --json`, `advise --scan --json`).
 nlohmann::json scan_answer_json(const scan_answer& a);

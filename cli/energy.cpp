@@ -27,8 +27,6 @@ struct energy_args {
   std::vector<std::string> sets;
 };
 
-json number_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-
 std::string sci(double v) { return std::isfinite(v) ? fmt::format("{:.2e}", v) : "-"; }
 std::string signed_sci(double v) { return std::isfinite(v) ? fmt::format("{:+.2e}", v) : "-"; }
 

@@ -9,7 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
-#include "study/registry.hpp"
+#include "registry/registry.hpp"
 #include "study/table_render.hpp"
 
 namespace stepbench::cli {
@@ -141,8 +141,8 @@ int run_list(bool as_json) {
               {"kind", to_string(m.kind)},
               {"library", m.library},
               {"capabilities", capabilities_json(m.traits)}};
-    j["declared_order"] = std::isfinite(m.declared_order) ? json(m.declared_order) : json(nullptr);
-    j["evals_per_step"] = std::isfinite(m.evals_per_step) ? json(m.evals_per_step) : json(nullptr);
+    j["declared_order"] = number_or_null(m.declared_order);
+    j["evals_per_step"] = number_or_null(m.evals_per_step);
     json runs_on = json::array();
     for (const auto& p : out["problems"])
       if (std::ranges::find(p["methods"], json(m.name)) != p["methods"].end()) runs_on.push_back(p["name"]);

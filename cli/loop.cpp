@@ -35,8 +35,6 @@ struct loop_args {
   bool json = false, quiet = false, strict = false;
 };
 
-json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-
 loop_design parse_design(const std::string& text) {
   for (loop_design d : all_loop_designs)
     if (to_string(d) == text) return d;
@@ -125,7 +123,7 @@ json one_loop_json(const loop_args& a, const problem_instance& problem, const lo
           {"clamp_s", c.clamp_s > 0.0 ? json(c.clamp_s) : json(nullptr)},
           {"jitter_seed", c.jitter_seed ? json(*c.jitter_seed) : json(nullptr)},
           {"jitter", c.jitter_seed ? json(c.jitter) : json(nullptr)},
-          {"stall_at_s", number(c.stall_at_s)},
+          {"stall_at_s", number_or_null(c.stall_at_s)},
           {"stall_s", c.stalls() ? json(c.stall_s) : json(nullptr)},
           {"horizon", c.horizon},
           {"position_unit", unit},
@@ -136,21 +134,21 @@ json one_loop_json(const loop_args& a, const problem_instance& problem, const lo
           {"final_physics_position", part(r.final_physics, 0)},
           {"final_physics_velocity", part(r.final_physics, dim)},
           {"final_shown_position", part(r.final_shown, 0)},
-          {"shown_err_max", number(r.shown_err_max)},
-          {"shown_err_rms", number(r.shown_err_rms)},
-          {"final_shown_err", number(r.final_shown_err)},
+          {"shown_err_max", number_or_null(r.shown_err_max)},
+          {"shown_err_rms", number_or_null(r.shown_err_rms)},
+          {"final_shown_err", number_or_null(r.final_shown_err)},
           {"reference_display_hz", opts.reference_display_hz},
-          {"clock_dependence", number(r.clock_dependence)},
-          {"physics_clock_dependence", number(r.physics_clock_dependence)},
-          {"judder", number(r.judder)},
-          {"lag_s", number(r.lag_s)},
-          {"lag_clock_s", number(r.lag_clock_s)},
-          {"steps_per_frame_mean", number(r.steps_per_frame_mean)},
+          {"clock_dependence", number_or_null(r.clock_dependence)},
+          {"physics_clock_dependence", number_or_null(r.physics_clock_dependence)},
+          {"judder", number_or_null(r.judder)},
+          {"lag_s", number_or_null(r.lag_s)},
+          {"lag_clock_s", number_or_null(r.lag_clock_s)},
+          {"steps_per_frame_mean", number_or_null(r.steps_per_frame_mean)},
           {"steps_per_frame_max", r.steps_per_frame_max},
           {"stall_burst_steps", r.stall_burst_steps},
           {"clamp_hits", r.clamp_hits},
-          {"alpha_min", number(r.alpha_min)},
-          {"alpha_max", number(r.alpha_max)},
+          {"alpha_min", number_or_null(r.alpha_min)},
+          {"alpha_max", number_or_null(r.alpha_max)},
           {"diverged", r.diverged},
           {"note", r.note},
           {"cost",

@@ -21,7 +21,7 @@
 
 #include "cli/commands.hpp"
 #include "core/work_precision.hpp"
-#include "study/registry.hpp"
+#include "registry/registry.hpp"
 #include "study/study_reader.hpp"
 #include "study/table_render.hpp"
 

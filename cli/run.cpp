@@ -12,7 +12,7 @@
 #include "cli/commands.hpp"
 #include "core/drive.hpp"
 #include "core/measure.hpp"
-#include "study/registry.hpp"
+#include "registry/registry.hpp"
 
 namespace stepbench::cli {
 namespace {

@@ -20,8 +20,6 @@ namespace {
 
 using json = nlohmann::json;
 
-json number_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-
 int run_stability(bool as_json) {
   const stability_data d = compute_stability();
   if (as_json) {

@@ -1,7 +1,7 @@
 #pragma once
 // What a problem and an integrator are. These are compile-time contracts: the step
 // loop is instantiated per (problem, integrator) pair and inlines the force model.
-// Type erasure happens only in the registry (problem_model<P> in study/problem_model.hpp,
+// Type erasure happens only in the registry (problem_model<P> in registry/problem_model.hpp,
 // compiled once per problem), outside every loop.
 //
 // The integrator categories follow Boost.Odeint's: a stepper advances by a given dt;

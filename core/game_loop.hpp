@@ -46,7 +46,6 @@
 
 #include "core/concepts.hpp"
 #include "core/drive.hpp"
-#include "core/flatten.hpp"
 #include "core/system.hpp"
 
 namespace stepbench {
@@ -300,11 +299,16 @@ std::vector<double> joined(const Vec& x, const Vec& v) {
 }
 }  // namespace detail
 
-// The run of one design. flatten, as drive(): the step, the force model and Eigen's
-// expressions inline into the frame loop.
-template <loop_design D, problem P, integrator I>
-STEPBENCH_FLATTEN loop_result simulate_loop_design(const P& problem, const I& method, const loop_config& cfg) {
+// Runs `cfg` (checked with loop_config_error first) for one problem and integrator: one
+// instance per pair, the design a run-time choice. Not flattened as drive() is: the loop
+// study's runs are measured for what they show, not timed, and a flattened copy of every
+// step in every pair's loop cost the build more than the rest of it (an implicit step on
+// n_pendulum flattened into the loop: 74 s to compile against 10 s).
+template <problem P, integrator I>
+loop_result simulate_loop(const P& problem, const I& method, const loop_config& cfg) {
   using Vec = typename P::vec;
+  const loop_design design = cfg.design;
+  const bool accumulator = uses_accumulator(design);
   counted_system<P> sys{problem};
   step_state<Vec> s = start_state(problem);
   stepper_t<I, counted_system<P>> stepper(method);
@@ -338,27 +342,26 @@ STEPBENCH_FLATTEN loop_result simulate_loop_design(const P& problem, const I& me
   while (!timer.done()) {
     const frame_plan f = timer.next();
     for (int i = 0; i < f.steps; ++i) {
-      // advance
-      if constexpr (D == loop_design::interpolated) previous_x = s.x, previous_v = s.v;
-      if constexpr (uses_accumulator(D)) {
-        // t = n dt, not a running sum: the step sees the same time on every clock.
+      // advance (t = n dt on the accumulator designs, not a running sum: the step sees the
+      // same time on every clock), then after_step
+      if (design == loop_design::interpolated) previous_x = s.x, previous_v = s.v;
+      if (accumulator) {
         advance(static_cast<double>(n) * dt, dt);
         ++n;
         stepbench::after_step(problem, static_cast<double>(n) * dt, s);
       } else {
         advance(t_frame + i * f.h, f.h);
-        // after_step
         stepbench::after_step(problem, i + 1 == f.steps ? f.game_t : t_frame + (i + 1) * f.h, s);
       }
     }
-    if constexpr (!uses_accumulator(D)) n += f.steps;
+    if (!accumulator) n += f.steps;
     t_frame = f.game_t;
     // record: the state the design shows
-    if constexpr (D == loop_design::interpolated) {
+    if (design == loop_design::interpolated) {
       shown_x = (1.0 - f.alpha) * previous_x + f.alpha * s.x;
       shown_v = (1.0 - f.alpha) * previous_v + f.alpha * s.v;
       out.record(f, n == 0 ? 0.0 : (static_cast<double>(n - 1) + f.alpha) * dt, shown_x);
-    } else if constexpr (D == loop_design::fixed) {
+    } else if (design == loop_design::fixed) {
       out.record(f, static_cast<double>(n) * dt, s.x);
     } else {
       out.record(f, f.game_t, s.x);
@@ -369,26 +372,11 @@ STEPBENCH_FLATTEN loop_result simulate_loop_design(const P& problem, const I& me
     }
   }
   out.physics_steps = n;
-  out.physics_t = uses_accumulator(D) ? static_cast<double>(n) * dt : t_frame;
+  out.physics_t = accumulator ? static_cast<double>(n) * dt : t_frame;
   out.final_physics = detail::joined(s.x, s.v);
-  out.final_shown = D == loop_design::interpolated ? detail::joined(shown_x, shown_v) : out.final_physics;
+  out.final_shown = design == loop_design::interpolated ? detail::joined(shown_x, shown_v) : out.final_physics;
   out.work = sys.work;
   return out;
-}
-
-// Runs `cfg` (checked with loop_config_error first) for one problem and integrator.
-template <problem P, integrator I>
-loop_result simulate_loop(const P& problem, const I& method, const loop_config& cfg) {
-  switch (cfg.design) {
-    case loop_design::variable:
-      return simulate_loop_design<loop_design::variable>(problem, method, cfg);
-    case loop_design::fixed:
-      return simulate_loop_design<loop_design::fixed>(problem, method, cfg);
-    case loop_design::interpolated:
-      return simulate_loop_design<loop_design::interpolated>(problem, method, cfg);
-    default:
-      return simulate_loop_design<loop_design::substeps>(problem, method, cfg);
-  }
 }
 
 // The cost model. Each physics step costs `step_cost_s` of wall time; a frame lasts

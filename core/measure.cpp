@@ -8,10 +8,10 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "core/number.hpp"
+
 namespace stepbench {
 namespace {
-
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
 double norm_diff(std::span<const double> a, std::span<const double> b, int offset, int dim) {
   double s = 0.0;

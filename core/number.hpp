@@ -4,10 +4,14 @@
 // (core/parameter.cpp's param_value::parse).
 #include <charconv>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <string_view>
 
 namespace stepbench {
+
+// The value of a measure that does not apply or was not taken.
+inline constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
 inline std::optional<double> finite_number(std::string_view text) {
   double value = 0.0;

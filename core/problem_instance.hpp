@@ -1,7 +1,7 @@
 #pragma once
 // A problem with its parameters, type-erased: what the application (sweep, commands,
-// benchmark) holds. problem_model<P> (study/problem_model.hpp) implements it once per
-// problem type, in that problem's own unit, and study/registry.cpp makes it by name;
+// benchmark) holds. problem_model<P> (registry/problem_model.hpp) implements it once per
+// problem type, in that problem's own unit, and registry/registry.cpp makes it by name;
 // every call below dispatches to code instantiated for that type, so no step loop makes
 // a virtual call.
 #include <functional>

@@ -1,7 +1,7 @@
 #pragma once
 // Our explicit fixed-step integrators, one group of the integrator registry
-// (integrators/all.hpp). Each group is compiled in its own unit per problem
-// (study/method_unit.cpp.in), so that editing one integrator rebuilds its group only.
+// (integrators/all.hpp), included by the generated unit of each problem its methods run
+// on (registry/problem_unit.cpp.in).
 #include "core/type_list.hpp"
 #include "integrators/euler.hpp"
 #include "integrators/forest_ruth.hpp"

@@ -1,6 +1,6 @@
 #pragma once
-// The adaptive peers, one group of the peer registry (peers/all.hpp), compiled in its own
-// unit per problem (study/method_unit.cpp.in).
+// The adaptive peers, one group of the peer registry (peers/all.hpp), included by the
+// generated unit of each problem they run on (registry/problem_unit.cpp.in).
 #include "core/type_list.hpp"
 #include "peers/library_adaptive.hpp"
 #include "peers/odeint_high_order.hpp"

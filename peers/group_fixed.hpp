@@ -1,6 +1,6 @@
 #pragma once
 // The fixed-step peers and the baselines, one group of the peer registry (peers/all.hpp),
-// compiled in its own unit per problem (study/method_unit.cpp.in).
+// included by the generated unit of each problem they run on (registry/problem_unit.cpp.in).
 #include "core/type_list.hpp"
 #include "peers/arkode_fixed.hpp"
 #include "peers/baseline_rk4.hpp"

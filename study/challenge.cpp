@@ -10,18 +10,17 @@
 
 #include "core/drive.hpp"
 #include "core/measure.hpp"
+#include "core/number.hpp"
 #include "integrators/implicit_euler.hpp"
 #include "integrators/semi_implicit_euler.hpp"
 #include "integrators/xpbd.hpp"
 #include "problems/n_pendulum.hpp"
 #include "problems/spring_chain.hpp"
+#include "registry/registry.hpp"
 #include "study/h5.hpp"
-#include "study/registry.hpp"
 
 namespace stepbench {
 namespace {
-
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
 // The median of `repeats` timings of a whole run, in ns (one untimed run first).
 double median_ns(const std::function<void()>& run, int repeats = 5) {

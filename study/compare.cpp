@@ -10,13 +10,12 @@
 #include <string_view>
 #include <tuple>
 
+#include "core/number.hpp"
 #include "core/work_precision.hpp"
 #include "study/table_render.hpp"
 
 namespace stepbench {
 namespace {
-
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
 // ---------------------------------------------------------------------------------------
 // The checks. Each takes a pair (the same problem, or the same method, in both files)

@@ -9,14 +9,13 @@
 #include <limits>
 #include <stdexcept>
 
+#include "core/number.hpp"
 #include "study/h5.hpp"
 #include "study/study_file.hpp"
 #include "study/sweep.hpp"
 
 namespace stepbench {
 namespace {
-
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
 // Least-squares slope of y against k = 1..n.
 double slope(const std::vector<double>& y) {

@@ -10,6 +10,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "core/contains.hpp"
+#include "core/number.hpp"
 #include "core/statistics.hpp"
 #include "study/h5.hpp"
 #include "study/sweep.hpp"
@@ -17,17 +19,10 @@
 namespace stepbench {
 namespace {
 
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
-
 double distance(const double* a, const double* b, int dim) {
   double s = 0.0;
   for (int i = 0; i < dim; ++i) s += (a[i] - b[i]) * (a[i] - b[i]);
   return std::sqrt(s);
-}
-
-template <class T>
-bool contains(const std::vector<T>& v, const T& x) {
-  return std::find(v.begin(), v.end(), x) != v.end();
 }
 
 // The truths of one problem's runs, by their display times: every design and physics

@@ -10,10 +10,10 @@
 #include <stdexcept>
 
 #include "core/measure.hpp"
+#include "registry/registry.hpp"
 #include "study/balanced_share.hpp"
 #include "study/h5.hpp"
 #include "study/machine.hpp"
-#include "study/registry.hpp"
 #include "study/verdict.hpp"
 
 namespace stepbench {

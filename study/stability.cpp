@@ -13,14 +13,13 @@
 #include <vector>
 
 #include "core/drive.hpp"
+#include "core/number.hpp"
 #include "core/system.hpp"
 #include "integrators/all.hpp"
 #include "study/h5.hpp"
 
 namespace stepbench {
 namespace {
-
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
 // ---------------------------------------------------------------------------------
 // The test problems. They satisfy the problem contract, so the integrators step them

@@ -5,14 +5,13 @@
 #include <cmath>
 #include <limits>
 
+#include "core/number.hpp"
 #include "core/work_precision.hpp"
 #include "study/h5.hpp"
 #include "study/study_file.hpp"
 
 namespace stepbench {
 namespace {
-
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
 bool completed(const method_row& r) { return r.metrics.completed(); }
 

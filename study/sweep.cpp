@@ -10,6 +10,7 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "core/contains.hpp"
 #include "core/drive.hpp"
 #include "core/measure.hpp"
 #include "study/balanced_share.hpp"
@@ -18,14 +19,7 @@
 #include "study/verdict.hpp"
 
 namespace stepbench {
-namespace {
-
-template <class T>
-bool contains(const std::vector<T>& v, const T& x) {
-  return std::find(v.begin(), v.end(), x) != v.end();
-}
-
-}  // namespace
+namespace {}  // namespace
 
 std::vector<double> decades(int first, int last, int stride) {
   std::vector<double> out;

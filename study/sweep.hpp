@@ -14,11 +14,11 @@
 #include "core/convergence_fit.hpp"
 #include "core/measure.hpp"
 #include "core/method.hpp"
+#include "registry/registry.hpp"
 #include "study/challenge.hpp"
 #include "study/energy.hpp"
 #include "study/loop.hpp"
 #include "study/method_row.hpp"
-#include "study/registry.hpp"
 #include "study/scan.hpp"
 #include "study/stability.hpp"
 

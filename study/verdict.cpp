@@ -8,6 +8,8 @@
 #include <map>
 #include <set>
 
+#include "core/contains.hpp"
+#include "core/number.hpp"
 #include "core/work_precision.hpp"
 #include "study/h5.hpp"
 #include "study/loop.hpp"
@@ -18,12 +20,7 @@
 namespace stepbench {
 namespace {
 
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 constexpr const char* metric = "err_pos_max";
-
-bool contains(const std::vector<std::string>& v, std::string_view s) {
-  return std::find(v.begin(), v.end(), s) != v.end();
-}
 
 std::string hz_text(double hz) { return fmt::format("{:g} Hz", hz); }
 

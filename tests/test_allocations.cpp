@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "core/drive.hpp"
-#include "study/registry.hpp"
+#include "registry/registry.hpp"
 
 extern "C" {
 void* __libc_malloc(std::size_t);

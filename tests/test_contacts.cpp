@@ -14,7 +14,7 @@
 #include "integrators/all.hpp"
 #include "problems/bouncing_ball.hpp"
 #include "problems/bouncing_balls.hpp"
-#include "study/registry.hpp"
+#include "registry/registry.hpp"
 #include "study/sweep.hpp"
 
 using namespace stepbench;

@@ -14,8 +14,8 @@
 #include "problems/kepler.hpp"
 #include "problems/pendulum.hpp"
 #include "problems/sliding_block.hpp"
+#include "registry/registry.hpp"
 #include "study/energy.hpp"
-#include "study/registry.hpp"
 #include "study/sweep.hpp"
 
 using namespace stepbench;

@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "core/drive.hpp"
-#include "study/registry.hpp"
+#include "registry/registry.hpp"
 
 using namespace stepbench;
 

@@ -12,8 +12,8 @@
 #include <stdexcept>
 
 #include "core/game_loop.hpp"
+#include "registry/registry.hpp"
 #include "study/loop.hpp"
-#include "study/registry.hpp"
 
 using namespace stepbench;
 

@@ -13,7 +13,7 @@
 #include <numbers>
 
 #include "core/measure.hpp"
-#include "study/registry.hpp"
+#include "registry/registry.hpp"
 #include "study/scan.hpp"
 #include "study/study_file.hpp"
 #include "study/sweep.hpp"

@@ -15,8 +15,8 @@
 #include "problems/pendulum.hpp"
 #include "problems/spring_chain.hpp"
 #include "problems/stiff_spring.hpp"
+#include "registry/registry.hpp"
 #include "study/challenge.hpp"
-#include "study/registry.hpp"
 
 using namespace stepbench;
 

@@ -1,4 +1,4 @@
-#include "study/registry.hpp"
+#include "registry/registry.hpp"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -9,7 +9,7 @@
 #include "integrators/all.hpp"
 #include "peers/all.hpp"
 #include "problem_entries.hpp"  // generated from STEPBENCH_PROBLEMS (CMakeLists.txt)
-#include "study/method_entry.hpp"
+#include "registry/method_entry.hpp"
 
 namespace stepbench {
 

@@ -1,10 +1,9 @@
 #pragma once
 // A problem's methods as a table of slots: for each method that runs on P, its info and
 // the functions that run it, time it and (ours at a fixed step) run it in the game loop.
-// The slots are filled by the method units CMake generates from study/method_unit.cpp.in,
-// one per problem and method group (integrators/group_*.hpp, peers/group_*.hpp), so that
-// editing one integrator rebuilds its group's units, not every method on every problem;
-// problem_model<P> (study/problem_model.hpp) reads the table and includes no method.
+// The slots are filled in the unit CMake generates for each problem from
+// registry/problem_unit.cpp.in, from the method groups that run on it (integrators/group_*.hpp,
+// peers/group_*.hpp); problem_model<P> (registry/problem_model.hpp) reads the table.
 #include <fmt/format.h>
 
 #include <exception>
@@ -19,7 +18,7 @@
 #include "core/method.hpp"
 #include "core/problem_instance.hpp"
 #include "core/type_list.hpp"
-#include "study/method_entry.hpp"
+#include "registry/method_entry.hpp"
 
 namespace stepbench::registry_detail {
 
@@ -95,7 +94,7 @@ std::function<double()> timed_method(const P& p, double param, double horizon, s
 }
 
 template <integrator I, problem P>
-loop_result loop_method(const P& p, const loop_config& config) {
+loop_result loop_of(const P& p, const loop_config& config) {
   return simulate_loop(p, I{}, config);
 }
 
@@ -105,7 +104,7 @@ void append_group(type_list<Ms...>, method_table<P>& table) {
   for_each_type(type_list<entry_t<Ms>...>{}, [&]<class M>() {
     if constexpr (runs_on<M, P>) {
       method_slot<P> slot{.info = &info_of<M>(), .run = &run_method<M, P>, .timed_run = &timed_method<M, P>};
-      if constexpr (requires { typename M::integrator_type; }) slot.loop = &loop_method<typename M::integrator_type, P>;
+      if constexpr (requires { typename M::integrator_type; }) slot.loop = &loop_of<typename M::integrator_type, P>;
       table.push_back(slot);
     }
   });

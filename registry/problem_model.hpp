@@ -1,10 +1,7 @@
 #pragma once
 // The registry's type erasure: problem_model<P>, the problem_instance of a problem type,
-// over its table of methods (study/method_table.hpp). Included by study/registry.cpp and
-// by the problem units CMake generates from study/problem_unit.cpp.in, one per problem,
-// each with its own problem's header only; the methods are compiled apart, one unit per
-// problem and method group (study/method_unit.cpp.in), so that an edit to a problem
-// rebuilds that problem's units and an edit to a method that method's group's.
+// over its table of methods (registry/method_table.hpp). Included by the problem units
+// CMake generates from registry/problem_unit.cpp.in, one per problem.
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -19,8 +16,8 @@
 #include "core/constraints.hpp"
 #include "core/first_order.hpp"
 #include "core/game_loop.hpp"
-#include "study/method_table.hpp"
-#include "study/registry.hpp"
+#include "registry/method_table.hpp"
+#include "registry/registry.hpp"
 
 namespace stepbench::registry_detail {
 

@@ -1,8 +1,8 @@
 #pragma once
 // Every method as a registry entry of one shape (info, applies, prepare): our integrators
 // wrapped as ours_fixed / ours_adaptive, the peers as they are (peers/step_adapter.hpp),
-// so that every method is run and measured by the same code. Included by the method units
-// (study/method_unit.cpp.in) and by study/registry.cpp; it includes no method.
+// so that every method is run and measured by the same code. Included by the problem units
+// (registry/problem_unit.cpp.in) and by registry/registry.cpp; it includes no method.
 #include <limits>
 #include <span>
 #include <string>

@@ -3,6 +3,7 @@
 #include <H5Cpp.h>
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -315,6 +316,17 @@ reading_child start_reading(const std::string& path) {
   }
   if (child == 0) {
     ::close(fds[0]);
+    // Bounds on what a damaged file can make HDF5 do: a stored length it trusts makes it
+    // allocate gigabytes, a damaged B-tree can make it loop. A whole study reads in well
+    // under a second and a few hundred MB, so past these the file is damaged: the child
+    // is stopped (SIGXCPU) or its allocation fails, and the parent says so. (Not the
+    // address-space bound under AddressSanitizer, which reserves terabytes of it.)
+    const rlimit cpu{20, 20};
+    ::setrlimit(RLIMIT_CPU, &cpu);
+#if !defined(__SANITIZE_ADDRESS__)
+    const rlimit memory{std::size_t{2} << 30, std::size_t{2} << 30};
+    ::setrlimit(RLIMIT_AS, &memory);
+#endif
     const int null = ::open("/dev/null", O_WRONLY);
     ::dup2(null, STDOUT_FILENO);
     ::dup2(null, STDERR_FILENO);
@@ -356,6 +368,8 @@ study_data finish_reading(reading_child& c) {
   c.pid = -1;
   // How the child ended when it did not end normally: a signal ("SIGSEGV"), or a
   // sanitizer's report ("exit 1").
+  if (WIFSIGNALED(status) && WTERMSIG(status) == SIGXCPU)
+    throw fail("damaged: reading it did not end within 20 s of CPU time (HDF5 looping on it)");
   if (WIFSIGNALED(status))
     throw fail(fmt::format("damaged: reading it crashes the HDF5 library (SIG{})", sigabbrev_np(WTERMSIG(status))));
   if (WEXITSTATUS(status) != 0)

@@ -67,7 +67,9 @@ void case_book::register_all(study& s) {
     }
   }
   // The small-steps comparison (study/substeps.hpp): each of its runs, timed the same way.
-  for (auto& st : s.substeps)
+  auto* substeps = s.results.find<std::vector<substep_study>>();
+  if (!substeps) return;
+  for (auto& st : *substeps)
     for (const auto& ps : s.problems) {
       if (ps.problem->name() != st.problem) continue;
       for (auto& m : st.methods)

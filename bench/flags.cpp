@@ -18,6 +18,7 @@ const char* own_flags_help() {
          "  --quick              CI mode: 8-level ladder, thinned tolerances, min time 0.002 s, 1 repetition\n"
          "  --study_out=PATH     write the study file (timings beside accuracy); results to bench.json beside it\n"
          "  --problem=NAME       sweep and time this problem only, and its scaling family (repeatable)\n"
+         "  --parts=A,B          run only these parts of the study (`stepbench list` names them)\n"
          "  --shard=K/N          the timed study of shard K of N: the share of the problems `stepbench sweep\n"
          "                       --shard K/N` takes, timing only their cases (`stepbench merge` joins the shards)\n"
          "  --set=P.NAME=VALUE   a problem parameter, as stepbench's --set; NAME=VALUE with one --problem\n"
@@ -54,11 +55,19 @@ options take_own_flags(int& argc, char** argv, std::vector<std::string>& extra) 
     } else if (a.rfind("--problem=", 0) == 0) {
       o.problems.push_back(a.substr(10));  // checked by run_sweep's validate()
       if (o.problems.back().empty()) throw std::invalid_argument("--problem needs a problem name");
+    } else if (a.rfind("--parts=", 0) == 0) {
+      for (std::size_t start = 8; start <= a.size();) {
+        const std::size_t comma = std::min(a.find(',', start), a.size());
+        o.parts.push_back(a.substr(start, comma - start));  // checked by run_sweep's validate()
+        if (o.parts.back().empty()) throw std::invalid_argument("--parts needs part names: --parts=A,B");
+        start = comma + 1;
+      }
     } else if (a.rfind("--shard=", 0) == 0) {
       const auto shard = parse_shard(a.substr(8));
       o.shard_index = shard.index;
       o.shard_count = shard.count;
-    } else if (a == "--study_out" || a == "--case_budget" || a == "--set" || a == "--problem" || a == "--shard") {
+    } else if (a == "--study_out" || a == "--case_budget" || a == "--set" || a == "--problem" || a == "--shard" ||
+               a == "--parts") {
       throw std::invalid_argument(a + " takes its value after '=': " + a + "=VALUE");
     } else if (a.rfind("--study_out=", 0) == 0) {
       o.study_out = a.substr(12);

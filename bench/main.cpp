@@ -26,6 +26,8 @@
 #include "bench/progress.hpp"
 #include "bench/scaling.hpp"
 #include "bench/timings.hpp"
+#include "parts/part.hpp"
+#include "parts/study.hpp"
 #include "registry/registry.hpp"
 #include "study/bench_merge.hpp"
 #include "study/study_file.hpp"
@@ -123,17 +125,15 @@ int main(int argc, char** argv) {
 
     // The accuracy sweep first: it gives each case its counters and the study its rows.
     sweep_options sopts;
-    if (opts.quick) {
-      sopts.levels = sopts.max_levels = 8;
-      sopts.scans = default_scans(true);
-      sopts.tolerances = tolerance_ladder(true);
-      sopts.challenge.enabled = false;  // its timings and 1000 s energy run belong to the full study
-    }
+    if (opts.quick) find_preset("quick").apply(sopts);
+    if (!opts.parts.empty()) sopts.parts = opts.parts;
     sopts.overrides = opts.overrides;
     sopts.problems = opts.problems;
     sopts.shard_index = opts.shard_index;
     sopts.shard_count = opts.shard_count;
-    validate(sopts);  // before any output: one line and exit 2 on a bad name or value
+    // Before any output: one line and exit 2 on a bad name or value.
+    validate(sopts);
+    selected_parts(sopts);
     // A shard's JSON names its shard, as `stepbench merge --bench` checks against its study.
     if (sopts.shard_count > 1)
       benchmark::AddCustomContext(bench_shard_key, fmt::format("{}/{}", sopts.shard_index + 1, sopts.shard_count));
@@ -197,6 +197,7 @@ int main(int argc, char** argv) {
     ts.cpu_scaling_enabled = reporter.cpu_scaling;
     ts.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     s.timed = ts;
+    judge_study(s);  // the verdict again, on the measured times
     const std::string timed = count_of(book.timed_count(), "case");
     if (opts.study_out.empty()) return report_study_outcome(s, "stepbench_bench", opts.strict);
     // The study first, then bench.json: a signal between the two leaves the new study

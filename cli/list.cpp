@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
+#include "parts/part.hpp"
 #include "registry/registry.hpp"
 #include "study/table_render.hpp"
 
@@ -102,6 +103,16 @@ void print_list(const json& out) {
     }
     for (const auto& [where, names] : limited) fmt::print("  {}: {}\n", fmt::join(names, ", "), where);
   }
+  fmt::print("\nParts of the study, in the order a study runs them (sweep --parts A,B runs only those):\n");
+  for (const auto& p : out["parts"])
+    fmt::print("  {:<12} {}\n", p["name"].get<std::string>(), p["summary"].get<std::string>());
+  fmt::print("Presets: {}\n", [&] {
+    std::string s;
+    for (const auto& p : out["presets"])
+      s += fmt::format("{}{} ({})", s.empty() ? "" : "; ", p["name"].get<std::string>(),
+                       p["summary"].get<std::string>());
+    return s;
+  }());
 }
 
 int run_list(bool as_json) {
@@ -149,6 +160,8 @@ int run_list(bool as_json) {
     j["runs_on"] = runs_on;
     out["methods"].push_back(j);
   }
+  for (const auto& p : study_parts()) out["parts"].push_back({{"name", p.name}, {"summary", p.summary}});
+  for (const auto& p : study_presets()) out["presets"].push_back({{"name", p.name}, {"summary", p.summary}});
   if (as_json) {
     std::cout << out.dump(2) << "\n";
     return 0;

@@ -19,6 +19,7 @@
 #include "cli/args.hpp"
 #include "cli/commands.hpp"
 #include "core/work_precision.hpp"
+#include "parts/study.hpp"
 #include "study/study_file.hpp"
 #include "study/sweep.hpp"
 #include "study/table_render.hpp"
@@ -231,7 +232,7 @@ int run_study(const loop_args& a) {
   make_problem(a.problem);  // names an unknown problem first
   so.methods = {loop_method_info(a.method).name};
   for (const auto& s : a.sets) add_override(so.overrides, s, so.problems);
-  so.substeps.enabled = false;
+  so.parts = {"sweep", "loop"};  // the loop study reads the sweep's problems and its rows' timings
   so.loop.problems = so.problems;
   so.loop.methods = so.methods;
   so.progress = !a.quiet;
@@ -239,10 +240,11 @@ int run_study(const loop_args& a) {
   check_writable(out);
   const study s = run_sweep(so);
   write_study(s, out);
-  if (!a.quiet && !s.loop.problems.empty()) {
-    const auto& lp = s.loop.problems.front();
+  const auto& ls = s.results.get<loop_study>();
+  if (!a.quiet && !ls.problems.empty()) {
+    const auto& lp = ls.problems.front();
     const auto& m = lp.methods.front();
-    const auto& o = s.loop.options;
+    const auto& o = ls.options;
     fmt::print("{} with {}: max shown error [{}] at a {:g} Hz display (constant clock, clamp {:g} s)\n", lp.name,
                m.info.name, lp.position_unit, o.reference_display_hz, o.clamp_s);
     table grid{{right_column("physics", "Hz")}, {}};
@@ -268,8 +270,7 @@ int run_study(const loop_args& a) {
                            : std::string("none of the designs at these physics rates"));
   }
   std::fflush(stdout);
-  fmt::print(stderr, "wrote {} (the loop study of {} with {}, {:.2f} s)\n", out, a.problem, a.method,
-             s.loop.wall_seconds);
+  fmt::print(stderr, "wrote {} (the loop study of {} with {}, {:.2f} s)\n", out, a.problem, a.method, ls.wall_seconds);
   return report_study_outcome(s, "stepbench", a.strict);
 }
 

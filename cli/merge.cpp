@@ -10,6 +10,7 @@
 
 #include "cli/args.hpp"
 #include "cli/commands.hpp"
+#include "parts/study.hpp"
 #include "study/bench_merge.hpp"
 #include "study/scan.hpp"
 #include "study/study_file.hpp"
@@ -105,19 +106,21 @@ int run_merge(const merge_args& a) {
     for (auto& s : read_scans(path)) by_name[s.options.name].push_back(std::move(s));
   check_writable(a.out);
   study merged;
+  merged.options.parts = {"scans"};
+  auto& scans = merged.results.put(std::vector<scan_result>{});
   for (auto& [name, shards] : by_name) {
     std::vector<std::size_t> missing;
-    merged.scans.push_back(merge_scans(shards, a.partial, missing));
-    merged.scans.back().options.name = name;
+    scans.push_back(merge_scans(shards, a.partial, missing));
+    scans.back().options.name = name;
     if (!missing.empty())
       fmt::print(stderr, "merge: scan '{}' lacks {} of {} grid points (--partial): {}{}\n", name, missing.size(),
-                 merged.scans.back().grid_points,
+                 scans.back().grid_points,
                  fmt::join(missing.begin(), missing.begin() + std::min<std::size_t>(missing.size(), 10), ", "),
                  missing.size() > 10 ? ", ..." : "");
-    merged.wall_seconds += merged.scans.back().wall_seconds;
+    merged.wall_seconds += scans.back().wall_seconds;
   }
   write_study(merged, a.out);
-  for (const auto& s : merged.scans)
+  for (const auto& s : scans)
     fmt::print(stderr, "merge: /scan/{}: {} of {} points from {}\n", s.options.name, s.points.size(), s.grid_points,
                count_of(static_cast<long long>(by_name[s.options.name].size()), "shard"));
   fmt::print(stderr, "wrote {}\n", a.out);

@@ -13,6 +13,7 @@
 
 #include "cli/args.hpp"
 #include "cli/commands.hpp"
+#include "parts/study.hpp"
 #include "study/study_file.hpp"
 
 namespace stepbench::cli {
@@ -129,10 +130,11 @@ int run_scan_command(const scan_args& a) {
                stderr);
   };
   study s;
-  s.scans.push_back(run_scan(o));
-  s.wall_seconds = s.scans.back().wall_seconds;
+  s.options.parts = {"scans"};
+  const auto& scan = s.results.put(std::vector<scan_result>{run_scan(o)}).front();
+  s.wall_seconds = scan.wall_seconds;
   write_study(s, a.out);
-  const scan_answer answer = answer_scan(s.scans.back(), o.tol);
+  const scan_answer answer = answer_scan(scan, o.tol);
   if (a.json)
     std::cout << scan_answer_json(answer).dump(2) << "\n";
   else
@@ -140,8 +142,8 @@ int run_scan_command(const scan_args& a) {
   if (!a.quiet)
     std::fputs(fmt::format("wrote {} (/scan/{}: {} points, {} runs) in {:.2f} s; `stepbench advise --scan {} --tol X` "
                            "answers at another tolerance\n",
-                           a.out, o.name.empty() ? o.problem : o.name, s.scans.back().points.size(),
-                           s.scans.back().runs.size(), s.wall_seconds, a.out)
+                           a.out, o.name.empty() ? o.problem : o.name, scan.points.size(), scan.runs.size(),
+                           s.wall_seconds, a.out)
                    .c_str(),
                stderr);
   return 0;

@@ -7,6 +7,8 @@
 
 #include "cli/args.hpp"
 #include "cli/commands.hpp"
+#include "parts/part.hpp"
+#include "parts/study.hpp"
 #include "study/study_file.hpp"
 
 namespace stepbench::cli {
@@ -19,6 +21,7 @@ struct sweep_args {
   std::string out = "results/study.h5";
   bool quiet = false;
   bool quick = false;
+  std::vector<std::string> parts;
   bool strict = false;
 };
 
@@ -29,12 +32,8 @@ std::string observed(const method_study& ms) {
 
 int run_sweep_command(sweep_args a) {
   for (const auto& s : a.sets) add_override(a.opts.overrides, s, a.opts.problems);
-  if (a.quick) {
-    a.opts.levels = a.opts.max_levels = 8;
-    a.opts.scans = default_scans(true);
-    a.opts.tolerances = tolerance_ladder(true);
-    a.opts.challenge.enabled = false;  // its timings and 1000 s energy run belong to the full study
-  }
+  if (a.quick) find_preset("quick").apply(a.opts);
+  if (!a.parts.empty()) a.opts.parts = a.parts;
   if (!a.shard.empty()) {
     const auto shard = parse_shard(a.shard);
     a.opts.shard_index = shard.index;
@@ -42,6 +41,7 @@ int run_sweep_command(sweep_args a) {
   }
   a.opts.progress = !a.quiet;
   validate(a.opts);
+  selected_parts(a.opts);
   check_writable(a.out);  // before the work, so a bad path costs nothing
   const study s = run_sweep(a.opts);
   write_study(s, a.out);
@@ -94,7 +94,13 @@ command add_sweep(CLI::App& app) {
                   "K/N: sweep shard K of N, a deterministic share of the selected problems balanced by their counted "
                   "cost, with every part of the study that belongs to them (`stepbench merge` joins the shards)");
   sub->add_option("--out", a->out, "study file to write")->capture_default_str();
-  sub->add_flag("--quick", a->quick, "8 levels (no more) and every other tolerance (the CI study)");
+  sub->add_flag("--quick", a->quick,
+                "the quick preset (the CI study): 8 levels (no more), every other tolerance, the quick scan, every "
+                "part but the challenge");
+  sub->add_option("--parts", a->parts,
+                  "run only these parts of the study, in the study's order (comma-separated or repeated; "
+                  "`stepbench list` names them)")
+      ->delimiter(',');
   sub->add_flag("--quiet", a->quiet, "print only the summary line");
   sub->add_flag("--strict", a->strict, "exit 3 when a method failed on some case");
   sub->footer(

@@ -32,7 +32,6 @@
 namespace stepbench {
 
 struct challenge_options {
-  bool enabled = true;
   double hz = 60.0;
   int xpbd_substeps = 50;
   double horizon = 2.0;            // s; GSL rk8pd and ARKODE erk8 agree to 4e-14 on the bobs here

@@ -126,7 +126,6 @@ energy_study run_energy_study(const energy_options& opts,
   const auto start = std::chrono::steady_clock::now();
   energy_study s;
   s.options = opts;
-  if (!opts.enabled) return s;
   if (!(opts.periods >= 1 && opts.periods <= 1e7 && opts.periods == std::floor(opts.periods)))
     throw std::invalid_argument("energy study: periods must be a whole number from 1 to 1e7");
   if (opts.samples_per_period < 1 || opts.series_points < 2)

@@ -37,7 +37,6 @@ struct energy_scene {
 };
 
 struct energy_options {
-  bool enabled = true;
   // Pendulum: its default 120-degree swing, T = 2.755 s, 64 steps a period (dt = 0.043 s).
   // Kepler: e = 0.5 (the sweep's default 0.9 passes periapsis in ~15 steps of a
   // 1000-step orbit, where semi-implicit Euler's bounded energy error reaches 93% and

@@ -256,7 +256,6 @@ loop_method run_loop_method(const problem_instance& problem, const method_info& 
 loop_study run_loop_study(const study& s, const loop_options& opts) {
   loop_study out;
   out.options = opts;
-  if (!opts.enabled) return out;
   const auto start = std::chrono::steady_clock::now();
   std::size_t configs = 0;
   for (const auto& ps : s.problems) {
@@ -426,7 +425,7 @@ void write_cheapest(H5::Group& g, const loop_method& m, const loop_options& opts
 }  // namespace
 
 void write_loop(H5::Group& root, const study& s) {
-  const loop_study& ls = s.loop;
+  const loop_study& ls = s.results.get<loop_study>();
   if (ls.problems.empty()) return;
   const loop_options& o = ls.options;
   H5::Group top = root.createGroup("loop");

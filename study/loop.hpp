@@ -40,7 +40,6 @@ struct study;
 struct problem_study;
 
 struct loop_options {
-  bool enabled = true;
   std::vector<std::string> problems{"pendulum", "damped_spring"};
   std::vector<std::string> methods{"semi_implicit_euler", "rk4"};
   std::vector<double> display_hz{30, 60, 75, 144, 165, 240};  // constant clocks

@@ -213,11 +213,16 @@ void write_problem(H5::Group& parent, const problem_study& ps, const std::option
   if (timed) write_front(g, ps, true, timed);
 }
 
-// /scan/<name>: a scan's axes and options as attributes, the grid values (points x axes),
-// and its points, runs and cheapest runs as tables (study/scan.hpp; docs/study-format.md).
-void write_scans(H5::H5File& file, const std::vector<scan_result>& scans) {
+}  // namespace
+
+void write_problems(H5::Group& root, const study& s) {
+  H5::Group problems = root.createGroup("problems");
+  for (const auto& ps : s.problems) write_problem(problems, ps, s.timed);
+}
+
+void write_scans(H5::Group& root, const std::vector<scan_result>& scans) {
   if (scans.empty()) return;
-  H5::Group all = file.createGroup("scan");
+  H5::Group all = root.createGroup("scan");
   const double nan = std::numeric_limits<double>::quiet_NaN();
   for (const auto& sc : scans) {
     const auto& o = sc.options;
@@ -355,8 +360,6 @@ void write_scans(H5::H5File& file, const std::vector<scan_result>& scans) {
   }
 }
 
-}  // namespace
-
 void write_machine(H5::H5Object& obj, const std::optional<timing_settings>& timing) {
   attr(obj, "cpu", cpu_model());
   attr(obj, "cores", core_count());
@@ -371,15 +374,28 @@ namespace {
 
 std::string temp_path_for(const std::string& path) { return fmt::format("{}.tmp.{}", path, ::getpid()); }
 
-// The whole study file built in memory (HDF5's core driver without a backing store;
-// `name` names it in HDF5's messages). The disk is written by write_whole alone: a full
-// disk, a quota or a file-size limit then fails one write(2), never HDF5's flush inside
-// H5Fclose, whose failure left the library holding a half-closed file that crashed it
-// while the stack unwound (SIGSEGV after "H5Fclose failed").
-std::vector<unsigned char> study_image(const study& s, const std::string& name) {
-  H5::FileAccPropList in_memory;
-  in_memory.setCore(std::size_t{1} << 20, false);
-  H5::H5File file(name, H5F_ACC_TRUNC, H5::FileCreatPropList::DEFAULT, in_memory);
+// Writes `bytes` to a new file at `path`; 0, or the errno of the call that failed
+// (ENOSPC, EDQUOT, EFBIG under temp_file_guard).
+int write_whole(const std::string& path, const std::vector<unsigned char>& bytes) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd < 0) return errno;
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int error = n < 0 ? errno : EIO;
+      ::close(fd);
+      return error;
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  return ::close(fd) == 0 ? 0 : errno;
+}
+
+}  // namespace
+
+void write_root_attributes(H5::H5File& file, const study& s, const std::string& described_options) {
   attr(file, "format_version", study_format_version);
   attr(file, "version", build_info::version);
   attr(file, "git_commit", build_info::git_commit);
@@ -396,7 +412,7 @@ std::vector<unsigned char> study_image(const study& s, const std::string& name) 
     attr(file, "selection", fmt::format("{}", fmt::join(selected_problems(s.options), ",")));
     attr(file, "shard_index", s.options.shard_index);
     attr(file, "shard_count", s.options.shard_count);
-    attr(file, "sweep_options", describe_options(s.options));
+    attr(file, "sweep_options", described_options);
   }
   attr(file, "levels", s.options.levels);
   attr(file, "max_levels", s.options.max_levels);
@@ -423,46 +439,7 @@ std::vector<unsigned char> study_image(const study& s, const std::string& name) 
     attr(file, "num_cpus", t.num_cpus);
     attr(file, "mhz_per_cpu", t.mhz_per_cpu);
   }
-  write_stability(file, s.stability);  // /stability: our compiled steps' limits (study/stability.hpp)
-  {
-    H5::Group problems = file.createGroup("problems");
-    for (const auto& ps : s.problems) write_problem(problems, ps, s.timed);
-  }
-  write_substeps(file, s.substeps, s.timed.has_value());
-  write_loop(file, s);           // /loop: the game-loop study (study/loop.hpp), when the study holds one
-  write_energy(file, s.energy);  // /energy: the long-run energy study (study/energy.hpp)
-  write_verdict(file, s);        // /verdict and /frame_rates: the answer (study/verdict.hpp)
-  write_scans(file, s.scans);    // /scan: parameter scans (study/scan.hpp)
-  if (s.challenge) write_challenge(file, *s.challenge);  // /challenge (study/challenge.hpp)
-  file.flush(H5F_SCOPE_GLOBAL);
-  const ssize_t size = H5Fget_file_image(file.getId(), nullptr, 0);
-  std::vector<unsigned char> image(size > 0 ? static_cast<std::size_t>(size) : 0);
-  if (size <= 0 || H5Fget_file_image(file.getId(), image.data(), image.size()) != size)
-    throw H5::FileIException("H5Fget_file_image", "cannot take the file's image");
-  file.close();
-  return image;
 }
-
-// Writes `bytes` to a new file at `path`; 0, or the errno of the call that failed
-// (ENOSPC, EDQUOT, EFBIG under temp_file_guard).
-int write_whole(const std::string& path, const std::vector<unsigned char>& bytes) {
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-  if (fd < 0) return errno;
-  std::size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const int error = n < 0 ? errno : EIO;
-      ::close(fd);
-      return error;
-    }
-    done += static_cast<std::size_t>(n);
-  }
-  return ::close(fd) == 0 ? 0 : errno;
-}
-
-}  // namespace
 
 h5::table parameters_table(const std::vector<param_value>& params) {
   std::vector<std::string> name, unit, kind, value_name, allowed, description;
@@ -561,13 +538,15 @@ void check_writable(const std::string& path) {
   std::remove(tmp.c_str());
 }
 
-void write_study(const study& s, const std::string& path) {
+void write_study_file(const std::string& path, const std::function<void(H5::H5File&)>& fill) {
   check_writable(path);
-  const std::string tmp = temp_path_for(path);
   H5::Exception::dontPrint();
   std::vector<unsigned char> image;
   try {
-    image = study_image(s, tmp);
+    H5::H5File file = in_memory_file(path);
+    fill(file);
+    image = file_image(file);
+    file.close();
   } catch (const H5::Exception& e) {
     throw std::runtime_error(fmt::format("cannot write results file '{}': HDF5: {}", path, e.getDetailMsg()));
   }

@@ -1,6 +1,7 @@
 #pragma once
 // The study file (HDF5): the public format users script against. Layout documented in
 // docs/study-format.md; bump study_format_version when it changes incompatibly.
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -20,9 +21,19 @@ std::vector<double> equal_error_targets();
 // path cannot be created; leaves nothing behind. Call before a long run.
 void check_writable(const std::string& path);
 
-// Writes the study to a temporary file beside `path` and renames it into place, so an
-// existing file is replaced whole or not at all.
-void write_study(const study& s, const std::string& path);
+// Builds a study file in memory with `fill` and writes it to a temporary file beside
+// `path`, renamed into place when whole: an existing file is replaced whole or not at all
+// (parts/study.hpp write_study fills it with the root attributes and every part).
+void write_study_file(const std::string& path, const std::function<void(H5::H5File&)>& fill);
+
+// The root attributes of a study file: format, build, machine, the sweep's settings
+// (`described_options`: the parts' describe lines), timing.
+void write_root_attributes(H5::H5File& file, const study& s, const std::string& described_options);
+
+// /problems (the sweep's rows, each problem's truth, references, equal-error table and
+// fronts) and /scan (each scan's grid, runs, cheapest runs and range answer).
+void write_problems(H5::Group& root, const study& s);
+void write_scans(H5::Group& root, const std::vector<scan_result>& scans);
 
 // The machine a study ran on (study/machine.hpp), as attributes of `obj`: cpu, cores,
 // and with timings num_cpus, mhz_per_cpu, cpu_scaling_enabled (Google Benchmark's context).

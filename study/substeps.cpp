@@ -78,7 +78,6 @@ std::string describe(const substep_verdict& v) {
 
 std::vector<substep_study> run_substeps(const study& s, const substep_options& opts) {
   std::vector<substep_study> out;
-  if (!opts.enabled) return out;
   for (const auto& ps : s.problems) {
     if (std::find(opts.problems.begin(), opts.problems.end(), ps.problem->name()) == opts.problems.end()) continue;
     substep_study st;

@@ -198,8 +198,6 @@ method_study run_method(const problem_study& ps, const method_info& m, const swe
   return ms;
 }
 
-std::size_t sweep_parts(const sweep_options& opts) { return shard_problems(opts).size() + 4; }
-
 std::vector<std::string> selected_problems(const sweep_options& opts) {
   return opts.problems.empty() ? problem_names() : opts.problems;
 }
@@ -230,176 +228,10 @@ std::vector<std::string> shard_problems(const sweep_options& opts) {
   return sweep_shard(opts, opts.shard_index, opts.shard_count);
 }
 
-std::string describe_options(const sweep_options& o) {
-  const auto list = [](const auto& v) { return v.empty() ? std::string("all") : fmt::format("{}", fmt::join(v, ",")); };
-  std::vector<std::string> overrides;
-  for (const auto& [problem, params] : o.overrides)
-    for (const auto& [name, value] : params) overrides.push_back(fmt::format("{}.{}={}", problem, name, value));
-  std::vector<std::string> scans;
-  for (const auto& sc : o.scans) {
-    std::vector<std::string> axes;
-    for (const auto& a : sc.axes)
-      axes.push_back(fmt::format("{}={}:{}:{}{}", a.param, a.lo, a.hi, a.count, a.log ? ":log" : ""));
-    scans.push_back(fmt::format("{} {} at {} Hz, substeps {}, methods {}, tol {}",
-                                sc.name.empty() ? sc.problem : sc.name, fmt::join(axes, " x "), fmt::join(sc.hz, ","),
-                                fmt::join(sc.substeps, ","), list(sc.methods), sc.tol));
-  }
-  std::vector<std::string> energy;
-  for (const auto& e : o.energy.scenes) {
-    std::vector<std::string> params;
-    for (const auto& [name, value] : e.params) params.push_back(fmt::format("{}={}", name, value));
-    energy.push_back(fmt::format("{} {} steps a period{}{}", e.problem, e.steps_per_period, params.empty() ? "" : " ",
-                                 fmt::join(params, ",")));
-  }
-  const auto& ss = o.substeps;
-  const auto& lp = o.loop;
-  const auto& ch = o.challenge;
-  return fmt::format(
-      "selection: {}\nmethods: {}\noverrides: {}\nlevels: {}\nmax_levels: {}\nround_off_fall: {}\n"
-      "base_steps: {}\nsample_count: {}\ntolerances: {}\nreference tolerances: rtol {} atol {}\n"
-      "work budget: {} (adaptive steps {})\n"
-      "substeps: {}; problems {}; explicit {}; implicit {}; counts {}; frames {}\n"
-      "frame rates: {}; {} Hz; substeps {}\n"
-      "loop: {}; problems {}; methods {}; display {} Hz; physics {} Hz; reference {} Hz; jitter {} seed {}; "
-      "clamp {} s; stall {} s at {}; target {}; stated step cost {} ns\n"
-      "energy: {}; periods {}; samples a period {}; series points {}; bounded growth {}; lost {}; methods {}; "
-      "scenes {}\n"
-      "scans: {}\n"
-      "challenge: {}; {} Hz; xpbd substeps {}; horizon {} s; energy horizon {} s; competitors {}; small steps {} "
-      "at {} s",
-      list(selected_problems(o)), list(o.methods),
-      overrides.empty() ? "none" : fmt::format("{}", fmt::join(overrides, ",")), o.levels, o.max_levels,
-      o.round_off_fall, o.base_steps, o.sample_count, fmt::join(o.tolerances, ","), o.tol.rtol, o.tol.atol,
-      o.limits.work_budget, o.limits.max_steps, ss.enabled ? "on" : "off", list(ss.problems), list(ss.explicit_methods),
-      list(ss.implicit_methods), fmt::join(ss.counts, ","), ss.frames, o.frame_rates.enabled ? "on" : "off",
-      fmt::join(o.frame_rates.hz, ","), fmt::join(o.frame_rates.substeps, ","), lp.enabled ? "on" : "off",
-      list(lp.problems), list(lp.methods), fmt::join(lp.display_hz, ","), fmt::join(lp.physics_hz, ","),
-      lp.reference_display_hz, lp.jitter, lp.jitter_seed, lp.clamp_s, lp.stall_s, lp.stall_at_fraction, lp.target,
-      lp.stated_step_cost_ns, o.energy.enabled ? "on" : "off", o.energy.periods, o.energy.samples_per_period,
-      o.energy.series_points, o.energy.bounded_growth, o.energy.lost, list(o.energy.methods),
-      energy.empty() ? "none" : fmt::format("{}", fmt::join(energy, "; ")),
-      scans.empty() ? "none" : fmt::format("{}", fmt::join(scans, "; ")), ch.enabled ? "on" : "off", ch.hz,
-      ch.xpbd_substeps, ch.horizon, ch.energy_horizon, list(ch.competitors), fmt::join(ch.small_steps_counts, ","),
-      ch.small_steps_time);
-}
-
-namespace {
-
-// One problem of the sweep: its truth and every selected method on its ladder.
-problem_study sweep_problem(const std::string& name, const sweep_options& opts,
-                            const std::function<void(const std::string&)>& warn) {
-  const auto t0 = std::chrono::steady_clock::now();
-  problem_study ps;
-  ps.problem = configured_problem(name, opts);
-  ps.horizon = ps.problem->horizon();
-  ps.truth = build_truth(*ps.problem, sample_times(ps.horizon, opts.sample_count), {.tol = opts.tol});
-  for (const auto& r : ps.truth.references)
-    if (r.status != "ok" && r.status != "unsupported")
-      warn(fmt::format("warning: {}: reference {} {}: {}", name, r.source, r.status, r.reason));
-  if (!ps.truth.trusted)
-    warn(fmt::format("warning: {}: no trusted truth ({}); its errors are recorded as NaN", name, ps.truth.note));
-  for (const auto& m : ps.problem->methods())
-    if (opts.methods.empty() || contains(opts.methods, m.name)) ps.methods.push_back(run_method(ps, m, opts));
-  if (opts.progress)
-    warn(fmt::format("swept {:<22} {:3} methods in {:.2f} s", name, ps.methods.size(),
-                     std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
-  return ps;
-}
-
-}  // namespace
-
 int sweep_jobs(const sweep_options& opts, std::size_t problems) {
   const int cores = std::max(1, core_count());
   const int jobs = opts.jobs > 0 ? opts.jobs : cores;
   return static_cast<int>(std::max<std::size_t>(1, std::min<std::size_t>(jobs, problems)));
-}
-
-study run_sweep(const sweep_options& opts) {
-  validate(opts);
-  const auto start = std::chrono::steady_clock::now();
-  study out;
-  out.options = opts;
-  out.swept = true;
-  // This run's problems: the selection, or the shard's share of it. Every later part
-  // (substeps, frame rates, loop, energy, scans, challenge) takes only these problems, so
-  // that the shards of a study hold every part of it once.
-  const auto names = shard_problems(opts);
-  const std::size_t parts = sweep_parts(opts);
-  std::size_t done = 0;
-  // The problems run on `jobs` threads (each problem's runs own their state: the
-  // references and peers make their solver objects per run), each into its own slot, so
-  // the study is the same as on one thread; the callers' callbacks are called under one lock.
-  std::mutex callbacks;
-  const auto part_done = [&] {
-    std::lock_guard lock(callbacks);
-    if (opts.on_progress) opts.on_progress(++done, parts);
-  };
-  const auto warn = [&](const std::string& line) {
-    std::lock_guard lock(callbacks);
-    if (opts.on_warning)
-      opts.on_warning(line);
-    else
-      std::fprintf(stderr, "%s\n", line.c_str());
-  };
-  std::vector<problem_study> swept(names.size());
-  parallel_indices(
-      names.size(), sweep_jobs(opts, names.size()),
-      [&](std::size_t i) { swept[i] = sweep_problem(names[i], opts, warn); }, part_done);
-  for (auto& ps : swept) out.problems.push_back(std::move(ps));
-  out.substeps = run_substeps(out, opts.substeps);
-  out.frame_rates = run_frame_rates(out, opts.frame_rates);
-  part_done();
-  loop_options loop = opts.loop;
-  loop.progress = opts.progress;
-  out.loop = run_loop_study(out, loop);
-  part_done();
-  // The energy study on the selected problems and methods only.
-  energy_options energy = opts.energy;
-  energy.progress = opts.progress;
-  std::erase_if(energy.scenes, [&](const energy_scene& e) { return !contains(names, e.problem); });
-  if (energy.methods.empty()) energy.methods = opts.methods;
-  if (energy.scenes.empty()) energy.enabled = false;
-  out.energy = run_energy_study(energy, opts.overrides);
-  part_done();
-  // The parameter scans of the selected problems, with the sweep's methods where named.
-  for (scan_options sc : opts.scans) {
-    if (!contains(names, sc.problem)) continue;
-    if (!opts.methods.empty()) {
-      sc.methods.clear();
-      for (const auto& m : make_problem(sc.problem)->methods())
-        if (m.kind == method_kind::fixed_step && contains(opts.methods, m.name)) sc.methods.push_back(m.name);
-      if (sc.methods.empty()) continue;
-    }
-    sc.ref_tol = opts.tol;
-    // The sweep's limits, but the tighter work budget: a default scan may set its own
-    // (the rope's, study/scan.cpp default_scans), and a sweep's --work-budget still binds.
-    const double scan_budget = sc.limits.work_budget;
-    sc.limits = opts.limits;
-    sc.limits.work_budget = std::min(scan_budget, opts.limits.work_budget);
-    sc.jobs = opts.jobs;
-    if (auto it = opts.overrides.find(sc.problem); it != opts.overrides.end())
-      for (const auto& [name, value] : it->second)
-        if (std::none_of(sc.axes.begin(), sc.axes.end(), [&](const scan_axis& a) { return a.param == name; }))
-          sc.fixed[name] = value;
-    const auto t0 = std::chrono::steady_clock::now();
-    out.scans.push_back(run_scan(sc));
-    if (opts.progress)
-      warn(fmt::format("scan    {:<22} {} points in {:.2f} s", sc.problem, out.scans.back().points.size(),
-                       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
-  }
-  // The pendulum challenge is one scene, the challenge's own: run with n_pendulum at its defaults.
-  if (opts.challenge.enabled && contains(names, std::string("n_pendulum")) && !opts.overrides.contains("n_pendulum") &&
-      opts.methods.empty()) {
-    const auto t0 = std::chrono::steady_clock::now();
-    out.challenge = run_challenge(opts.challenge);
-    if (opts.progress)
-      warn(fmt::format("challenge n_pendulum in {:.2f} s",
-                       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
-  }
-  part_done();
-  out.stability = compute_stability();
-  out.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return out;
 }
 
 std::vector<std::string> failed_cases(const study& s) {
@@ -412,7 +244,7 @@ std::vector<std::string> failed_cases(const study& s) {
           out.push_back(fmt::format("{}/{} at {} {:g}: {}", ps.problem->name(), ms.info.name, param_name(ms.info.kind),
                                     r.param, r.metrics.note));
   }
-  for (const auto& st : s.substeps)
+  for (const auto& st : s.results.get<std::vector<substep_study>>())
     for (const auto& m : st.methods)
       for (const auto& r : m.rows)
         if (r.row.metrics.failed)
@@ -484,7 +316,7 @@ std::vector<std::string> failure_summary(const study& s) {
             failure_line(ms.info.name, ps.problem->name(), param_name(ms.info.kind), failed, params, ms.rows.size()));
     }
   }
-  for (const auto& st : s.substeps)
+  for (const auto& st : s.results.get<std::vector<substep_study>>())
     for (const auto& m : st.methods) {
       std::vector<const run_metrics*> failed;
       std::vector<double> params;

@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <typeindex>
 #include <vector>
 
 #include "core/convergence_fit.hpp"
@@ -33,7 +34,6 @@ std::vector<double> decades(int first, int last, int stride);
 std::vector<double> tolerance_ladder(bool thinned = false);
 
 struct substep_options {
-  bool enabled = true;
   std::vector<std::string> problems{"stiff_spring", "spring_chain", "n_pendulum"};
   // xpbd's n substeps of one constraint pass: the method the Small Steps paper is about.
   std::vector<std::string> explicit_methods{"semi_implicit_euler", "velocity_verlet", "xpbd"};
@@ -45,12 +45,15 @@ struct substep_options {
 // The frame-rate study (study/verdict.hpp): our fixed-step methods at whole frames of
 // each rate, with n substeps a frame.
 struct frame_rate_options {
-  bool enabled = true;
   std::vector<double> hz{30, 60, 120, 240};  // each divides the largest, so one truth serves all
   std::vector<int> substeps{1, 2, 4, 8, 16, 32, 64};
 };
 
 struct sweep_options {
+  // The parts of the study to run (parts/part.hpp), by name, in any order; empty: every
+  // part. The sweep's rows are the part every other reads: a selection without it runs
+  // only parts that need no rows (stability, energy, scans, challenge).
+  std::vector<std::string> parts;
   std::vector<std::string> problems;  // empty: all
   std::vector<std::string> methods;   // empty: all that run on each problem
   // Parameter overrides per problem: overrides["pendulum"]["theta0_deg"] = 30.
@@ -104,19 +107,8 @@ std::vector<std::string> sweep_shard(const sweep_options& opts, int k, int n);
 // The problems this run sweeps: sweep_shard(opts, opts.shard_index, opts.shard_count).
 std::vector<std::string> shard_problems(const sweep_options& opts);
 
-// The options that shape a study, one `name: value` line each (levels, ladders,
-// tolerances, work budget, methods, --set overrides, the substeps, frame-rate, loop,
-// energy, scan and challenge settings, the selection; not the shard): written to the
-// study file (root attribute `sweep_options`) so that `stepbench merge` joins only shards
-// of one study. Doubles in the shortest form that reads back exactly.
-std::string describe_options(const sweep_options& opts);
-
 // The threads run_sweep uses for `problems` problems (opts.jobs, 0: one a core).
 int sweep_jobs(const sweep_options& opts, std::size_t problems);
-
-// The parts on_progress counts: the problems, then the frame-rate, loop and energy studies
-// and the scans.
-std::size_t sweep_parts(const sweep_options& opts);
 
 struct method_study {
   method_info info;
@@ -175,19 +167,44 @@ struct frame_rate_study {
   std::vector<frame_rate_run> runs;
 };
 
+// The results of the study's parts besides the sweep's rows: one value a part, of the
+// part's own type, which is its key (a part's file declares it; parts/part.hpp). A part
+// that did not run has none; get() then gives an empty value.
+class part_results {
+ public:
+  template <class T>
+  const T* find() const {
+    const auto it = items_.find(std::type_index(typeid(T)));
+    return it == items_.end() ? nullptr : static_cast<const T*>(it->second.get());
+  }
+  template <class T>
+  T* find() {
+    const auto it = items_.find(std::type_index(typeid(T)));
+    return it == items_.end() ? nullptr : static_cast<T*>(it->second.get());
+  }
+  template <class T>
+  const T& get() const {
+    static const T none{};
+    const T* found = find<T>();
+    return found ? *found : none;
+  }
+  template <class T>
+  T& put(T value) {
+    auto item = std::make_shared<T>(std::move(value));
+    T& out = *item;
+    items_[std::type_index(typeid(T))] = std::move(item);
+    return out;
+  }
+
+ private:
+  std::map<std::type_index, std::shared_ptr<void>> items_;
+};
+
 struct study {
   sweep_options options;
   bool swept = false;  // made by run_sweep (a scan-only file is not): the file records the selection and shard
-  std::vector<problem_study> problems;
-  std::vector<substep_study> substeps;
-  std::vector<frame_rate_study> frame_rates;
-  loop_study loop;      // empty when the options disable it or name none of the problems
-  energy_study energy;  // empty when the options disable it
-  // The stability limits and regions of our integrators (study/stability.hpp): not of the
-  // selected problems, so every study carries the same, computed by run_sweep.
-  stability_data stability;
-  std::vector<scan_result> scans;             // parameter scans (study/scan.hpp), written under /scan
-  std::optional<challenge_result> challenge;  // under /challenge
+  std::vector<problem_study> problems;  // the sweep's rows, which the other parts read
+  part_results results;                 // every other part's
   double wall_seconds = 0.0;
   std::optional<timing_settings> timed;
 };
@@ -212,8 +229,6 @@ method_study run_method(const problem_study& ps, const method_info& m, const swe
 // Fits the observed order (or, for adaptive methods, the slope of error against the
 // tolerance) from the rows, and checks it against the declared order.
 void fit_rows(method_study& ms, double pos_scale);
-
-study run_sweep(const sweep_options& opts);
 
 // Problems whose truth is not trusted (no closed form, no two references agreeing).
 std::vector<std::string> untrusted_problems(const study& s);

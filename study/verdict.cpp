@@ -46,7 +46,7 @@ std::vector<double> verdict_targets() { return equal_error_targets(); }
 
 std::vector<frame_rate_study> run_frame_rates(const study& s, const frame_rate_options& opts) {
   std::vector<frame_rate_study> out;
-  if (!opts.enabled || opts.hz.empty()) return out;
+  if (opts.hz.empty()) return out;
   const double slowest = *std::min_element(opts.hz.begin(), opts.hz.end());
   const double fastest = *std::max_element(opts.hz.begin(), opts.hz.end());
   const double finest_target = verdict_targets().back();
@@ -273,7 +273,7 @@ std::vector<std::string> findings_of(const verdict_tables& v, const finding_inpu
 
 finding_inputs finding_inputs_of(const study& s) {
   finding_inputs in;
-  for (const auto& st : s.substeps)
+  for (const auto& st : s.results.get<std::vector<substep_study>>())
     for (const auto& sv : substep_verdicts(st, s.timed.has_value()))
       if (sv.implicit_method == "implicit_euler" && sv.explicit_method == "semi_implicit_euler")
         in.substeps.push_back({st.problem, st.frame_dt, sv});
@@ -371,7 +371,7 @@ verdict_tables compute_verdict(const study& s) {
       v.equal_error.push_back(std::move(e));
     }
   }
-  for (const auto& fs : s.frame_rates) {
+  for (const auto& fs : s.results.get<std::vector<frame_rate_study>>()) {
     const problem_study* ps = find_problem(s, fs.problem);
     std::vector<double> rates;
     for (const auto& r : fs.runs)
@@ -408,7 +408,9 @@ verdict_tables compute_verdict(const study& s) {
 
 void write_verdict(H5::Group& root, const study& s) {
   using h5::attr;
-  const verdict_tables v = compute_verdict(s);
+  const verdict_tables* found = s.results.find<verdict_tables>();
+  if (!found) return;
+  const verdict_tables& v = *found;
   H5::Group g = root.createGroup("verdict");
   attr(g, "metric", metric);
   attr(g, "targets", verdict_targets());
@@ -523,9 +525,15 @@ void write_verdict(H5::Group& root, const study& s) {
     t.add("frame_share", share);
     t.write(g, "frame_answer", schema::find("verdict_frame_answer"));
   }
+}
+
+void write_frame_rates(H5::Group& root, const study& s) {
+  using h5::attr;
+  const auto& studies = s.results.get<std::vector<frame_rate_study>>();
+  if (studies.empty()) return;
   H5::Group fr = root.createGroup("frame_rates");
   const bool timed = s.timed.has_value();
-  for (const auto& fs : s.frame_rates) {
+  for (const auto& fs : studies) {
     H5::Group pg = fr.createGroup(fs.problem);
     attr(pg, "horizon", fs.horizon);
     attr(pg, "position_unit", fs.unit);
@@ -563,7 +571,10 @@ void write_verdict(H5::Group& root, const study& s) {
   }
 }
 
-std::string format_verdict_text(const study& s) { return format_verdict_text(compute_verdict(s)); }
+std::string format_verdict_text(const study& s) {
+  const verdict_tables* v = s.results.find<verdict_tables>();
+  return format_verdict_text(v ? *v : compute_verdict(s));
+}
 
 std::string format_verdict_text(const verdict_tables& v) {
   std::string out;

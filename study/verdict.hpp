@@ -113,8 +113,10 @@ finding_inputs finding_inputs_of(const study& s);
 finding_inputs read_finding_inputs(const H5::Group& root, const std::vector<std::string>& problems);
 std::vector<std::string> findings_of(const verdict_tables& v, const finding_inputs& in);
 
-// /verdict and /frame_rates/<problem> (docs/study-format.md).
+// /verdict, as judged into the study (nothing when it holds no verdict), and
+// /frame_rates/<problem> (docs/study-format.md).
 void write_verdict(H5::Group& root, const study& s);
+void write_frame_rates(H5::Group& root, const study& s);
 
 // The verdict tables as text: the equal-error table across problems and targets, the
 // frame-rate table and the findings (what a study run prints at its end).

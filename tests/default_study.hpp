@@ -4,6 +4,7 @@
 // under the sanitizers), so those tests run in one process: see tests/CMakeLists.txt.
 #pragma once
 
+#include "parts/study.hpp"
 #include "study/sweep.hpp"
 
 namespace stepbench::test_support {

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "parts/study.hpp"
 #include "study/compare.hpp"
 #include "study/compare_render.hpp"
 #include "study/study_file.hpp"

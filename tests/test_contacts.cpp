@@ -12,6 +12,7 @@
 #include "core/drive.hpp"
 #include "core/measure.hpp"
 #include "integrators/all.hpp"
+#include "parts/study.hpp"
 #include "problems/bouncing_ball.hpp"
 #include "problems/bouncing_balls.hpp"
 #include "registry/registry.hpp"
@@ -131,9 +132,7 @@ TEST(contacts, orders_in_both_modes) {
   sweep_options opts;
   opts.problems = {"bouncing_ball", "bouncing_ball_locate"};
   opts.methods = {"euler", "semi_implicit_euler", "velocity_verlet", "rk4", "forest_ruth"};
-  opts.substeps.enabled = false;
-  opts.loop.problems.clear();
-  opts.energy.enabled = false;
+  opts.parts = {"sweep"};
   const study s = run_sweep(opts);
   for (const auto& ps : s.problems) {
     const bool locate = ps.problem->name() == "bouncing_ball_locate";

@@ -10,6 +10,7 @@
 #include "core/drive.hpp"
 #include "core/measure.hpp"
 #include "integrators/all.hpp"
+#include "parts/study.hpp"
 #include "problems/falling_drag.hpp"
 #include "problems/kepler.hpp"
 #include "problems/pendulum.hpp"
@@ -193,9 +194,7 @@ TEST(forest_ruth, fourth_order) {
   sweep_options opts;
   opts.problems = {"pendulum", "damped_spring", "kepler"};
   opts.methods = {"forest_ruth"};
-  opts.substeps.enabled = false;
-  opts.loop.problems.clear();
-  opts.energy.enabled = false;
+  opts.parts = {"sweep"};
   const study s = run_sweep(opts);
   for (const auto& ps : s.problems) {
     ASSERT_EQ(ps.methods.size(), 1u);

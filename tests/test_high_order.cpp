@@ -13,6 +13,7 @@
 #include "integrators/all.hpp"
 #include "integrators/explicit_rk.hpp"
 #include "integrators/tableaus.hpp"
+#include "parts/study.hpp"
 #include "problems/damped_spring.hpp"
 #include "problems/pendulum.hpp"
 #include "problems/spring_chain.hpp"
@@ -245,8 +246,7 @@ TEST(observed_order, rk8_and_the_eighth_order_peers) {
   opts.methods = {"rk8", "gsl_rk8pd", "arkode_erk8", "arkode_erk5"};
   for (const auto& m : all_methods())
     if (m.name == "odeint_rkf78") opts.methods.push_back(m.name);
-  opts.substeps.enabled = false;
-  opts.loop.enabled = false;
+  opts.parts = {"sweep"};
   const study s = run_sweep(opts);
 
   const auto& spring = find(s, "damped_spring");
@@ -316,8 +316,7 @@ TEST(observed_order, rk8_on_a_small_swing_pendulum) {
   opts.base_steps = 8;
   opts.sample_count = 8;
   opts.levels = 6;
-  opts.substeps.enabled = false;
-  opts.loop.enabled = false;
+  opts.parts = {"sweep"};
   const study s = run_sweep(opts);
   const auto* m = find(find(s, "pendulum"), "rk8");
   ASSERT_NE(m, nullptr);

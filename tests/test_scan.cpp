@@ -13,6 +13,7 @@
 #include <numbers>
 
 #include "core/measure.hpp"
+#include "parts/study.hpp"
 #include "registry/registry.hpp"
 #include "study/scan.hpp"
 #include "study/study_file.hpp"
@@ -117,22 +118,23 @@ TEST(scan, written_and_read_back) {
   o.substeps = {1, 4};
   o.methods = {"rk4", "velocity_verlet"};
   study s;
-  s.scans.push_back(run_scan(o));
+  s.options.parts = {"scans"};
+  const auto& scans = s.results.put(std::vector<scan_result>{run_scan(o)});
   const auto path = (std::filesystem::temp_directory_path() / "stepbench_test_scan.h5").string();
   write_study(s, path);
   const scan_result back = read_scan(path, "");
   std::filesystem::remove(path);
   EXPECT_EQ(back.options.substeps, o.substeps);  // the file's counts, not the defaults and them
   ASSERT_EQ(back.points.size(), 3u);
-  ASSERT_EQ(back.runs.size(), s.scans[0].runs.size());
+  ASSERT_EQ(back.runs.size(), scans[0].runs.size());
   for (std::size_t i = 0; i < back.runs.size(); ++i) {
-    const auto &x = back.runs[i].row.metrics, &y = s.scans[0].runs[i].row.metrics;
+    const auto &x = back.runs[i].row.metrics, &y = scans[0].runs[i].row.metrics;
     EXPECT_TRUE(x.err_pos_max == y.err_pos_max || (std::isnan(x.err_pos_max) && std::isnan(y.err_pos_max)));
-    EXPECT_EQ(back.runs[i].row.work.force_evals, s.scans[0].runs[i].row.work.force_evals);
+    EXPECT_EQ(back.runs[i].row.work.force_evals, scans[0].runs[i].row.work.force_evals);
   }
   // The pendulum has a closed form: every point is trusted, and its answer is the same read back.
   for (const auto& p : back.points) EXPECT_EQ(p.truth_source, "closed_form");
-  EXPECT_EQ(format_scan_answer(answer_scan(back, 1e-3)), format_scan_answer(answer_scan(s.scans[0], 1e-3)));
+  EXPECT_EQ(format_scan_answer(answer_scan(back, 1e-3)), format_scan_answer(answer_scan(scans[0], 1e-3)));
 }
 
 // A scan in three shards, merged, equals the unsharded scan in every accuracy field; the
@@ -220,7 +222,8 @@ scan_result through_file(const scan_result& scan, const std::string& file) {
   // The process id keeps test processes run at once apart.
   const auto path = (std::filesystem::temp_directory_path() / (std::to_string(::getpid()) + "_" + file)).string();
   study s;
-  s.scans.push_back(scan);
+  s.options.parts = {"scans"};
+  s.results.put(std::vector<scan_result>{scan});
   write_study(s, path);
   scan_result back = read_scan(path, "");
   std::filesystem::remove(path);

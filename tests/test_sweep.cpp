@@ -13,6 +13,7 @@
 #include "core/drive.hpp"
 #include "core/work_precision.hpp"
 #include "default_study.hpp"
+#include "parts/study.hpp"
 #include "study/sweep.hpp"
 #include "study/verdict.hpp"
 
@@ -431,10 +432,7 @@ TEST(sweep, threads_do_not_change_a_row) {
   one.problems = {"damped_spring", "pendulum", "bouncing_ball"};
   one.levels = one.max_levels = 6;
   one.tolerances = tolerance_ladder(true);
-  one.frame_rates.enabled = false;
-  one.energy.enabled = false;
-  one.loop.enabled = false;
-  one.substeps.enabled = false;
+  one.parts = {"sweep"};
   one.jobs = 1;
   sweep_options three = one;
   three.jobs = 3;

@@ -11,6 +11,7 @@
 #include <fstream>
 
 #include "core/work_precision.hpp"
+#include "parts/study.hpp"
 #include "study/advise.hpp"
 #include "study/study_file.hpp"
 #include "study/study_reader.hpp"
@@ -318,17 +319,18 @@ TEST(advise, frame_rates_follow_the_stability_limits_and_agree_with_the_substeps
   opts.problems = {"stiff_spring"};
   opts.methods = {"rk4", "semi_implicit_euler", "implicit_euler"};
   opts.levels = 8;
-  opts.loop.enabled = false;
-  opts.energy.enabled = false;
+  opts.parts = {"sweep", "substeps", "frame_rates", "verdict"};
   const study s = run_sweep(opts);
-  ASSERT_EQ(s.frame_rates.size(), 1u);
-  ASSERT_EQ(s.substeps.size(), 1u);
-  ASSERT_NEAR(s.substeps.front().frame_dt, 1.0 / 60.0, 1e-15);
+  const auto& frame_rates = s.results.get<std::vector<frame_rate_study>>();
+  const auto& substeps = s.results.get<std::vector<substep_study>>();
+  ASSERT_EQ(frame_rates.size(), 1u);
+  ASSERT_EQ(substeps.size(), 1u);
+  ASSERT_NEAR(substeps.front().frame_dt, 1.0 / 60.0, 1e-15);
   const auto path = (std::filesystem::temp_directory_path() / fmt::format("test_frames_{}.h5", ::getpid())).string();
   write_study(s, path);
   const frame_advice f = advise_frame(path, "stiff_spring", 60.0, 1e-3);
   auto completed_at = [&](const std::string& m, int n) {
-    for (const auto& r : s.frame_rates.front().runs)
+    for (const auto& r : frame_rates.front().runs)
       if (r.hz == 60.0 && r.method == m && r.substeps == n) return r.row.metrics.completed();
     ADD_FAILURE() << m << " x" << n << " not run";
     return false;
@@ -341,9 +343,9 @@ TEST(advise, frame_rates_follow_the_stability_limits_and_agree_with_the_substeps
   for (const auto& o : f.one_step) EXPECT_EQ(o.completed, o.method == "implicit_euler") << o.method;
   // The same runs as the substeps study's.
   int compared = 0;
-  for (const auto& sm : s.substeps.front().methods)
+  for (const auto& sm : substeps.front().methods)
     for (const auto& sr : sm.rows)
-      for (const auto& r : s.frame_rates.front().runs)
+      for (const auto& r : frame_rates.front().runs)
         if (r.hz == 60.0 && r.method == sm.info.name && r.substeps == sr.substeps && r.row.metrics.completed()) {
           EXPECT_EQ(r.row.metrics.err_pos_max, sr.row.metrics.err_pos_max) << r.method << " x" << r.substeps;
           ++compared;
@@ -352,7 +354,7 @@ TEST(advise, frame_rates_follow_the_stability_limits_and_agree_with_the_substeps
   // The answer is the cheapest run meeting the tolerance, by force evaluations a frame.
   ASSERT_TRUE(f.met());
   double cheapest = INFINITY;
-  for (const auto& r : s.frame_rates.front().runs)
+  for (const auto& r : frame_rates.front().runs)
     if (r.hz == 60.0 && r.row.metrics.completed() && r.row.metrics.err_pos_max <= 1e-3)
       cheapest = std::min(cheapest, static_cast<double>(r.row.work.force_evals) / 32.0);
   EXPECT_DOUBLE_EQ(f.ranked.front().cost_per_frame, cheapest);

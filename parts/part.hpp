@@ -1,0 +1,82 @@
+#pragma once
+// One shape for every analysis of the study (a "part"): the sweep's rows, the stability
+// limits, substeps, frame rates, the game loop, long-run energy, the scans, the pendulum
+// challenge and the verdict are each a row of one table (parts/registry.cpp), declared
+// once with what the study does with it:
+//
+//   name      the part's name in `--parts`, `stepbench list` and the file's `parts`
+//   describe  its settings, as lines of the file's `sweep_options` (merge joins only
+//             shards whose options agree)
+//   run       measures it into the study, after the parts above it
+//   judge     derives its answers from the study as measured (and timed): run again by
+//             stepbench_bench after it times the rows, and by merge on the joined study
+//   write     its groups of the study file
+//   merge     how the shards of a study hold it (merge_rule)
+//
+// Run, judge and write follow the table's order; describe and merge read the same table;
+// the report orders its sections by the `parts` the file names. Adding an analysis is
+// one file of parts/ that defines its study_part (its result type is its own: the study
+// keeps it in `results`, keyed by that type) and one line of parts/registry.cpp;
+// docs/analyses.md shows one.
+#include <functional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace H5 {
+class Group;
+}
+
+namespace stepbench {
+
+struct study;
+struct sweep_options;
+
+// How the shards of a study (sweep --shard K/N) hold a part, and so how merge joins it.
+enum class merge_rule {
+  per_problem,          // one child a problem, in the shard that ran the problem
+  same_in_every_shard,  // computed from the build, not the problems: the first shard's
+  in_one_shard,         // each child (a scan, the challenge) in the one shard whose problem it is
+  judged_again,         // joined in the study's order, its answers judged again on the whole
+};
+
+// What a part's run gets besides the study: the problems of this run (the selection, or
+// its shard's share), and where its progress and warnings go.
+struct part_context {
+  std::vector<std::string> problems;
+  bool progress = false;
+  std::function<void(const std::string&)> say;  // one line, to stderr or around a live progress line
+  std::function<void()> step_done;              // the sweep's, after each problem (a unit of progress)
+};
+
+struct study_part {
+  std::string_view name;
+  std::string_view summary;  // what it answers, one line (`stepbench list --parts`)
+  merge_rule merge = merge_rule::per_problem;
+  std::string (*describe)(const sweep_options&) = nullptr;
+  void (*run)(study&, const part_context&) = nullptr;
+  void (*judge)(study&) = nullptr;  // nullptr: nothing to judge
+  void (*write)(H5::Group& root, const study&) = nullptr;
+};
+
+// A list of names as a describe line shows it: "a,b,c", or "all" when empty.
+std::string list_or_all(const std::vector<std::string>& names);
+
+// Every part, in the study's order.
+const std::vector<study_part>& study_parts();
+// Throws std::invalid_argument naming the unknown part and the known ones.
+const study_part& find_part(std::string_view name);
+// The parts `opts` selects (opts.parts, or every part), in the study's order.
+std::vector<const study_part*> selected_parts(const sweep_options& opts);
+
+// A preset is a selection of parts with the settings that go with it: `full` (every part
+// at its defaults: the default study), `quick` (the CI study: 8 levels, every other
+// tolerance, the stiff spring's quick scan, every part but the challenge).
+struct study_preset {
+  std::string_view name, summary;
+  void (*apply)(sweep_options&);
+};
+const std::vector<study_preset>& study_presets();
+const study_preset& find_preset(std::string_view name);
+
+}  // namespace stepbench

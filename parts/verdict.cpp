@@ -1,0 +1,19 @@
+// The answer (/verdict): judged from every other part as the study holds it, timings
+// included, so it is judged again after stepbench_bench times the rows and after merge
+// joins the shards.
+#include "parts/part.hpp"
+#include "study/sweep.hpp"
+#include "study/verdict.hpp"
+
+namespace stepbench {
+
+extern const study_part verdict_part{
+    .name = "verdict",
+    .summary = "the fastest of ours against the fastest peer at equal error, the frame-rate answers, the findings",
+    .merge = merge_rule::judged_again,
+    .describe = [](const sweep_options&) { return std::string("verdict: targets 1e-2 .. 1e-12"); },
+    .judge = [](study& s) { s.results.put(compute_verdict(s)); },
+    .write = write_verdict,
+};
+
+}  // namespace stepbench

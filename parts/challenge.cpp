@@ -1,5 +1,7 @@
 // The pendulum challenge and Small Steps (/challenge): one scene, the challenge's own,
 // run with n_pendulum at its defaults.
+#include "study/challenge.hpp"
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -7,7 +9,6 @@
 
 #include "core/contains.hpp"
 #include "parts/part.hpp"
-#include "study/challenge.hpp"
 #include "study/sweep.hpp"
 
 namespace stepbench {

@@ -1,5 +1,7 @@
 // Energy over the long run (/energy): 10^4 periods of our fixed-step methods on the
 // pendulum and the orbit, bounded or drifting.
+#include "study/energy.hpp"
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -7,7 +9,6 @@
 
 #include "core/contains.hpp"
 #include "parts/part.hpp"
-#include "study/energy.hpp"
 #include "study/sweep.hpp"
 
 namespace stepbench {
@@ -29,8 +30,8 @@ extern const study_part energy_part{
           return fmt::format(
               "energy: periods {}; samples a period {}; series points {}; bounded growth {}; lost {}; methods {}; "
               "scenes {}",
-              en.periods, en.samples_per_period, en.series_points, en.bounded_growth, en.lost,
-              list_or_all(en.methods), scenes.empty() ? "none" : fmt::format("{}", fmt::join(scenes, "; ")));
+              en.periods, en.samples_per_period, en.series_points, en.bounded_growth, en.lost, list_or_all(en.methods),
+              scenes.empty() ? "none" : fmt::format("{}", fmt::join(scenes, "; ")));
         },
     .run =
         [](study& s, const part_context& ctx) {

@@ -1,10 +1,11 @@
 // The game loop around the integrator (/loop): what the player sees, designs, clocks and
 // the cost model.
+#include "study/loop.hpp"
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include "parts/part.hpp"
-#include "study/loop.hpp"
 #include "study/sweep.hpp"
 
 namespace stepbench {
@@ -20,8 +21,8 @@ extern const study_part loop_part{
               "loop: problems {}; methods {}; display {} Hz; physics {} Hz; reference {} Hz; jitter {} seed {}; "
               "clamp {} s; stall {} s at {}; target {}; stated step cost {} ns",
               list_or_all(lp.problems), list_or_all(lp.methods), fmt::join(lp.display_hz, ","),
-              fmt::join(lp.physics_hz, ","), lp.reference_display_hz, lp.jitter, lp.jitter_seed, lp.clamp_s,
-              lp.stall_s, lp.stall_at_fraction, lp.target, lp.stated_step_cost_ns);
+              fmt::join(lp.physics_hz, ","), lp.reference_display_hz, lp.jitter, lp.jitter_seed, lp.clamp_s, lp.stall_s,
+              lp.stall_at_fraction, lp.target, lp.stated_step_cost_ns);
         },
     .run =
         [](study& s, const part_context& ctx) {

@@ -11,8 +11,8 @@
 
 namespace stepbench {
 
-extern const study_part sweep_part, stability_part, substeps_part, frame_rates_part, loop_part, energy_part,
-    scans_part, challenge_part, verdict_part;
+extern const study_part sweep_part, stability_part, substeps_part, frame_rates_part, loop_part, energy_part, scans_part,
+    challenge_part, verdict_part;
 
 std::string list_or_all(const std::vector<std::string>& names) {
   return names.empty() ? std::string("all") : fmt::format("{}", fmt::join(names, ","));

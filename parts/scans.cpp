@@ -62,7 +62,8 @@ void run(study& s, const part_context& ctx) {
 
 extern const study_part scans_part{
     .name = "scans",
-    .summary = "over a scene's parameter range: the cheapest method and substeps within tolerance, and where each breaks",
+    .summary =
+        "over a scene's parameter range: the cheapest method and substeps within tolerance, and where each breaks",
     .merge = merge_rule::in_one_shard,
     .describe = describe,
     .run = run,

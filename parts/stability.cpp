@@ -1,7 +1,8 @@
 // The stability limits and regions of our compiled steps (/stability): of the build, not
 // of the selected problems, so every shard of a study computes the same.
-#include "parts/part.hpp"
 #include "study/stability.hpp"
+
+#include "parts/part.hpp"
 #include "study/sweep.hpp"
 
 namespace stepbench {
@@ -12,9 +13,10 @@ extern const study_part stability_part{
     .merge = merge_rule::same_in_every_shard,
     .describe = [](const sweep_options&) { return std::string("stability: the default settings"); },
     .run = [](study& s, const part_context&) { s.results.put(compute_stability()); },
-    .write = [](H5::Group& root, const study& s) {
-      if (const auto* d = s.results.find<stability_data>()) write_stability(root, *d);
-    },
+    .write =
+        [](H5::Group& root, const study& s) {
+          if (const auto* d = s.results.find<stability_data>()) write_stability(root, *d);
+        },
 };
 
 }  // namespace stepbench

@@ -66,8 +66,8 @@ study run_sweep(const sweep_options& opts) {
 
 void judge_study(study& s) {
   for (const auto& p : study_parts())
-    if (p.judge && (s.options.parts.empty() || std::find(s.options.parts.begin(), s.options.parts.end(), p.name) !=
-                                                   s.options.parts.end()))
+    if (p.judge && (s.options.parts.empty() ||
+                    std::find(s.options.parts.begin(), s.options.parts.end(), p.name) != s.options.parts.end()))
       p.judge(s);
 }
 

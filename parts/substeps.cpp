@@ -1,10 +1,11 @@
 // Small steps against one implicit step a frame (/substeps): n explicit substeps a frame
 // against implicit steps on the stiff problems.
+#include "study/substeps.hpp"
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include "parts/part.hpp"
-#include "study/substeps.hpp"
 #include "study/sweep.hpp"
 
 namespace stepbench {

@@ -1,5 +1,7 @@
 // The sweep (/problems): every selected method on every problem of this run, over its
 // ladder, measured against the truth; the rows every other part reads.
+#include "study/sweep.hpp"
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -9,7 +11,6 @@
 #include "parts/part.hpp"
 #include "study/machine.hpp"
 #include "study/study_file.hpp"
-#include "study/sweep.hpp"
 
 namespace stepbench {
 namespace {

@@ -1,9 +1,10 @@
 // The answer (/verdict): judged from every other part as the study holds it, timings
 // included, so it is judged again after stepbench_bench times the rows and after merge
 // joins the shards.
+#include "study/verdict.hpp"
+
 #include "parts/part.hpp"
 #include "study/sweep.hpp"
-#include "study/verdict.hpp"
 
 namespace stepbench {
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "study/sweep.hpp"
+#include "run/sweep.hpp"
 
 namespace stepbench::bench {
 

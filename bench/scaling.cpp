@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "registry/registry.hpp"
-#include "study/bench_merge.hpp"
+#include "store/bench_merge.hpp"
 
 namespace stepbench::bench {
 namespace {
@@ -78,7 +78,7 @@ void register_scaling(const std::vector<std::string>& problems) {
   // 2^25 doubles (256 MiB) an array: far beyond every cache of the machines here; and the
   // size of one vector of the 65536-mass chain's state (3 x 65536 doubles).
   // Of the machine, not a problem: every shard with a scaling family runs it, and `stepbench
-  // merge --bench` keeps each shard's (study/bench_merge.hpp).
+  // merge --bench` keeps each shard's (store/bench_merge.hpp).
   benchmark::RegisterBenchmark(std::string(stream_triad_benchmark).c_str(), triad)
       ->ArgName("doubles")
       ->Arg(1L << 25)

@@ -1,6 +1,6 @@
 // `stepbench advise`: the cheapest method and its dt (or tolerance) for an error, from a
-// study file (study/advise.hpp).
-#include "study/advise.hpp"
+// study file (judge/advise.hpp).
+#include "judge/advise.hpp"
 
 #include <fmt/format.h>
 
@@ -9,6 +9,13 @@
 
 #include "cli/args.hpp"
 #include "cli/commands.hpp"
+#include "judge/scan.hpp"
+#include "judge/verdict.hpp"
+#include "render/advise.hpp"
+#include "render/scan.hpp"
+#include "store/scan.hpp"
+#include "store/study_reader.hpp"
+#include "store/verdict.hpp"
 #include "study/scan.hpp"
 
 namespace stepbench::cli {
@@ -81,7 +88,7 @@ int run_advise(const advise_args& args) {
     const double hz = parse_number(args.hz_text, "--hz");
     if (args.metric != "err_pos_max")
       throw std::invalid_argument("--hz answers for err_pos_max only (the frame-rate study measures that)");
-    const frame_advice f = advise_frame(args.study, args.problem, hz, tol);
+    const frame_advice f = advise_frame(read_frame_rate_runs(args.study, args.problem), hz, tol);
     if (args.json)
       std::cout << frame_advice_json(f).dump(2) << "\n";
     else

@@ -1,8 +1,8 @@
 // `stepbench compare BASE NEW`: did anything get worse between two study files?
-// (study/compare.hpp). Exit 0 nothing regressed, 1 a regression, 2 could not compare:
+// (judge/compare.hpp). Exit 0 nothing regressed, 1 a regression, 2 could not compare:
 // this command maps every error, including an unreadable file, to 2 itself, so CI can
 // tell a regression from a broken job.
-#include "study/compare.hpp"
+#include "judge/compare.hpp"
 
 #include <fmt/format.h>
 
@@ -13,7 +13,10 @@
 #include "cli/args.hpp"
 #include "cli/commands.hpp"
 #include "core/work_precision.hpp"
-#include "study/compare_render.hpp"
+#include "judge/verdict.hpp"
+#include "render/compare_render.hpp"
+#include "render/verdict.hpp"
+#include "store/verdict.hpp"
 #include "study/verdict.hpp"
 
 namespace stepbench::cli {

@@ -2,7 +2,7 @@
 // fixed-step integrator of ours on pendulum and kepler for 10^4 periods at a stated dt,
 // its largest energy error, its drift per period, bounded or drifting (with the sign),
 // and on kepler the angular momentum. The study file carries the same under /energy.
-#include "study/energy.hpp"
+#include "run/energy.hpp"
 
 #include <fmt/format.h>
 
@@ -13,7 +13,8 @@
 #include "cli/args.hpp"
 #include "cli/commands.hpp"
 #include "core/work_precision.hpp"
-#include "study/table_render.hpp"
+#include "render/table_render.hpp"
+#include "study/energy.hpp"
 
 namespace stepbench::cli {
 namespace {

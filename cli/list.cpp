@@ -11,7 +11,7 @@
 #include "cli/commands.hpp"
 #include "parts/part.hpp"
 #include "registry/registry.hpp"
-#include "study/table_render.hpp"
+#include "render/table_render.hpp"
 
 namespace stepbench::cli {
 namespace {

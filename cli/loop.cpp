@@ -5,7 +5,7 @@
 //   loop --problem P --integrator I --design D [--display-hz H] [--physics-hz H]
 //        [--clamp S|off] [--jitter SEED] [--stall-at T] [--step-cost NS] [--json]
 //     one configuration: its figures, printed.
-#include "study/loop.hpp"
+#include "judge/loop.hpp"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -19,10 +19,13 @@
 #include "cli/args.hpp"
 #include "cli/commands.hpp"
 #include "core/work_precision.hpp"
+#include "judge/outcome.hpp"
 #include "parts/study.hpp"
-#include "study/study_file.hpp"
-#include "study/sweep.hpp"
-#include "study/table_render.hpp"
+#include "render/table_render.hpp"
+#include "run/loop.hpp"
+#include "run/sweep.hpp"
+#include "store/study_file.hpp"
+#include "study/loop.hpp"
 
 namespace stepbench::cli {
 namespace {

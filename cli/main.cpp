@@ -14,7 +14,7 @@ int main(int argc, char** argv) {
   using namespace stepbench::cli;
   CLI::App app{"stepbench: accuracy, stability and speed of time integrators on game-physics problems"};
   app.require_subcommand(1);
-  // The build facts every study file records (study/build_info.cmake).
+  // The build facts every study file records (store/build_info.cmake).
   namespace info = stepbench::build_info;
   app.set_version_flag("--version",
                        fmt::format("stepbench {} (commit {}, {} build)\ncompiler: {}; flags: {}\ndependencies: {}",

@@ -1,7 +1,9 @@
 // `stepbench merge`: joins the shards of a study run with `sweep --shard K/N` or
-// `stepbench_bench --shard=K/N` (study/study_merge.hpp merge_studies), or of scans run with
+// `stepbench_bench --shard=K/N` (parts/merge.hpp merge_studies), or of scans run with
 // `scan --shard K/N` (study/scan.hpp merge_scans), on one machine or many, into one file;
-// with --bench, the timed shards' Google Benchmark JSON too (study/bench_merge.hpp).
+// with --bench, the timed shards' Google Benchmark JSON too (store/bench_merge.hpp).
+#include "store/merge.hpp"
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -11,10 +13,10 @@
 #include "cli/args.hpp"
 #include "cli/commands.hpp"
 #include "parts/study.hpp"
-#include "study/bench_merge.hpp"
+#include "store/bench_merge.hpp"
+#include "store/scan.hpp"
+#include "store/study_file.hpp"
 #include "study/scan.hpp"
-#include "study/study_file.hpp"
-#include "study/study_merge.hpp"
 
 namespace stepbench::cli {
 namespace {
@@ -119,6 +121,7 @@ int run_merge(const merge_args& a) {
                  missing.size() > 10 ? ", ..." : "");
     merged.wall_seconds += scans.back().wall_seconds;
   }
+  judge_study(merged);
   write_study(merged, a.out);
   for (const auto& s : scans)
     fmt::print(stderr, "merge: /scan/{}: {} of {} points from {}\n", s.options.name, s.points.size(), s.grid_points,

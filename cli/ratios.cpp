@@ -21,9 +21,10 @@
 
 #include "cli/commands.hpp"
 #include "core/work_precision.hpp"
+#include "judge/rows.hpp"
 #include "registry/registry.hpp"
-#include "study/study_reader.hpp"
-#include "study/table_render.hpp"
+#include "render/table_render.hpp"
+#include "store/study_reader.hpp"
 
 namespace stepbench::cli {
 namespace {
@@ -165,7 +166,7 @@ json ratios_json(const study_data& s, const ratios_args& a) {
   return out;
 }
 
-// --- The text form: every table drawn by the one renderer (study/table_render.hpp). ---
+// --- The text form: every table drawn by the one renderer (render/table_render.hpp). ---
 
 std::string fixed(const json& v, int digits) {
   return v.is_null() ? "-" : fmt::format("{:.{}f}", v.get<double>(), digits);

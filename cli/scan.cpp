@@ -1,6 +1,6 @@
 // `stepbench scan`: a problem over a grid of its parameters, at frame rates and substeps
 // (study/scan.hpp), into a study file under /scan/<name>, then the range answer.
-#include "study/scan.hpp"
+#include "judge/scan.hpp"
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -14,7 +14,10 @@
 #include "cli/args.hpp"
 #include "cli/commands.hpp"
 #include "parts/study.hpp"
-#include "study/study_file.hpp"
+#include "render/scan.hpp"
+#include "run/scan.hpp"
+#include "store/study_file.hpp"
+#include "study/scan.hpp"
 
 namespace stepbench::cli {
 namespace {
@@ -133,6 +136,7 @@ int run_scan_command(const scan_args& a) {
   s.options.parts = {"scans"};
   const auto& scan = s.results.put(std::vector<scan_result>{run_scan(o)}).front();
   s.wall_seconds = scan.wall_seconds;
+  judge_study(s);
   write_study(s, a.out);
   const scan_answer answer = answer_scan(scan, o.tol);
   if (a.json)

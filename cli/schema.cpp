@@ -1,6 +1,6 @@
-// `stepbench schema`: the study file's schema (study/schema.hpp) as JSON, the text the
+// `stepbench schema`: the study file's schema (store/schema.hpp) as JSON, the text the
 // Python report reads as scripts/stepbench_report/schema.json (a test compares the two).
-#include "study/schema.hpp"
+#include "store/schema.hpp"
 
 #include <cstdio>
 

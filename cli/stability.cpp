@@ -3,7 +3,7 @@
 // (a) from the amplification matrix of one step, (b) from long runs, and whether a method
 // is unstable for every dt or unconditionally stable. The study file carries the same
 // figures and the stability regions under /stability.
-#include "study/stability.hpp"
+#include "run/stability.hpp"
 
 #include <fmt/format.h>
 
@@ -13,7 +13,8 @@
 
 #include "cli/commands.hpp"
 #include "core/work_precision.hpp"
-#include "study/table_render.hpp"
+#include "render/table_render.hpp"
+#include "study/stability.hpp"
 
 namespace stepbench::cli {
 namespace {

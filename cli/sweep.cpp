@@ -1,15 +1,16 @@
 // `stepbench sweep`: the accuracy study (every method on every problem over its ladder,
 // untimed) into an HDF5 study file.
-#include "study/sweep.hpp"
+#include "run/sweep.hpp"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include "cli/args.hpp"
 #include "cli/commands.hpp"
+#include "judge/outcome.hpp"
 #include "parts/part.hpp"
 #include "parts/study.hpp"
-#include "study/study_file.hpp"
+#include "store/study_file.hpp"
 
 namespace stepbench::cli {
 namespace {

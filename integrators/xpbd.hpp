@@ -77,7 +77,7 @@ struct xpbd_solver {
   }
 };
 
-// The method on the fixed-step loop (peers/step_adapter.hpp's descriptor and adapter
+// The method on the fixed-step loop (core/step_adapter.hpp's descriptor and adapter
 // shape): the solver on the problem's constraint view, the state read back in the
 // problem's coordinates.
 template <int Iterations>

@@ -1,6 +1,6 @@
 // The pendulum challenge and Small Steps (/challenge): one scene, the challenge's own,
 // run with n_pendulum at its defaults.
-#include "study/challenge.hpp"
+#include "run/challenge.hpp"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -9,7 +9,8 @@
 
 #include "core/contains.hpp"
 #include "parts/part.hpp"
-#include "study/sweep.hpp"
+#include "run/sweep.hpp"
+#include "store/challenge.hpp"
 
 namespace stepbench {
 

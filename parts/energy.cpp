@@ -1,6 +1,6 @@
 // Energy over the long run (/energy): 10^4 periods of our fixed-step methods on the
 // pendulum and the orbit, bounded or drifting.
-#include "study/energy.hpp"
+#include "run/energy.hpp"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -9,7 +9,8 @@
 
 #include "core/contains.hpp"
 #include "parts/part.hpp"
-#include "study/sweep.hpp"
+#include "run/sweep.hpp"
+#include "store/energy.hpp"
 
 namespace stepbench {
 

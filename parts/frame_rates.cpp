@@ -1,11 +1,13 @@
 // The game programmer's question (/frame_rates): our fixed-step methods at whole frames of
 // each rate with n substeps a frame, measured at the frame ends.
+#include "run/frame_rates.hpp"
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include "parts/part.hpp"
-#include "study/sweep.hpp"
-#include "study/verdict.hpp"
+#include "run/sweep.hpp"
+#include "store/verdict.hpp"
 
 namespace stepbench {
 

@@ -1,12 +1,13 @@
 // The game loop around the integrator (/loop): what the player sees, designs, clocks and
 // the cost model.
-#include "study/loop.hpp"
+#include "run/loop.hpp"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include "parts/part.hpp"
-#include "study/sweep.hpp"
+#include "run/sweep.hpp"
+#include "store/loop.hpp"
 
 namespace stepbench {
 

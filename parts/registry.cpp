@@ -7,7 +7,8 @@
 
 #include "core/contains.hpp"
 #include "parts/part.hpp"
-#include "study/sweep.hpp"
+#include "run/scan.hpp"
+#include "run/sweep.hpp"
 
 namespace stepbench {
 

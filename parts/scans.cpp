@@ -6,16 +6,19 @@
 #include <chrono>
 
 #include "core/contains.hpp"
+#include "judge/scan.hpp"
 #include "parts/part.hpp"
-#include "study/study_file.hpp"
-#include "study/sweep.hpp"
+#include "render/scan.hpp"
+#include "run/scan.hpp"
+#include "run/sweep.hpp"
+#include "store/scan.hpp"
 
 namespace stepbench {
 namespace {
 
 std::string describe(const sweep_options& o) {
   std::vector<std::string> scans;
-  for (const auto& sc : o.scans) {
+  for (const auto& sc : o.scans.value_or(default_scans())) {
     std::vector<std::string> axes;
     for (const auto& a : sc.axes)
       axes.push_back(fmt::format("{}={}:{}:{}{}", a.param, a.lo, a.hi, a.count, a.log ? ":log" : ""));
@@ -30,7 +33,7 @@ std::string describe(const sweep_options& o) {
 void run(study& s, const part_context& ctx) {
   const sweep_options& opts = s.options;
   std::vector<scan_result> out;
-  for (scan_options sc : opts.scans) {
+  for (scan_options sc : opts.scans.value_or(default_scans())) {
     if (!contains(ctx.problems, sc.problem)) continue;
     if (!opts.methods.empty()) {
       sc.methods.clear();
@@ -67,6 +70,11 @@ extern const study_part scans_part{
     .merge = merge_rule::in_one_shard,
     .describe = describe,
     .run = run,
+    .judge =
+        [](study& s) {
+          if (auto* scans = s.results.find<std::vector<scan_result>>())
+            for (auto& sc : *scans) sc.range_answer = format_scan_answer(answer_scan(sc, sc.options.tol));
+        },
     .write = [](H5::Group& root, const study& s) { write_scans(root, s.results.get<std::vector<scan_result>>()); },
 };
 

@@ -1,9 +1,10 @@
 // The stability limits and regions of our compiled steps (/stability): of the build, not
 // of the selected problems, so every shard of a study computes the same.
-#include "study/stability.hpp"
+#include "run/stability.hpp"
 
 #include "parts/part.hpp"
-#include "study/sweep.hpp"
+#include "run/sweep.hpp"
+#include "store/stability.hpp"
 
 namespace stepbench {
 

@@ -8,8 +8,9 @@
 #include <mutex>
 
 #include "parts/part.hpp"
-#include "study/h5.hpp"
-#include "study/study_file.hpp"
+#include "run/sweep.hpp"
+#include "store/h5.hpp"
+#include "store/study_file.hpp"
 
 namespace stepbench {
 

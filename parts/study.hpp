@@ -3,7 +3,7 @@
 // table of parts in its order.
 #include <string>
 
-#include "study/sweep.hpp"
+#include "study/study.hpp"
 
 namespace stepbench {
 
@@ -28,7 +28,7 @@ std::string describe_options(const sweep_options& opts);
 std::size_t sweep_parts(const sweep_options& opts);
 
 // Writes the study: the root attributes, then every part that holds results, in the
-// study's order, atomically (study/study_file.hpp write_study_file).
+// study's order, atomically (store/study_file.hpp write_study_file).
 void write_study(const study& s, const std::string& path);
 
 }  // namespace stepbench

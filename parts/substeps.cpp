@@ -1,12 +1,13 @@
 // Small steps against one implicit step a frame (/substeps): n explicit substeps a frame
 // against implicit steps on the stiff problems.
-#include "study/substeps.hpp"
+#include "run/substeps.hpp"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include "parts/part.hpp"
-#include "study/sweep.hpp"
+#include "run/sweep.hpp"
+#include "store/substeps.hpp"
 
 namespace stepbench {
 

@@ -1,6 +1,6 @@
 // The sweep (/problems): every selected method on every problem of this run, over its
 // ladder, measured against the truth; the rows every other part reads.
-#include "study/sweep.hpp"
+#include "run/sweep.hpp"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -9,8 +9,8 @@
 
 #include "core/contains.hpp"
 #include "parts/part.hpp"
-#include "study/machine.hpp"
-#include "study/study_file.hpp"
+#include "run/machine.hpp"
+#include "store/study_file.hpp"
 
 namespace stepbench {
 namespace {

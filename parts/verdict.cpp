@@ -1,10 +1,11 @@
 // The answer (/verdict): judged from every other part as the study holds it, timings
 // included, so it is judged again after stepbench_bench times the rows and after merge
 // joins the shards.
-#include "study/verdict.hpp"
+#include "judge/verdict.hpp"
 
 #include "parts/part.hpp"
-#include "study/sweep.hpp"
+#include "run/sweep.hpp"
+#include "store/verdict.hpp"
 
 namespace stepbench {
 

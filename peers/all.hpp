@@ -1,7 +1,7 @@
 #pragma once
 // The peer registry: what a user might run instead of our integrators, on the same
 // problems, measured by the same code. Adding a peer is its header (a descriptor and a
-// step adapter, peers/step_adapter.hpp) plus one entry in its group's list
+// step adapter, core/step_adapter.hpp) plus one entry in its group's list
 // (peers/group_*.hpp). The registry's order is the groups' in turn.
 #include "core/type_list.hpp"
 #include "peers/group_adaptive.hpp"

@@ -10,7 +10,7 @@
 #include <utility>
 
 #include "core/method.hpp"
-#include "peers/step_adapter.hpp"
+#include "core/step_adapter.hpp"
 
 namespace stepbench::peers {
 
@@ -54,7 +54,7 @@ struct scalar_baseline_state {
 };
 
 // The descriptor and the step adapter (registered as fixed_step_peer<baseline_rk4>,
-// peers/step_adapter.hpp, whose loop flattens the step into it).
+// core/step_adapter.hpp, whose loop flattens the step into it).
 struct baseline_rk4 {
   static method_info describe() {
     return {.name = "baseline_rk4",

@@ -9,7 +9,7 @@ namespace stepbench {
 
 // Each entry: a library's whole run (library_adaptive: GSL's driver, CVODE and ARKODE
 // own the loop, as a user would call them), or Odeint's stepper on the adaptive loop
-// (peers/step_adapter.hpp).
+// (core/step_adapter.hpp).
 using adaptive_peers =
     type_list<peers::library_adaptive<peers::gsl_rkf45_solver>, peers::library_adaptive<peers::gsl_rk8pd_solver>,
               peers::library_adaptive<peers::cvode_adams_solver>, peers::library_adaptive<peers::cvode_bdf_solver>,

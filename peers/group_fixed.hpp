@@ -12,7 +12,7 @@
 namespace stepbench {
 
 // Each entry: a peer's descriptor and step adapter on the fixed-step loop
-// (peers/step_adapter.hpp), or a library's whole run (arkode_fixed: the library owns the
+// (core/step_adapter.hpp), or a library's whole run (arkode_fixed: the library owns the
 // loop, as a user would call it).
 using fixed_step_peers =
     type_list<peers::fixed_step_peer<peers::gsl_fixed<peers::gsl_rk4_tag>>,

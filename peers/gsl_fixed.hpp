@@ -1,6 +1,6 @@
 #pragma once
 // GSL's fixed-step steppers at our dt: gsl_odeiv2_step_apply as a step adapter on our
-// fixed-step loop (peers/step_adapter.hpp), as the GSL manual describes a fixed-step
+// fixed-step loop (core/step_adapter.hpp), as the GSL manual describes a fixed-step
 // loop: dydt_out of one step is passed as dydt_in of the next, so no stage is computed
 // twice. GSL's rk4 still estimates its error by step
 // doubling (a full step and two half steps), and rkf45 by its embedded pair: work a
@@ -16,7 +16,7 @@
 
 #include "core/first_order.hpp"
 #include "core/method.hpp"
-#include "peers/step_adapter.hpp"
+#include "core/step_adapter.hpp"
 
 namespace stepbench::peers {
 
@@ -58,7 +58,7 @@ struct gsl_rkf45_tag {
 };
 
 // The descriptor and the step adapter of one GSL stepper (registered as
-// fixed_step_peer<gsl_fixed<Tag>>, peers/step_adapter.hpp).
+// fixed_step_peer<gsl_fixed<Tag>>, core/step_adapter.hpp).
 template <class Stepper>
 struct gsl_fixed {
   static method_info describe() {

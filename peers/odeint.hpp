@@ -14,7 +14,7 @@
 
 #include "core/first_order.hpp"
 #include "core/method.hpp"
-#include "peers/step_adapter.hpp"
+#include "core/step_adapter.hpp"
 
 #if STEPBENCH_HAVE_ODEINT
 #include <boost/numeric/odeint/stepper/runge_kutta4.hpp>
@@ -70,7 +70,7 @@ struct odeint_rkf78_step {
 };
 
 // The descriptor and the step adapter (registered as fixed_step_peer<odeint_fixed<Tag>>,
-// peers/step_adapter.hpp).
+// core/step_adapter.hpp).
 template <class Tag>
 struct odeint_fixed {
   static method_info describe() {

@@ -7,7 +7,7 @@
 //    (`odeint_bulirsch_stoer`);
 // (runge_kutta_fehlberg78 at our dt, `odeint_rkf78`, is in peers/odeint.hpp with the
 // other fixed-step Odeint peers.)
-// Their loop is integrate_times' (adaptive_peer, peers/step_adapter.hpp).
+// Their loop is integrate_times' (adaptive_peer, core/step_adapter.hpp).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -18,8 +18,8 @@
 
 #include "core/first_order.hpp"
 #include "core/method.hpp"
+#include "core/step_adapter.hpp"
 #include "peers/odeint.hpp"
-#include "peers/step_adapter.hpp"
 
 #if STEPBENCH_HAVE_ODEINT
 #include <boost/numeric/odeint/stepper/bulirsch_stoer.hpp>
@@ -80,7 +80,7 @@ struct odeint_bulirsch_stoer_tag {
 #pragma GCC diagnostic ignored "-Wuninitialized"
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 // The descriptor and the step adapter (registered as adaptive_peer<odeint_adaptive<Tag>>,
-// whose loop is integrate_times', peers/step_adapter.hpp).
+// whose loop is integrate_times', core/step_adapter.hpp).
 template <class Tag>
 struct odeint_adaptive {
   static constexpr double evals_per_step = Tag::evals_per_step;

@@ -1,6 +1,6 @@
 #pragma once
 // Every method as a registry entry of one shape (info, applies, prepare): our integrators
-// wrapped as ours_fixed / ours_adaptive, the peers as they are (peers/step_adapter.hpp),
+// wrapped as ours_fixed / ours_adaptive, the peers as they are (core/step_adapter.hpp),
 // so that every method is run and measured by the same code. Included by the problem units
 // (registry/problem_unit.cpp.in) and by registry/registry.cpp; it includes no method.
 #include <limits>

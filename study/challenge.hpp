@@ -23,8 +23,6 @@
 // accumulated), against n semi-implicit Euler substeps and one implicit Euler step; the
 // counted cost (force evaluations or constraint passes a frame) and the measured time
 // a frame for each.
-#include <H5Cpp.h>
-
 #include <limits>
 #include <string>
 #include <vector>
@@ -77,12 +75,5 @@ struct challenge_result {
   std::vector<std::string> small_steps_verdicts;  // one line a problem
   double seconds = 0.0;
 };
-
-// Runs both (seconds: about 10 on one core). Progress lines go to `progress` when set.
-challenge_result run_challenge(const challenge_options& opts, void (*progress)(const std::string&) = nullptr);
-
-// /challenge: attributes (the options, energy_scale), tables `entries`, `verdicts`
-// (criterion, verdict) and `small_steps` (docs/study-format.md).
-void write_challenge(H5::Group& root, const challenge_result& r);
 
 }  // namespace stepbench

@@ -19,8 +19,6 @@
 // Numerical Integration, 2nd ed., ch. IX): its error oscillates without drift; explicit
 // Euler and the explicit midpoint rule gain energy on oscillators, RK4 loses it.
 // Runs through the registry's drive loops, like every study row.
-#include <H5Cpp.h>
-
 #include <map>
 #include <string>
 #include <vector>
@@ -84,15 +82,5 @@ struct energy_study {
   std::vector<energy_problem> problems;
   double wall_seconds = 0.0;
 };
-
-// Runs the study on the scenes the options name, each with the problem's overrides (as
-// the sweep takes them). Throws std::invalid_argument for a scene that has no period or
-// no energy, or bad options.
-energy_study run_energy_study(const energy_options& opts,
-                              const std::map<std::string, std::map<std::string, double>>& overrides = {});
-
-// /energy (docs/study-format.md): attributes of the rule, one group per problem with the
-// summary table and the error curves.
-void write_energy(H5::Group& root, const energy_study& s);
 
 }  // namespace stepbench

@@ -30,14 +30,7 @@
 #include "core/method.hpp"
 #include "core/problem_instance.hpp"
 
-namespace H5 {
-class Group;
-}
-
 namespace stepbench {
-
-struct study;
-struct problem_study;
 
 struct loop_options {
   std::vector<std::string> problems{"pendulum", "damped_spring"};
@@ -97,56 +90,5 @@ struct loop_study {
   std::vector<loop_problem> problems;
   double wall_seconds = 0.0;
 };
-
-// The exact state at the frames' display times: the closed form, or the references
-// (build_truth) where there is none.
-truth_table loop_truth(const problem_instance& problem, const loop_result& run);
-
-// Measures a simulated run against the truth at its display times; `reference` is the
-// same configuration on the reference clock (nullptr: frame-rate independence NaN).
-loop_row measure_loop(const loop_config& config, std::string clock, const loop_result& run, const truth_table& truth,
-                      const loop_result* reference);
-
-// One configuration as `stepbench loop --design` runs it: simulated, its reference clock
-// simulated, measured. Throws std::invalid_argument for bad input.
-loop_row run_loop_config(const problem_instance& problem, std::string_view method, const loop_config& config,
-                         const loop_options& opts);
-
-// Every configuration of the study for one integrator on one problem.
-loop_method run_loop_method(const problem_instance& problem, const method_info& method, const loop_options& opts);
-
-// The loop study of the problems of `s` that the options name (with their overrides).
-loop_study run_loop_study(const study& s, const loop_options& opts);
-
-// The cost verdict of a configuration at a step cost.
-struct loop_cost {
-  double step_cost_ns = 0.0;
-  std::string source;  // "measured" or "stated"
-  loop_schedule schedule;
-  loop_outcome without_clamp = loop_outcome::keeps_up;  // the same configuration, clamp off
-  bool clamp_prevented_spiral = false;                  // with the clamp no spiral, without it one
-};
-loop_cost cost_verdict(const loop_config& config, double step_cost_ns, std::string source);
-
-// The benchmark's median ns per step of `method` on the problem (its timed rows that
-// completed); NaN when the study has no timing for it.
-double measured_step_cost_ns(const problem_study& ps, std::string_view method);
-
-// The cheapest design at a constant display rate whose shown error stays at or under
-// the target: fewest physics steps per frame, then the smaller error, then the designs
-// that do not depend on the frame rate first (fixed, interpolated, substeps, variable).
-struct loop_cheapest {
-  double display_hz = 0.0;
-  double target = 0.0;
-  bool found = false;
-  std::string design;
-  double physics_hz = 0.0;  // NaN for variable
-  double steps_per_frame_mean = 0.0;
-  double shown_err_max = 0.0;
-};
-std::vector<loop_cheapest> cheapest_designs(const loop_method& m, const loop_options& opts);
-
-// /loop (docs/study-format.md), when the study holds a loop study.
-void write_loop(H5::Group& root, const study& s);
 
 }  // namespace stepbench

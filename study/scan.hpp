@@ -32,11 +32,6 @@ struct scan_axis {
   std::vector<double> values() const;  // lo .. hi, count points, evenly (in log when `log`)
 };
 
-// Parses `P.name=lo:hi:count[:log]` for problem P; throws std::invalid_argument with a
-// one-line reason (another problem, an unknown parameter, a bound outside the parameter's
-// declared range, count < 1 or above 10^5, log with a bound <= 0).
-scan_axis parse_scan_axis(std::string_view text, const std::string& problem);
-
 struct scan_options {
   std::string problem;
   std::string name;  // the group under /scan ("" : the problem's name)
@@ -65,15 +60,6 @@ struct scan_options {
   // Progress: called after each grid point with the points done and the total.
   std::function<void(std::size_t done, std::size_t total)> on_progress;
 };
-
-// Checks the options; throws std::invalid_argument with a one-line reason.
-void validate(const scan_options& opts);
-
-// The scans of the full study: stiff_spring over k_s 1e1 .. 1e7 N/m (25 points, log), the
-// pendulum over its release angle 1 .. 179.9 deg (12 points) and spring_chain over 8 .. 4096
-// masses x k_s 1e2 .. 1e5 N/m (4 x 4, log), each at 30 .. 240 Hz with 1 .. 64 substeps;
-// `quick`: the stiff spring's 13 points at 60 Hz only (the CI study).
-std::vector<scan_options> default_scans(bool quick = false);
 
 struct scan_run {
   std::size_t point = 0;  // index into scan_result::points (not the grid: see scan_point::index)
@@ -106,7 +92,10 @@ struct scan_best {
 
 struct scan_result {
   scan_options options;
-  std::string unit;                // the problem's position unit
+  std::string unit;  // the problem's position unit
+  // The range answer at the scan's tolerance, as `scan` and `advise --scan` print it:
+  // judged once (parts/scans.cpp), so the report and the README quote it, not redo it.
+  std::string range_answer;
   std::size_t grid_points = 0;     // the whole grid's points; `points` holds them all unless sharded
   std::vector<scan_point> points;  // in grid order
   std::vector<scan_run> runs;
@@ -115,23 +104,9 @@ struct scan_result {
   std::string source;         // the file it was read from ("" when run here): merge names it
 };
 
-scan_result run_scan(const scan_options& opts);
-
-// The grid points in order: the first axis varies slowest.
-std::vector<std::vector<double>> scan_grid(const std::vector<scan_axis>& axes);
-
-// The grid points of shard k of n (0-based), in grid order: each point's size is counted
-// as its problem's coordinates (the force work of a step grows with them), and the points,
-// largest first (ties in grid order), go each to the shard with the least so far (ties to
-// the lowest shard). Deterministic: every machine computes the same split.
-std::vector<std::size_t> scan_shard(const scan_options& opts, int k, int n);
-
-// Joins shards of one scan (the same problem, axes, rates, substeps, methods, tolerance,
-// fixed parameters, reference tolerances and work budget) into one scan, points in grid
-// order; throws std::invalid_argument naming the first difference and the two values, a
-// point two shards hold, or, unless `partial`, the points none holds. `missing` receives
-// the grid indices no shard holds. A shard may hold no point (N above the grid's points).
-scan_result merge_scans(const std::vector<scan_result>& shards, bool partial, std::vector<std::size_t>& missing);
+// The cheapest run meeting the tolerance at each point and rate (scan_result::best), from
+// its runs: after a scan's run, its read and its merge.
+void compute_best(scan_result& s);
 
 }  // namespace stepbench
 
@@ -165,17 +140,8 @@ struct scan_answer {
   std::vector<scan_break> breaks;
 };
 
-scan_answer answer_scan(const scan_result& scan, double tol);
-std::string format_scan_answer(const scan_answer& a);
-
-// Reads /scan/<name> of a study file (name "" : the only scan in it); throws
-// std::runtime_error naming the file and what is wrong, std::invalid_argument for a
-// name it does not hold (listing those it does).
-scan_result read_scan(const std::string& path, const std::string& name);
-
-// Every scan of a study file, and the build that wrote it (format_version, git_commit,
-// build_type, build_flags as one line), for `stepbench merge`; errors as read_scan's.
-std::vector<scan_result> read_scans(const std::string& path);
-std::string file_build(const std::string& path);
+// The cheapest run meeting the tolerance at each point and rate (scan_result::best), from
+// its runs: after a scan's run, its read and its merge.
+void compute_best(scan_result& s);
 
 }  // namespace stepbench

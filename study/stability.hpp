@@ -19,9 +19,6 @@
 //
 // Computed by the sweep into every study (study/sweep.hpp), written to the study file as
 // /stability (docs/study-format.md), and printed by `stepbench stability`.
-#include <H5Cpp.h>
-
-#include <Eigen/Core>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -125,18 +122,5 @@ struct stability_data {
   stability_regions regions;
   double limits_seconds = 0.0, regions_seconds = 0.0;
 };
-
-stability_data compute_stability(const stability_settings& settings = {});
-
-// The amplification matrix of one step of `integrator` (a name in all_integrators) on
-// `test` at y: the map [x; v] -> [x; v] of one step of dt = y with omega = lambda = 1.
-// Throws std::invalid_argument for an unknown name.
-Eigen::Matrix2d amplification_matrix(std::string_view integrator, stability_test test, double y);
-// max |eigenvalue| of a 2x2 matrix, from its trace and determinant.
-double spectral_radius(const Eigen::Matrix2d& m);
-
-// Writes /stability under `root` (docs/study-format.md): what run_sweep computed with the
-// default settings, in every study file.
-void write_stability(H5::Group& root, const stability_data& data);
 
 }  // namespace stepbench

@@ -11,20 +11,31 @@
 // run, max_j (E_true(t_j) - E(t_j)) / energy_scale. At equal cost per frame (the
 // measured time when the study is timed, else force evaluations), the verdict says how
 // many substeps the implicit step's cost buys and what they achieve.
-#include <H5Cpp.h>
-
 #include <string>
 #include <vector>
 
-#include "study/sweep.hpp"
+#include "core/method.hpp"
+#include "study/method_row.hpp"
 
 namespace stepbench {
 
-// Runs the comparison on the problems of `s` that the options name (their truths are
-// already built: the frame ends are the study's sample times).
-std::vector<substep_study> run_substeps(const study& s, const substep_options& opts);
+struct substep_row {
+  int substeps = 1;
+  method_row row;              // param = dt = frame / substeps
+  double extra_damping = 0.0;  // max_j (E_true - E) / energy_scale; NaN without energy or when not completed
+};
 
-// At equal cost per frame: for each implicit method and each explicit one.
+struct substep_method {
+  method_info info;
+  std::vector<substep_row> rows;
+};
+
+struct substep_study {
+  std::string problem;
+  double frame_dt = 0.0;
+  std::vector<substep_method> methods;
+};
+
 struct substep_verdict {
   std::string problem, implicit_method, explicit_method, cost_kind;  // cost_kind: time_ns or force_evals
   double implicit_cost = 0.0, implicit_error = 0.0, implicit_damping = 0.0;
@@ -35,10 +46,5 @@ struct substep_verdict {
   double cost_to_match = 0.0;  // their cost (NaN if none)
   std::string summary;         // one line, as measured
 };
-std::vector<substep_verdict> substep_verdicts(const substep_study& s, bool timed);
-
-// /substeps/<problem>: attribute frame_dt (frames = the problem's horizon / frame_dt); methods/<m>/runs (the study's
-// row fields plus `substeps` and `extra_damping`); `verdict` (a table of substep_verdict).
-void write_substeps(H5::Group& root, const std::vector<substep_study>& studies, bool timed);
 
 }  // namespace stepbench

@@ -17,27 +17,14 @@
 //    step of the method on the problem times the steps of a frame (timed study), else the
 //    force evaluations of a frame.
 //  - Findings: a few sentences generated from these and the other studies' verdicts.
-#include <H5Cpp.h>
-
 #include <map>
 #include <set>
 #include <string>
 #include <vector>
 
 #include "study/substeps.hpp"
-#include "study/sweep.hpp"
 
 namespace stepbench {
-
-// Runs the frame-rate study on every problem of `s` (their truths are rebuilt at the frame
-// ends of the fastest rate). A problem whose horizon holds no whole frame is left out.
-// The truth at every stride-th sample of `t` (the frame ends of a slower rate).
-truth_table every_nth(const truth_table& t, std::size_t stride);
-
-std::vector<frame_rate_study> run_frame_rates(const study& s, const frame_rate_options& opts);
-
-// The error targets of the verdict: 1e-2 .. 1e-12.
-std::vector<double> verdict_targets();
 
 struct cost_at_error {
   std::string method, kind;  // empty method: none reaches the target
@@ -81,8 +68,6 @@ struct verdict_tables {
   std::vector<std::string> findings;
 };
 
-verdict_tables compute_verdict(const study& s);
-
 // What the findings are generated from besides the verdict tables, as a study holds it
 // and as its file does: `stepbench merge` generates a merged study's findings from the
 // merged file by the same code.
@@ -107,22 +92,6 @@ struct finding_inputs {
   std::map<std::string, std::set<std::string>> broken_orders;  // peer -> problems where its declared order fails
   std::vector<ladder_finding> xpbd_ladders;                    // in the study's problem order
 };
-finding_inputs finding_inputs_of(const study& s);
-// From a study file's /substeps/<p>/verdict and /problems/<p>/methods, for `problems` in
-// that order.
-finding_inputs read_finding_inputs(const H5::Group& root, const std::vector<std::string>& problems);
-std::vector<std::string> findings_of(const verdict_tables& v, const finding_inputs& in);
-
-// /verdict, as judged into the study (nothing when it holds no verdict), and
-// /frame_rates/<problem> (docs/study-format.md).
-void write_verdict(H5::Group& root, const study& s);
-void write_frame_rates(H5::Group& root, const study& s);
-
-// The verdict tables as text: the equal-error table across problems and targets, the
-// frame-rate table and the findings (what a study run prints at its end).
-std::string format_verdict_text(const study& s);
-std::string format_verdict_text(const verdict_tables& v);
-
 // Two studies' equal-error verdicts side by side (`stepbench compare`): over the
 // (problem, target) pairs where both say "ahead" or "behind", how many agree and which
 // flip; and how many are decided in one and within the spread in the other. Of the same
@@ -131,12 +100,20 @@ struct verdict_agreement {
   int both_decided = 0, agree = 0, decided_in_one = 0;
   std::vector<std::string> flips;  // "pendulum at 1e-06: ahead (0.94x) -> behind (1.03x)"
 };
-verdict_agreement compare_verdicts(const verdict_tables& base, const verdict_tables& next);
-std::string format_verdict_agreement(const verdict_agreement& a);
+// One frame-rate run as /frame_rates/<problem>/runs holds it, with its cost a frame.
+struct frame_option {
+  std::string method, note;
+  double hz = 0.0;
+  int substeps = 1;
+  bool completed = false, diverged = false;
+  double err_pos_max = 0.0, cost_per_frame = 0.0;
+};
 
-// Reads /verdict back from a study file (`stepbench advise --hz`); throws
-// std::runtime_error naming what is missing.
-verdict_tables read_verdict(const std::string& path);
-verdict_tables read_verdict(const H5::Group& root);  // the file's root; errors without the path
+// A problem's frame-rate runs as a study file holds them (store/verdict.hpp reads them).
+struct frame_rate_runs {
+  std::string problem, unit, cost_kind;  // cost_kind: time_ns or force_evals (per frame)
+  double horizon = 0.0;
+  std::vector<frame_option> runs;
+};
 
 }  // namespace stepbench

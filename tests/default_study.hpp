@@ -5,7 +5,7 @@
 #pragma once
 
 #include "parts/study.hpp"
-#include "study/sweep.hpp"
+#include "run/sweep.hpp"
 
 namespace stepbench::test_support {
 

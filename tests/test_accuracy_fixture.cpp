@@ -11,7 +11,8 @@
 #include <nlohmann/json.hpp>
 
 #include "default_study.hpp"
-#include "study/sweep.hpp"
+#include "judge/verdict.hpp"
+#include "run/sweep.hpp"
 
 using namespace stepbench;
 using stepbench::test_support::default_study;

@@ -12,13 +12,13 @@
 #include <filesystem>
 #include <fstream>
 
+#include "judge/compare.hpp"
 #include "parts/study.hpp"
-#include "study/compare.hpp"
-#include "study/compare_render.hpp"
-#include "study/study_file.hpp"
-#include "study/study_reader.hpp"
-#include "study/sweep.hpp"
-#include "study/table_render.hpp"
+#include "render/compare_render.hpp"
+#include "render/table_render.hpp"
+#include "run/sweep.hpp"
+#include "store/study_file.hpp"
+#include "store/study_reader.hpp"
 
 using namespace stepbench;
 namespace fs = std::filesystem;

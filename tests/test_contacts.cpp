@@ -16,7 +16,7 @@
 #include "problems/bouncing_ball.hpp"
 #include "problems/bouncing_balls.hpp"
 #include "registry/registry.hpp"
-#include "study/sweep.hpp"
+#include "run/sweep.hpp"
 
 using namespace stepbench;
 

@@ -16,8 +16,9 @@
 #include "problems/pendulum.hpp"
 #include "problems/sliding_block.hpp"
 #include "registry/registry.hpp"
+#include "run/energy.hpp"
+#include "run/sweep.hpp"
 #include "study/energy.hpp"
-#include "study/sweep.hpp"
 
 using namespace stepbench;
 

@@ -18,7 +18,7 @@
 #include "problems/pendulum.hpp"
 #include "problems/spring_chain.hpp"
 #include "references/reference.hpp"
-#include "study/sweep.hpp"
+#include "run/sweep.hpp"
 
 using namespace stepbench;
 

@@ -12,7 +12,9 @@
 #include <stdexcept>
 
 #include "core/game_loop.hpp"
+#include "judge/loop.hpp"
 #include "registry/registry.hpp"
+#include "run/loop.hpp"
 #include "study/loop.hpp"
 
 using namespace stepbench;

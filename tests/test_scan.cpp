@@ -13,11 +13,15 @@
 #include <numbers>
 
 #include "core/measure.hpp"
+#include "judge/scan.hpp"
 #include "parts/study.hpp"
 #include "registry/registry.hpp"
+#include "render/scan.hpp"
+#include "run/scan.hpp"
+#include "run/sweep.hpp"
+#include "store/scan.hpp"
+#include "store/study_file.hpp"
 #include "study/scan.hpp"
-#include "study/study_file.hpp"
-#include "study/sweep.hpp"
 
 using namespace stepbench;
 
@@ -120,6 +124,7 @@ TEST(scan, written_and_read_back) {
   study s;
   s.options.parts = {"scans"};
   const auto& scans = s.results.put(std::vector<scan_result>{run_scan(o)});
+  judge_study(s);
   const auto path = (std::filesystem::temp_directory_path() / "stepbench_test_scan.h5").string();
   write_study(s, path);
   const scan_result back = read_scan(path, "");
@@ -224,6 +229,7 @@ scan_result through_file(const scan_result& scan, const std::string& file) {
   study s;
   s.options.parts = {"scans"};
   s.results.put(std::vector<scan_result>{scan});
+  judge_study(s);
   write_study(s, path);
   scan_result back = read_scan(path, "");
   std::filesystem::remove(path);

@@ -1,4 +1,4 @@
-// The study file's schema (study/schema.hpp) is what the writer checks each table
+// The study file's schema (store/schema.hpp) is what the writer checks each table
 // against: a table whose columns differ from the declaration in name, order or type is
 // refused before anything is written, and the timing group comes whole or not at all.
 #include <gtest/gtest.h>
@@ -7,9 +7,9 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
-#include "study/h5.hpp"
-#include "study/schema.hpp"
-#include "study/study_file.hpp"
+#include "store/h5.hpp"
+#include "store/schema.hpp"
+#include "store/study_file.hpp"
 
 namespace stepbench {
 namespace {

@@ -11,7 +11,9 @@
 
 #include "integrators/all.hpp"
 #include "integrators/tableaus.hpp"
-#include "study/h5.hpp"
+#include "run/stability.hpp"
+#include "store/h5.hpp"
+#include "store/stability.hpp"
 #include "study/stability.hpp"
 
 using namespace stepbench;

@@ -13,8 +13,9 @@
 #include "core/drive.hpp"
 #include "core/work_precision.hpp"
 #include "default_study.hpp"
+#include "judge/verdict.hpp"
 #include "parts/study.hpp"
-#include "study/sweep.hpp"
+#include "run/sweep.hpp"
 #include "study/verdict.hpp"
 
 using namespace stepbench;

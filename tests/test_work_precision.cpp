@@ -11,11 +11,13 @@
 #include <fstream>
 
 #include "core/work_precision.hpp"
+#include "judge/advise.hpp"
+#include "judge/verdict.hpp"
 #include "parts/study.hpp"
-#include "study/advise.hpp"
-#include "study/study_file.hpp"
-#include "study/study_reader.hpp"
-#include "study/sweep.hpp"
+#include "run/sweep.hpp"
+#include "store/study_file.hpp"
+#include "store/study_reader.hpp"
+#include "store/verdict.hpp"
 
 using namespace stepbench;
 
@@ -328,7 +330,7 @@ TEST(advise, frame_rates_follow_the_stability_limits_and_agree_with_the_substeps
   ASSERT_NEAR(substeps.front().frame_dt, 1.0 / 60.0, 1e-15);
   const auto path = (std::filesystem::temp_directory_path() / fmt::format("test_frames_{}.h5", ::getpid())).string();
   write_study(s, path);
-  const frame_advice f = advise_frame(path, "stiff_spring", 60.0, 1e-3);
+  const frame_advice f = advise_frame(read_frame_rate_runs(path, "stiff_spring"), 60.0, 1e-3);
   auto completed_at = [&](const std::string& m, int n) {
     for (const auto& r : frame_rates.front().runs)
       if (r.hz == 60.0 && r.method == m && r.substeps == n) return r.row.metrics.completed();
@@ -359,7 +361,7 @@ TEST(advise, frame_rates_follow_the_stability_limits_and_agree_with_the_substeps
       cheapest = std::min(cheapest, static_cast<double>(r.row.work.force_evals) / 32.0);
   EXPECT_DOUBLE_EQ(f.ranked.front().cost_per_frame, cheapest);
   EXPECT_LE(f.ranked.front().err_pos_max, 1e-3);
-  EXPECT_THROW(advise_frame(path, "stiff_spring", 50.0, 1e-3), std::invalid_argument);
-  EXPECT_THROW(advise_frame(path, "nosuch", 60.0, 1e-3), std::invalid_argument);
+  EXPECT_THROW(advise_frame(read_frame_rate_runs(path, "stiff_spring"), 50.0, 1e-3), std::invalid_argument);
+  EXPECT_THROW(read_frame_rate_runs(path, "nosuch"), std::invalid_argument);
   std::filesystem::remove(path);
 }

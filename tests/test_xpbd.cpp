@@ -16,6 +16,7 @@
 #include "problems/spring_chain.hpp"
 #include "problems/stiff_spring.hpp"
 #include "registry/registry.hpp"
+#include "run/challenge.hpp"
 #include "study/challenge.hpp"
 
 using namespace stepbench;

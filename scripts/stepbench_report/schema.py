@@ -1,4 +1,4 @@
-"""The study file's schema as the C++ side declares it (study/schema.hpp): schema.json
+"""The study file's schema as the C++ side declares it (store/schema.hpp): schema.json
 beside this file is what `stepbench schema` prints, and a test (ctest schema_python_copy)
 fails when the two differ. Every reader of the package takes its fields, the format
 version, the "row completed" rule and what `param` holds from here. A leaf module: it

@@ -1,0 +1,540 @@
+#include "judge/compare.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+#include <set>
+#include <stdexcept>
+#include <string_view>
+#include <tuple>
+
+#include "core/number.hpp"
+#include "core/text.hpp"
+#include "core/work_precision.hpp"
+
+namespace stepbench {
+namespace {
+
+// ---------------------------------------------------------------------------------------
+// The checks. Each takes a pair (the same problem, or the same method, in both files)
+// and appends what it finds to the comparison. A new group of the study file is one more
+// function in one of the two lists below.
+
+struct problem_pair {
+  const study_problem& base;
+  const study_problem& next;
+  const compare_options& opts;
+};
+
+struct method_pair {
+  const study_problem& base_problem;
+  const study_problem& next_problem;
+  const study_method& base;
+  const study_method& next;
+  const compare_options& opts;
+  std::vector<std::pair<std::size_t, std::size_t>> rows;  // (base row, new row) with equal param
+};
+
+change problem_change(change_kind k, const study_problem& p, std::string what, compare_value old_value,
+                      compare_value new_value) {
+  change c;
+  c.kind = k;
+  c.problem = p.name;
+  c.what = std::move(what);
+  c.old_value = std::move(old_value);
+  c.new_value = std::move(new_value);
+  return c;
+}
+
+change row_change(change_kind k, const method_pair& mp, std::size_t new_row, std::string what, double old_value,
+                  double new_value) {
+  change c;
+  c.kind = k;
+  c.problem = mp.next_problem.name;
+  c.method = mp.next.name;
+  c.param_name = std::string(param_name(mp.next.kind));
+  c.param = mp.next.col("param")[new_row];
+  c.what = std::move(what);
+  c.old_value = old_value;
+  c.new_value = new_value;
+  c.ratio = new_value / old_value;
+  if (new_row < mp.next.notes.size()) c.note = mp.next.notes[new_row];
+  return c;
+}
+
+// The truth a problem's errors are measured against: its source and whether it is trusted.
+void check_truth(const problem_pair& pp, comparison& out) {
+  if (pp.base.truth_source != pp.next.truth_source)
+    out.changes.push_back(
+        problem_change(change_kind::regression, pp.next, "truth_source", pp.base.truth_source, pp.next.truth_source));
+  if (pp.base.truth_trusted != pp.next.truth_trusted)
+    out.changes.push_back(problem_change(pp.next.truth_trusted ? change_kind::improvement : change_kind::regression,
+                                         pp.next, "truth_trusted", pp.base.truth_trusted ? 1.0 : 0.0,
+                                         pp.next.truth_trusted ? 1.0 : 0.0));
+}
+
+// The references: status (ok, failed, disagrees) and agreement with what they are compared with.
+void check_references(const problem_pair& pp, comparison& out) {
+  for (const auto& r : pp.base.references) {
+    const auto it = std::find_if(pp.next.references.begin(), pp.next.references.end(),
+                                 [&](const study_reference& n) { return n.source == r.source; });
+    if (it == pp.next.references.end()) {
+      out.removed.push_back({pp.base.name, "", "reference " + r.source, "status " + r.status + " in BASE"});
+      continue;
+    }
+    const study_reference& n = *it;
+    const bool was_ok = r.status == "ok", is_ok = n.status == "ok";
+    if (was_ok != is_ok) {
+      auto c = problem_change(is_ok ? change_kind::improvement : change_kind::regression, pp.next,
+                              fmt::format("reference {} status", r.source), r.status, n.status);
+      c.note = n.reason;
+      out.changes.push_back(std::move(c));
+    }
+    if (r.compared_with != n.compared_with) continue;  // agreements with different things do not compare
+    for (const auto& [field, old_rel, new_rel] : {std::tuple{"err_pos_rel", r.err_pos_rel, n.err_pos_rel},
+                                                  std::tuple{"err_vel_rel", r.err_vel_rel, n.err_vel_rel}})
+      if (const auto k = judge_agreement(old_rel, new_rel, pp.opts.error_factor)) {
+        auto c = problem_change(*k, pp.next, fmt::format("reference {} {}", r.source, field), old_rel, new_rel);
+        c.ratio = new_rel / old_rel;
+        c.note = fmt::format("vs {}", n.compared_with);
+        out.changes.push_back(std::move(c));
+      }
+  }
+  for (const auto& n : pp.next.references)
+    if (std::none_of(pp.base.references.begin(), pp.base.references.end(),
+                     [&](const study_reference& r) { return r.source == n.source; }))
+      out.added.push_back({pp.next.name, "", "reference " + n.source, "status " + n.status + " in NEW"});
+}
+
+std::string param_list(const study_method& m, const std::vector<double>& params) {
+  std::string s;
+  for (double p : params) s += (s.empty() ? "" : ", ") + format_param(m.kind, p);
+  return s;
+}
+
+// The ladder: rows are matched by their param, exactly. Rows only in BASE are removed,
+// rows only in NEW added; a method whose kind changed has no rows in common.
+void match_ladder(method_pair& mp, comparison& out) {
+  const auto& bp = mp.base.col("param");
+  const auto& np = mp.next.col("param");
+  if (mp.base.kind != mp.next.kind) {
+    out.removed.push_back({mp.next_problem.name, mp.next.name, "ladder",
+                           fmt::format("was {} ({} rows), now {} ({} rows): no row compared", to_string(mp.base.kind),
+                                       bp.size(), to_string(mp.next.kind), np.size())});
+    return;
+  }
+  std::vector<double> only_base, only_new;
+  for (std::size_t i = 0; i < bp.size(); ++i) {
+    const auto it = std::find(np.begin(), np.end(), bp[i]);
+    if (it == np.end())
+      only_base.push_back(bp[i]);
+    else
+      mp.rows.emplace_back(i, static_cast<std::size_t>(it - np.begin()));
+  }
+  for (double p : np)
+    if (std::find(bp.begin(), bp.end(), p) == bp.end()) only_new.push_back(p);
+  if (!only_base.empty())
+    out.removed.push_back({mp.next_problem.name, mp.next.name, "ladder",
+                           fmt::format("ladder changed: {} of {} rows only in BASE ({}); {} compared", only_base.size(),
+                                       bp.size(), param_list(mp.base, only_base), mp.rows.size())});
+  if (!only_new.empty())
+    out.added.push_back({mp.next_problem.name, mp.next.name, "ladder",
+                         fmt::format("ladder changed: {} of {} rows only in NEW ({}); {} compared", only_new.size(),
+                                     np.size(), param_list(mp.next, only_new), mp.rows.size())});
+}
+
+// The timesteps of a method's fitted levels.
+std::vector<double> fitted_params(const study_method& m) {
+  std::vector<double> out;
+  const auto& params = m.col("param");
+  for (long level : m.fit_levels)
+    if (level >= 0 && static_cast<std::size_t>(level) < params.size()) out.push_back(params[level]);
+  return out;
+}
+
+// The observed order of a fixed-step method (the fit of err_pos_max against dt). On the
+// same ladder it is always judged (the fit chooses its levels from the errors, so levels
+// that moved are part of what changed). On different ladders (a quick study's shorter
+// one) only where both fitted the same timesteps: otherwise its order is another
+// measurement, not a change; and a change of fit status only on the same ladder.
+void check_order(const method_pair& mp, comparison& out) {
+  if (mp.base.kind != method_kind::fixed_step || mp.next.kind != method_kind::fixed_step) return;
+  const bool same_ladder =
+      mp.rows.size() == mp.base.col("param").size() && mp.rows.size() == mp.next.col("param").size();
+  const bool was = mp.base.fit_status == "fitted", is = mp.next.fit_status == "fitted";
+  change c;
+  c.problem = mp.next_problem.name;
+  c.method = mp.next.name;
+  if (was && is) {
+    if (!same_ladder && fitted_params(mp.base) != fitted_params(mp.next)) return;
+    const auto k = judge_order(mp.base.fit_slope, mp.next.fit_slope, mp.opts.order_drop);
+    if (!k) return;
+    c.kind = *k;
+    c.what = "observed order";
+    c.old_value = mp.base.fit_slope;
+    c.new_value = mp.next.fit_slope;
+    c.ratio = mp.next.fit_slope / mp.base.fit_slope;
+  } else if (same_ladder && (was || (is && mp.base.fit_status == "insufficient"))) {
+    // Fitted and no longer is; or could not be fitted and now is. (From `exact` to fitted
+    // is no improvement: the errors left round-off, which the row checks judge.)
+    c.kind = was ? change_kind::regression : change_kind::improvement;
+    c.what = "order fit";
+    c.old_value = mp.base.fit_status;
+    c.new_value = mp.next.fit_status;
+  } else {
+    return;
+  }
+  out.changes.push_back(std::move(c));
+}
+
+// The flags that say a row has no result: diverged, failed, and (where both files have
+// the field) skipped over the work budget.
+std::vector<std::string> row_flags(const method_pair& mp) {
+  std::vector<std::string> out{"diverged", "failed"};
+  if (mp.base.columns.count("skipped") && mp.next.columns.count("skipped")) out.emplace_back("skipped");
+  return out;
+}
+
+// Every row in both files: newly diverged, failed or skipped (or no longer), and each error.
+void check_rows(const method_pair& mp, comparison& out) {
+  const auto flags = row_flags(mp);
+  const double pos_floor = error_floor_rel * std::max(mp.base_problem.pos_scale, mp.next_problem.pos_scale);
+  const double vel_floor = error_floor_rel * std::max(mp.base_problem.vel_scale, mp.next_problem.vel_scale);
+  for (const auto& [i, j] : mp.rows) {
+    bool completed = true;
+    for (const auto& flag : flags) {
+      const double old_flag = mp.base.col(flag)[i], new_flag = mp.next.col(flag)[j];
+      completed = completed && old_flag == 0 && new_flag == 0;
+      if ((old_flag != 0) != (new_flag != 0)) {
+        auto c = row_change(new_flag != 0 ? change_kind::regression : change_kind::improvement, mp, j, flag, old_flag,
+                            new_flag);
+        c.ratio = nan;  // a flag: 0 -> 1 has no ratio
+        out.changes.push_back(std::move(c));
+      }
+    }
+    if (!completed) continue;  // errors of completed runs only
+    for (const char* metric : error_metrics) {
+      const double old_err = mp.base.col(metric)[i], new_err = mp.next.col(metric)[j];
+      const double floor = std::string_view(metric) == "err_vel_final" ? vel_floor : pos_floor;
+      if (const auto k = judge_error(old_err, new_err, floor, mp.opts.error_factor)) {
+        auto c = row_change(*k, mp, j, metric, old_err, new_err);
+        c.note.clear();
+        out.changes.push_back(std::move(c));
+      }
+    }
+  }
+}
+
+timing_side side(const study_method& m, std::size_t row) {
+  return {m.col("time_ns")[row], m.col("time_ns_min")[row], m.col("time_ns_max")[row],
+          static_cast<long>(m.col("repetitions")[row])};
+}
+
+bool timed_row(const study_method& m, std::size_t row) {
+  return std::isfinite(m.col("time_ns")[row]) && m.col("time_ns")[row] > 0 && m.col("repetitions")[row] >= 1 &&
+         m.col("cut")[row] == 0;
+}
+
+// Rows timed in both files: ratio, noise threshold, flag.
+void collect_timing(const method_pair& mp, comparison& out) {
+  if (!out.timing_compared) return;
+  for (const auto& [i, j] : mp.rows) {
+    if (!timed_row(mp.base, i) || !timed_row(mp.next, j)) continue;
+    timing_row t{mp.next_problem.name,
+                 mp.next.name,
+                 std::string(param_name(mp.next.kind)),
+                 mp.next.col("param")[j],
+                 side(mp.base, i),
+                 side(mp.next, j),
+                 0.0,
+                 0.0,
+                 0};
+    t.ratio = t.new_time.median / t.old_time.median;
+    t.threshold = timing_threshold(t.old_time, t.new_time);
+    t.flag = judge_timing(t.ratio, t.threshold);
+    out.timing.push_back(std::move(t));
+  }
+}
+
+// Per method, over every problem: the geometric mean of its rows' ratios.
+void summarize_timing(comparison& out) {
+  std::map<std::string, timing_summary> by_method;
+  std::map<std::string, std::set<std::string>> problems;
+  std::map<std::string, double> log_sum;
+  for (const auto& t : out.timing) {
+    auto& s = by_method[t.method];
+    s.method = t.method;
+    s.min_ratio = s.rows == 0 ? t.ratio : std::min(s.min_ratio, t.ratio);
+    s.max_ratio = s.rows == 0 ? t.ratio : std::max(s.max_ratio, t.ratio);
+    ++s.rows;
+    s.slower += t.flag > 0;
+    s.faster += t.flag < 0;
+    problems[t.method].insert(t.problem);
+    log_sum[t.method] += std::log(t.ratio);
+  }
+  for (auto& [name, s] : by_method) {
+    s.problems = problems[name].size();
+    s.geomean = std::exp(log_sum[name] / static_cast<double>(s.rows));
+    out.timing_summaries.push_back(s);
+  }
+}
+
+using method_check = void (*)(const method_pair&, comparison&);
+constexpr method_check method_checks[] = {check_order, check_rows, collect_timing};
+
+// The methods of a problem: present in one file only, or compared by every method check.
+void check_methods(const problem_pair& pp, comparison& out) {
+  for (const auto& m : pp.base.methods) {
+    const study_method* n = pp.next.find(m.name);
+    if (!n) {
+      out.removed.push_back({pp.base.name, m.name, "method", fmt::format("{}, {} rows", to_string(m.kind), m.rows())});
+      continue;
+    }
+    method_pair mp{pp.base, pp.next, m, *n, pp.opts, {}};
+    match_ladder(mp, out);
+    for (const auto check : method_checks) check(mp, out);
+  }
+  for (const auto& n : pp.next.methods)
+    if (!pp.base.find(n.name))
+      out.added.push_back({pp.next.name, n.name, "method", fmt::format("{}, {} rows", to_string(n.kind), n.rows())});
+}
+
+using problem_check = void (*)(const problem_pair&, comparison&);
+constexpr problem_check problem_checks[] = {check_truth, check_references, check_methods};
+
+// ---------------------------------------------------------------------------------------
+// What differs between the files besides the results.
+
+std::string number(double v) { return fmt::format("{:.12g}", v); }
+
+void root_differences(const study_data& base, const study_data& next, comparison& out) {
+  // Run-specific figures that always differ are left out, and `sweep_options`, the
+  // options as a block of lines for `stepbench merge`: the settings that shape results
+  // have attributes of their own (levels, tolerances, ...), and --set shows as parameters.
+  const std::set<std::string> skip{"created_utc", "wall_seconds", "benchmark_wall_seconds", "sweep_options"};
+  // Machine, build and mode first: they decide whether the timings compare at all.
+  const std::vector<std::string> first{
+      "cpu",        "cores",      "num_cpus",      "mhz_per_cpu", "cpu_scaling_enabled",
+      "compiler",   "build_type", "dependencies",  "build_flags", "version",
+      "git_commit", "timing",     "benchmark_mode"};
+  std::map<std::string, std::pair<std::string, std::string>> all;
+  const auto gather = [&](const study_data& s, bool is_new) {
+    for (const auto& [k, v] : s.meta) (is_new ? all[k].second : all[k].first) = v;
+    for (const auto& [k, v] : s.settings) (is_new ? all[k].second : all[k].first) = number(v);
+  };
+  gather(base, false);
+  gather(next, true);
+  std::vector<std::string> order(first);
+  for (const auto& [k, v] : all)
+    if (std::find(first.begin(), first.end(), k) == first.end()) order.push_back(k);
+  for (const auto& k : order) {
+    const auto it = all.find(k);
+    if (it == all.end() || skip.count(k) || it->second.first == it->second.second) continue;
+    const auto shown = [](const std::string& v) { return v.empty() ? std::string("(absent)") : v; };
+    out.differences.push_back({k, shown(it->second.first), shown(it->second.second)});
+  }
+}
+
+// A problem's parameters (and the scales derived from its truth), equal to 1e-9 relative.
+void problem_differences(const study_problem& base, const study_problem& next, comparison& out) {
+  std::set<std::string> keys;
+  for (const auto& [k, v] : base.params) keys.insert(k);
+  for (const auto& [k, v] : next.params) keys.insert(k);
+  for (const auto& k : keys) {
+    const auto b = base.params.find(k), n = next.params.find(k);
+    const bool in_b = b != base.params.end(), in_n = n != next.params.end();
+    if (in_b && in_n) {
+      const double x = b->second, y = n->second;
+      if (x == y || std::abs(x - y) <= 1e-9 * std::max(std::abs(x), std::abs(y)) || (std::isnan(x) && std::isnan(y)))
+        continue;
+    }
+    out.differences.push_back({fmt::format("{}: {}", next.name, k), in_b ? number(b->second) : "(absent)",
+                               in_n ? number(n->second) : "(absent)"});
+  }
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------
+
+double timing_side::spread() const { return repetitions >= 2 ? (max - min) / median : nan; }
+
+std::optional<change_kind> judge_error(double old_err, double new_err, double floor, double factor) {
+  if (std::isnan(old_err) && std::isnan(new_err)) return std::nullopt;
+  if (!std::isfinite(new_err) && std::isfinite(old_err)) return change_kind::regression;
+  if (std::isfinite(new_err) && !std::isfinite(old_err)) return change_kind::improvement;
+  if (new_err > floor && new_err > factor * old_err) return change_kind::regression;
+  if (old_err > floor && old_err > factor * new_err) return change_kind::improvement;
+  return std::nullopt;
+}
+
+std::optional<change_kind> judge_agreement(double old_rel, double new_rel, double factor) {
+  if (!std::isfinite(old_rel) || !std::isfinite(new_rel)) return std::nullopt;  // not compared
+  return judge_error(old_rel, new_rel, agreement_floor, factor);
+}
+
+std::optional<change_kind> judge_order(double old_order, double new_order, double drop) {
+  if (!std::isfinite(old_order) || !std::isfinite(new_order)) return std::nullopt;
+  if (new_order < old_order - drop) return change_kind::regression;
+  if (new_order > old_order + drop) return change_kind::improvement;
+  return std::nullopt;
+}
+
+double timing_threshold(const timing_side& old_time, const timing_side& new_time) {
+  const bool both_spread = old_time.repetitions >= 2 && new_time.repetitions >= 2;
+  double t = both_spread ? timing_noise_floor : timing_single_run_floor;
+  for (const auto& s : {old_time, new_time})
+    if (std::isfinite(s.spread())) t = std::max(t, timing_spread_multiple * s.spread());
+  return t;
+}
+
+int judge_timing(double ratio, double threshold) {
+  if (ratio > 1.0 + threshold) return 1;
+  if (ratio < 1.0 / (1.0 + threshold)) return -1;
+  return 0;
+}
+
+std::vector<std::string> describe_thresholds(const compare_options& o) {
+  return {
+      fmt::format(
+          "An error (err_pos_max, err_pos_final, err_pos_rms, err_vel_final) of a row that completed in both "
+          "files regresses when it grows by more than {:g}x (--error-factor) while the new error is above the "
+          "round-off floor {:g} x pos_scale for position errors, {:g} x vel_scale for err_vel_final (the larger "
+          "scale of the two files); it improves when it shrinks by as much from above the floor.",
+          o.error_factor, error_floor_rel, error_floor_rel),
+      "A row that newly diverges, fails or is skipped (over the work budget) regresses; one that no longer does "
+      "improves.",
+      fmt::format("An observed order (fit_slope of a fixed-step method fitted in both) regresses when it drops by more "
+                  "than {:g} (--order-drop), or when it was fitted and no longer is; it improves when it rises by as "
+                  "much.",
+                  o.order_drop),
+      fmt::format("A reference regresses when its status leaves ok or its agreement (err_pos_rel, err_vel_rel) grows "
+                  "by more than {:g}x above {:g}; a problem regresses when its truth_source changes or its truth "
+                  "is no longer trusted.",
+                  o.error_factor, agreement_floor),
+      fmt::format("A stability limit of our methods (/stability, from the amplification matrix) regresses when it "
+                  "moves by more than {:g} %, or when a method becomes or stops being unstable for every dt or "
+                  "unconditionally stable.",
+                  100 * stability_tolerance),
+      fmt::format("Only what both files hold is compared: what only BASE has (a problem, a method, a reference, "
+                  "rows of a ladder) {}; what only NEW has is listed as added.",
+                  o.require_base ? "regresses (--require-base)" : "is listed as removed, not a regression"),
+      fmt::format("Timing: a row timed in both is flagged when new/old exceeds 1+t (slower) or falls below "
+                  "1/(1+t) (faster), t = max({:g} %, {:g} x the larger (max - min)/median of the two files' "
+                  "repetitions); with a single repetition on a side there is no spread, and the floor is {:g} % "
+                  "instead of {:g} %. {}",
+                  100 * timing_noise_floor, timing_spread_multiple, 100 * timing_single_run_floor,
+                  100 * timing_noise_floor,
+                  o.gate_timing ? "A flagged slowdown regresses (--gate-timing)."
+                                : "Timing informs; it gates only with --gate-timing."),
+  };
+}
+
+std::size_t comparison::count(change_kind k) const {
+  return static_cast<std::size_t>(
+      std::count_if(changes.begin(), changes.end(), [k](const change& c) { return c.kind == k; }));
+}
+std::size_t comparison::slower() const {
+  return static_cast<std::size_t>(
+      std::count_if(timing.begin(), timing.end(), [](const timing_row& r) { return r.flag > 0; }));
+}
+std::size_t comparison::faster() const {
+  return static_cast<std::size_t>(
+      std::count_if(timing.begin(), timing.end(), [](const timing_row& r) { return r.flag < 0; }));
+}
+std::size_t comparison::gating() const {
+  return count(change_kind::regression) + (options.require_base ? removed.size() : 0) +
+         (options.gate_timing ? slower() : 0);
+}
+
+// The stability limits of our methods (/stability): a limit that moves by more than
+// stability_tolerance (relative), or a method that becomes (or stops being) stable for
+// every dt or unstable for every dt, is a regression.
+void check_stability(const study_data& base, const study_data& next, comparison& out) {
+  for (const auto& b : base.stability) {
+    const auto it = std::find_if(next.stability.begin(), next.stability.end(),
+                                 [&](const auto& n) { return n.integrator == b.integrator && n.test == b.test; });
+    if (it == next.stability.end()) {
+      if (!next.stability.empty())
+        out.removed.push_back({"stability", b.integrator, "limit " + b.test, "in BASE only"});
+      continue;
+    }
+    change c;
+    c.problem = "stability";
+    c.method = b.integrator;
+    auto flags = [](const study_stability_limit& l) {
+      return l.unconditionally_stable ? std::string("unconditionally stable")
+             : l.unstable_for_all_dt  ? std::string("unstable for every dt")
+                                      : std::string("finite limit");
+    };
+    if (flags(b) != flags(*it)) {
+      c.kind = change_kind::regression;
+      c.what = b.test + " stability";
+      c.old_value = flags(b);
+      c.new_value = flags(*it);
+      out.changes.push_back(c);
+    } else if (std::isfinite(b.theory) && std::isfinite(it->theory) &&
+               std::abs(it->theory / b.theory - 1.0) > stability_tolerance) {
+      c.kind = change_kind::regression;
+      c.what = b.test + " stability limit (y = w dt or lambda dt)";
+      c.old_value = b.theory;
+      c.new_value = it->theory;
+      c.ratio = it->theory / b.theory;
+      out.changes.push_back(c);
+    }
+  }
+}
+
+comparison compare_studies(const study_data& base, const study_data& next, const compare_options& opts) {
+  if (!(opts.error_factor >= 1.0) || !std::isfinite(opts.error_factor))
+    throw std::invalid_argument(
+        fmt::format("--error-factor must be a finite number >= 1, got {:g}", opts.error_factor));
+  if (!(opts.order_drop >= 0.0) || !std::isfinite(opts.order_drop))
+    throw std::invalid_argument(fmt::format("--order-drop must be a finite number >= 0, got {:g}", opts.order_drop));
+  if (base.format_version != next.format_version)
+    throw std::runtime_error(
+        fmt::format("cannot compare '{}' (format_version {}) with '{}' (format_version {}): "
+                    "different study formats",
+                    base.path, base.format_version, next.path, next.format_version));
+  comparison out;
+  out.options = opts;
+  out.base_path = base.path;
+  out.new_path = next.path;
+  out.base_meta = base.meta;
+  out.new_meta = next.meta;
+  out.base_timed = base.timed;
+  out.new_timed = next.timed;
+  out.timing_compared = base.timed && next.timed;
+  if (!out.timing_compared)
+    out.timing_note = !base.timed && !next.timed ? "neither file is timed"
+                      : base.timed               ? "NEW is not timed"
+                                                 : "BASE is not timed";
+  root_differences(base, next, out);
+  if (out.timing_compared) {
+    std::string differ;
+    for (const auto& d : out.differences)
+      for (const char* k : {"cpu", "cores", "compiler", "build_type", "build_flags", "dependencies", "benchmark_mode"})
+        if (d.what == k) differ += (differ.empty() ? "" : ", ") + d.what;
+    if (!differ.empty()) out.timing_note = fmt::format("the files differ in {}: the ratios measure that too", differ);
+  }
+  for (const auto& bp : base.problems) {
+    const study_problem* np = next.find(bp.name);
+    if (!np) {
+      out.removed.push_back({bp.name, "", "problem", plural(bp.methods.size(), "method", "methods")});
+      continue;
+    }
+    problem_differences(bp, *np, out);
+    const problem_pair pp{bp, *np, opts};
+    for (const auto check : problem_checks) check(pp, out);
+  }
+  for (const auto& np : next.problems)
+    if (!base.find(np.name))
+      out.added.push_back({np.name, "", "problem", plural(np.methods.size(), "method", "methods")});
+  check_stability(base, next, out);
+  summarize_timing(out);
+  return out;
+}
+
+}  // namespace stepbench

@@ -1,0 +1,309 @@
+#include "judge/verdict.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <set>
+
+#include "core/contains.hpp"
+#include "core/number.hpp"
+#include "core/work_precision.hpp"
+#include "judge/loop.hpp"
+#include "judge/substeps.hpp"
+
+namespace stepbench {
+
+// The cost of a frame of a run: the measured ns per step times the steps of a frame
+// (timed), else the force evaluations of a frame.
+double cost_per_frame(const problem_study* ps, const frame_rate_study& fs, const frame_rate_run& r, bool timed) {
+  const double frames = fs.horizon * r.hz;
+  if (!timed) return static_cast<double>(r.row.work.force_evals) / frames;
+  const double ns = ps ? measured_step_cost_ns(*ps, r.method) : nan;
+  return std::isfinite(ns) && ns > 0.0 ? ns * r.substeps : nan;
+}
+
+const problem_study* find_problem(const study& s, std::string_view name) {
+  for (const auto& ps : s.problems)
+    if (ps.problem->name() == name) return &ps;
+  return nullptr;
+}
+
+namespace {
+
+cost_at_error cost_of(const std::vector<wp_method>& methods, const wp_pick* p) {
+  if (!p) return {};
+  const auto& m = methods[p->method];
+  return {m.name, std::string(to_string(m.kind)), p->param, p->cost, p->cost_lo, p->cost_hi, p->interpolated};
+}
+
+std::string verdict_of(const cost_at_error& ours, const cost_at_error& peer, bool timed) {
+  if (!ours.found() && !peer.found()) return "not reached";
+  if (!peer.found()) return "ours only";
+  if (!ours.found()) return "peers only";
+  const std::string v =
+      compare_at_equal_error({ours.cost, ours.cost_lo, ours.cost_hi}, {peer.cost, peer.cost_lo, peer.cost_hi}, timed);
+  // An upper bound on the side found cheaper proves nothing: its true cost may be lower.
+  if ((v == "ahead" && !peer.interpolated) || (v == "behind" && !ours.interpolated)) return "bounded";
+  return v;
+}
+
+}  // namespace
+
+// The findings: one sentence each, from the verdicts just computed and the studies'.
+std::vector<std::string> findings_of(const verdict_tables& v, const finding_inputs& in) {
+  std::vector<std::string> out;
+  const bool timed = v.cost_kind == "time_ns";
+  // Equal error.
+  {
+    int ahead = 0, behind = 0, within = 0, bounded = 0, ours_only = 0, peers_only = 0;
+    const equal_error_verdict* best_win = nullptr;
+    const equal_error_verdict* worst_loss = nullptr;
+    for (const auto& e : v.equal_error) {
+      if (e.verdict == "ahead") ++ahead;
+      if (e.verdict == "behind") ++behind;
+      if (e.verdict == "within spread") ++within;
+      if (e.verdict == "bounded") ++bounded;
+      if (e.verdict == "ours only") ++ours_only;
+      if (e.verdict == "peers only") ++peers_only;
+      if (e.verdict == "ahead" && (!best_win || e.ratio < best_win->ratio)) best_win = &e;
+      if (e.verdict == "behind" && (!worst_loss || e.ratio > worst_loss->ratio)) worst_loss = &e;
+    }
+    std::string line = fmt::format(
+        "At equal error ({}, interpolated on each method's measured curve), the fastest of ours against the "
+        "fastest library peer: ahead on {}, behind on {}, within the {} on {}, undecided on {} (the side found "
+        "cheaper only bounded: its ladder does not bracket the target) of the {} problem-and-target pairs both "
+        "reach; only ours reach {}, only a peer {}.",
+        timed ? "measured time" : "force evaluations", ahead, behind, timed ? "timing noise" : "rounding", within,
+        bounded, ahead + behind + within + bounded, ours_only, peers_only);
+    if (best_win)
+      line += fmt::format(" Largest lead: {} on {} at {:g} {} ({:.2g}x the {} of {}).", best_win->ours.method,
+                          best_win->problem, best_win->target, best_win->unit, best_win->ratio,
+                          timed ? "time" : "force evaluations", best_win->peer.method);
+    if (worst_loss)
+      line += fmt::format(" Largest deficit: {} on {} at {:g} {} ({:.2g}x {}).", worst_loss->ours.method,
+                          worst_loss->problem, worst_loss->target, worst_loss->unit, worst_loss->ratio,
+                          worst_loss->peer.method);
+    out.push_back(line);
+  }
+  // Implicit step against substeps.
+  for (const auto& [problem, frame_dt, sv] : in.substeps) {
+    const int n = sv.substeps_at_equal_cost;
+    std::string line = fmt::format("{} (frame {:.3g} s): ", problem, frame_dt);
+    if (n == 0 && sv.cost_kind == "time_ns")
+      line +=
+          "no timed semi_implicit_euler run costs as little as one implicit_euler step (the substep counts "
+          "that diverge are not timed)";
+    else if (n == 0)
+      line += "even one semi_implicit_euler substep costs more than one implicit_euler step";
+    else if (!std::isfinite(sv.explicit_error))
+      line += fmt::format("one implicit_euler step costs as much as {} semi_implicit_euler substep{}, which diverge{}",
+                          n, n == 1 ? "" : "s", n == 1 ? "s" : "");
+    else if (sv.explicit_error <= sv.implicit_error)
+      line += fmt::format(
+          "{} semi_implicit_euler substep{} cost as much as one implicit_euler step and are {:.2g}x "
+          "more accurate",
+          n, n == 1 ? "" : "s", sv.implicit_error / sv.explicit_error);
+    else
+      line += fmt::format(
+          "{} semi_implicit_euler substep{} cost as much as one implicit_euler step and are {:.2g}x "
+          "less accurate",
+          n, n == 1 ? "" : "s", sv.explicit_error / sv.implicit_error);
+    if (sv.substeps_to_match > 0) line += fmt::format("; {} substeps match its error", sv.substeps_to_match);
+    out.push_back(line + ".");
+  }
+  // Declared orders that do not hold.
+  {
+    const auto& broken = in.broken_orders;
+    if (!broken.empty()) {
+      std::string names;
+      for (const auto& [m, ps] : broken)
+        names +=
+            fmt::format("{}{} on {} problem{}", names.empty() ? "" : ", ", m, ps.size(), ps.size() == 1 ? "" : "s");
+      out.push_back(
+          fmt::format("Library methods whose observed order differs from the order they declare: {}.", names));
+    } else {
+      out.push_back("Every library method's observed order matches its declared order where it can be fitted.");
+    }
+  }
+  // xpbd's stability and energy over its dt ladder (at a 60 Hz frame, the substep
+  // ladder): the claim that rigid links stay stable at every substep count, and
+  // XPBD's projection only removing energy, as the study's own runs show them. The energy
+  // is the run's at its end (energy_drift), not its largest excursion: the text says so.
+  {
+    std::string parts;
+    for (const auto& [problem, runs] : in.xpbd_ladders) {
+      int ran = 0, completed = 0, diverged = 0, failed = 0;
+      double dt_max = 0.0, dt_min = std::numeric_limits<double>::infinity();
+      const ladder_run *coarsest = nullptr, *finest = nullptr;  // of the completed runs
+      double largest_drift = -std::numeric_limits<double>::infinity(), worst_constraint = nan;
+      for (const auto& r : runs) {
+        if (r.skipped) continue;
+        ++ran;
+        dt_max = std::fmax(dt_max, r.dt);
+        dt_min = std::fmin(dt_min, r.dt);
+        diverged += r.diverged;
+        failed += r.failed && !r.diverged;
+        if (!row_completed(r.diverged, r.failed, r.skipped)) continue;
+        ++completed;
+        if (!coarsest || r.dt > coarsest->dt) coarsest = &r;
+        if (!finest || r.dt < finest->dt) finest = &r;
+        largest_drift = std::fmax(largest_drift, r.energy_drift);  // fmax drops a NaN
+        worst_constraint = std::fmax(worst_constraint, r.constraint_violation);
+      }
+      if (ran == 0) continue;  // every rung over the work budget: nothing to say of it
+      std::string part = fmt::format("{} completed {} of the {} dt it ran ({} to {})", problem, completed, ran,
+                                     format_time_ns(dt_max * 1e9), format_time_ns(dt_min * 1e9));
+      if (diverged > 0) part += fmt::format(", diverged at {}", diverged);
+      if (failed > 0) part += fmt::format(", failed at {}", failed);
+      // A merged file may lack a drift (NaN): say only the numbers the runs have.
+      if (coarsest && std::isfinite(coarsest->energy_drift) && std::isfinite(finest->energy_drift))
+        part += fmt::format(", final energy drift {:.2g} at {} and {:.2g} at {} (largest {:.2g})",
+                            coarsest->energy_drift, format_time_ns(coarsest->dt * 1e9), finest->energy_drift,
+                            format_time_ns(finest->dt * 1e9), largest_drift);
+      if (std::isfinite(worst_constraint)) part += fmt::format(", |C|/L within {:.2g}", worst_constraint);
+      parts += (parts.empty() ? "" : "; ") + part;
+    }
+    if (!parts.empty())
+      out.push_back(fmt::format(
+          "xpbd over its dt ladder (final energy drift: the energy at the run's end against the truth's, of the "
+          "problem's energy scale, at the coarsest and the finest completed dt and the largest over the completed; "
+          "|C|/L: the largest relative length error of a rigid link, the stretch of a spring, over the run): {}.",
+          parts));
+  }
+  // Stability at 60 Hz, one step a frame.
+  {
+    std::map<std::string, std::vector<std::string>> unstable;  // problem -> methods
+    for (const auto& f : v.frame_rate)
+      if (f.hz == 60.0 && !f.stable) unstable[f.problem].push_back(f.method);
+    const bool any_60 =
+        std::any_of(v.frame_rate.begin(), v.frame_rate.end(), [](const auto& f) { return f.hz == 60.0; });
+    if (!any_60) {
+    } else if (unstable.empty()) {
+      out.push_back("At 60 Hz, one step a frame, every fixed-step method of ours stays stable on every problem.");
+    } else {
+      std::string parts;
+      for (const auto& [p, ms] : unstable)
+        parts += fmt::format("{}{}: {}", parts.empty() ? "" : "; ", p, fmt::join(ms, ", "));
+      out.push_back(fmt::format("At 60 Hz, one step a frame, these diverge or fail: {}.", parts));
+    }
+  }
+  return out;
+}
+
+finding_inputs finding_inputs_of(const study& s) {
+  finding_inputs in;
+  for (const auto& st : s.results.get<std::vector<substep_study>>())
+    for (const auto& sv : substep_verdicts(st, s.timed.has_value()))
+      if (sv.implicit_method == "implicit_euler" && sv.explicit_method == "semi_implicit_euler")
+        in.substeps.push_back({st.problem, st.frame_dt, sv});
+  for (const auto& ps : s.problems)
+    for (const auto& ms : ps.methods)
+      if (ms.info.origin == method_origin::peer && ms.declared_order_holds == 0)
+        in.broken_orders[ms.info.name].insert(std::string(ps.problem->name()));
+  for (const auto& ps : s.problems)
+    for (const auto& ms : ps.methods) {
+      if (ms.info.name != "xpbd") continue;
+      ladder_finding f{std::string(ps.problem->name()), {}};
+      for (const auto& r : ms.rows) {
+        const auto& m = r.metrics;
+        f.runs.push_back({r.param, m.diverged, m.failed, m.skipped, m.energy_drift, m.constraint_violation_max});
+      }
+      in.xpbd_ladders.push_back(std::move(f));
+    }
+  return in;
+}
+
+verdict_tables compute_verdict(const study& s) {
+  verdict_tables v;
+  const bool timed = s.timed.has_value();
+  v.cost_kind = timed ? "time_ns" : "force_evals";
+  for (const auto& ps : s.problems) {
+    const auto methods = work_precision_input(ps, verdict_metric);
+    const std::string unit(ps.problem->position_unit());
+    double best_error = std::numeric_limits<double>::infinity();
+    for (const auto& m : methods)
+      if (m.origin != method_origin::baseline)
+        for (const auto& r : m.rows)
+          if (r.completed && std::isfinite(r.error)) best_error = std::min(best_error, r.error);
+    for (double target : verdict_targets()) {
+      const auto r = cheapest(methods, target, timed, verdict_metric, unit,
+                              timed ? wp_candidates::timed_methods : wp_candidates::every_method);
+      const wp_pick *ours = nullptr, *peer = nullptr;
+      for (const auto& p : r.ranked) {
+        if (methods[p.method].origin == method_origin::ours && !ours) ours = &p;
+        if (methods[p.method].origin == method_origin::peer && !peer) peer = &p;
+      }
+      equal_error_verdict e;
+      e.problem = std::string(ps.problem->name());
+      e.unit = unit;
+      e.target = target;
+      e.ours = cost_of(methods, ours);
+      e.peer = cost_of(methods, peer);
+      e.ratio = ours && peer ? ours->cost / peer->cost : nan;
+      e.cost_kind = r.cost;
+      e.verdict = verdict_of(e.ours, e.peer, r.cost == "time_ns");
+      e.best_error = std::isfinite(best_error) ? best_error : nan;
+      v.equal_error.push_back(std::move(e));
+    }
+  }
+  for (const auto& fs : s.results.get<std::vector<frame_rate_study>>()) {
+    const problem_study* ps = find_problem(s, fs.problem);
+    std::vector<double> rates;
+    for (const auto& r : fs.runs)
+      if (std::find(rates.begin(), rates.end(), r.hz) == rates.end()) rates.push_back(r.hz);
+    for (double hz : rates) {
+      for (const auto& r : fs.runs) {
+        if (r.hz != hz || r.substeps != 1) continue;
+        const auto& m = r.row.metrics;
+        v.frame_rate.push_back({fs.problem, fs.unit, r.method, m.completed() ? "" : (m.diverged ? "diverged" : m.note),
+                                hz, m.completed(), m.completed() ? m.err_pos_max : nan});
+      }
+      for (double target : verdict_targets()) {
+        frame_answer a{fs.problem, fs.unit, "", hz, target, 0, nan, nan, nan};
+        for (const auto& r : fs.runs) {
+          if (r.hz != hz || !r.row.metrics.completed() || !(r.row.metrics.err_pos_max <= target)) continue;
+          const double c = cost_per_frame(ps, fs, r, timed);
+          if (!std::isfinite(c)) continue;
+          if (a.method.empty() || c < a.cost_per_frame ||
+              (c == a.cost_per_frame && r.row.metrics.err_pos_max < a.err_pos_max)) {
+            a.method = r.method;
+            a.substeps = r.substeps;
+            a.err_pos_max = r.row.metrics.err_pos_max;
+            a.cost_per_frame = c;
+            a.frame_share = timed ? c / (1e9 / hz) : nan;
+          }
+        }
+        v.frame_answers.push_back(std::move(a));
+      }
+    }
+  }
+  v.findings = findings_of(v, finding_inputs_of(s));
+  return v;
+}
+
+verdict_agreement compare_verdicts(const verdict_tables& base, const verdict_tables& next) {
+  verdict_agreement out;
+  const auto decided = [](const std::string& v) { return v == "ahead" || v == "behind"; };
+  for (const auto& b : base.equal_error)
+    for (const auto& n : next.equal_error) {
+      if (b.problem != n.problem || b.target != n.target) continue;
+      if (decided(b.verdict) && decided(n.verdict)) {
+        ++out.both_decided;
+        if (b.verdict == n.verdict)
+          ++out.agree;
+        else
+          out.flips.push_back(fmt::format("{} at {:g} {}: {} ({:.3g}x {}) -> {} ({:.3g}x {})", b.problem, b.target,
+                                          b.unit, b.verdict, b.ratio, b.ours.method, n.verdict, n.ratio,
+                                          n.ours.method));
+      } else if (decided(b.verdict) != decided(n.verdict) && b.verdict != "ours only" && n.verdict != "ours only" &&
+                 b.verdict != "peers only" && n.verdict != "peers only") {
+        ++out.decided_in_one;
+      }
+    }
+  return out;
+}
+
+}  // namespace stepbench

@@ -1,0 +1,29 @@
+#pragma once
+// The verdict (study/verdict.hpp says what it answers), judged from the study as it holds
+// it, and the findings generated from it and the other parts' results.
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "study/study.hpp"
+
+namespace stepbench {
+
+// The error metric the verdict ranks by.
+inline constexpr const char* verdict_metric = "err_pos_max";
+
+verdict_tables compute_verdict(const study& s);
+
+finding_inputs finding_inputs_of(const study& s);
+std::vector<std::string> findings_of(const verdict_tables& v, const finding_inputs& in);
+
+// The problem named `name` in the study's sweep, or nullptr.
+const problem_study* find_problem(const study& s, std::string_view name);
+
+// The cost of a frame of a frame-rate run: the benchmark's median ns per step of its
+// method on the problem (`ps`, nullptr: none) times the steps of a frame when `timed`,
+// else the force evaluations of a frame.
+double cost_per_frame(const problem_study* ps, const frame_rate_study& fs, const frame_rate_run& r, bool timed);
+
+verdict_agreement compare_verdicts(const verdict_tables& base, const verdict_tables& next);
+}  // namespace stepbench

@@ -1,0 +1,41 @@
+#include "render/scan.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "judge/scan.hpp"
+
+namespace stepbench {
+
+std::string format_scan_answer(const scan_answer& a) {
+  std::string out = fmt::format(
+      "{} over {}, within {:g} {} (err_pos_max){}:\n", a.problem, a.range, a.tol, a.unit,
+      a.points < a.grid_points
+          ? fmt::format(", on {} of the grid's {} points (a shard, or a partial merge)", a.points, a.grid_points)
+          : "");
+  for (const auto& c : a.choices) {
+    if (c.method.empty())
+      out += fmt::format("  {:g} Hz: no method of the scan stays within {:g} {} over the whole range\n", c.hz, a.tol,
+                         a.unit);
+    else
+      out += fmt::format(
+          "  {:g} Hz: {} with {} stays stable and within {:g} {} {} (worst {:.3g} {}, "
+          "{:.4g} force evaluations a frame at most)\n",
+          c.hz, c.method, c.substeps == 1 ? std::string("one step a frame") : fmt::format("{} substeps", c.substeps),
+          a.tol, a.unit,
+          a.untrusted == 0
+              ? std::string("everywhere")
+              : fmt::format("at the {} points with a truth (stable at all {})", a.points - a.untrusted, a.points),
+          c.worst_err, a.unit, c.max_force_evals_per_frame);
+  }
+  out += "At one step a frame:\n";
+  for (const auto& b : a.breaks) out += fmt::format("  {:g} Hz  {:<22} {}\n", b.hz, b.method, b.where);
+  if (a.untrusted > 0)
+    out += fmt::format(
+        "{} of {} points have no trusted truth: their runs are judged on stability alone, the tolerance on the other "
+        "{} (see the scan's points table)\n",
+        a.untrusted, a.points, a.points - a.untrusted);
+  return out;
+}
+
+}  // namespace stepbench

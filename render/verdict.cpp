@@ -1,0 +1,124 @@
+#include "render/verdict.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "core/contains.hpp"
+#include "judge/verdict.hpp"
+#include "render/table_render.hpp"
+#include "store/study_file.hpp"
+
+namespace stepbench {
+namespace {
+
+std::string hz_text(double hz) { return fmt::format("{:g} Hz", hz); }
+
+// "rk4 x4" for four substeps, "rk4" for one.
+std::string with_substeps(const std::string& method, int n) {
+  return n == 1 ? method : fmt::format("{} x{}", method, n);
+}
+
+std::string cost_text(const std::string& kind, double c) {
+  if (!std::isfinite(c)) return "-";
+  return kind == "time_ns" ? format_time_ns(c) : fmt::format("{:.3g} evals", c);
+}
+
+}  // namespace
+
+std::string format_verdict_text(const study& s) {
+  const verdict_tables* v = s.results.find<verdict_tables>();
+  return format_verdict_text(v ? *v : compute_verdict(s));
+}
+
+std::string format_verdict_text(const verdict_tables& v) {
+  std::string out;
+  const bool timed = v.cost_kind == "time_ns";
+  // The equal-error table: problems down, every other target across.
+  const std::vector<double> shown{1e-2, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12};
+  std::vector<std::string> problems;
+  for (const auto& e : v.equal_error)
+    if (!contains(problems, e.problem)) problems.push_back(e.problem);
+  {
+    std::vector<column> cols{{"problem"}};
+    for (double t : shown) cols.push_back({fmt::format("err <= {:g}", t)});
+    table tb{cols, {}};
+    for (const auto& p : problems) {
+      std::vector<std::string> row{p};
+      for (double t : shown) {
+        std::string cell = "-";
+        for (const auto& e : v.equal_error) {
+          if (e.problem != p || e.target != t) continue;
+          if (e.ours.found()) {
+            cell = e.ours.method;
+            if (std::isfinite(e.ratio))
+              cell += fmt::format(" {:.2g}x{}", e.ratio,
+                                  e.verdict == "ahead"     ? "+"
+                                  : e.verdict == "behind"  ? "-"
+                                  : e.verdict == "bounded" ? "?"
+                                                           : "~");
+          } else if (e.peer.found()) {
+            cell = "(" + e.peer.method + ")";
+          }
+        }
+        row.push_back(cell);
+      }
+      tb.add(row);
+    }
+    out += fmt::format(
+        "Fastest of ours at equal error (err_pos_max in the problem's unit, m or rad), and its {} over the fastest "
+        "library peer's: + ahead, - behind, ~ within the {}, ? undecided (the cheaper side's cost only bounded: "
+        "its ladder does not bracket the target); (peer) when none of ours reaches it.\n",
+        timed ? "time" : "force evaluations",
+        timed ? "timing noise (the larger of 15 %, 25 % from a single repetition, and 3x the repetitions' spread)"
+              : "interpolation's rounding");
+    out += render_text(tb);
+  }
+  // The frame-rate table at 60 Hz.
+  {
+    const std::vector<double> targets{1e-2, 1e-4, 1e-6};
+    std::vector<column> cols{{"problem"}, {"stable at 1 step"}};
+    for (double t : targets) cols.push_back({fmt::format("cheapest for {:g}", t)});
+    table tb{cols, {}};
+    for (const auto& p : problems) {
+      int stable = 0, total = 0;
+      for (const auto& f : v.frame_rate)
+        if (f.problem == p && f.hz == 60.0) {
+          ++total;
+          stable += f.stable;
+        }
+      if (total == 0) continue;
+      std::vector<std::string> row{p, fmt::format("{} of {}", stable, total)};
+      for (double t : targets) {
+        std::string cell = "none <= x64";
+        for (const auto& a : v.frame_answers)
+          if (a.problem == p && a.hz == 60.0 && a.target == t && !a.method.empty())
+            cell = with_substeps(a.method, a.substeps) + " " + cost_text(v.cost_kind, a.cost_per_frame);
+        row.push_back(cell);
+      }
+      tb.add(row);
+    }
+    out += fmt::format(
+        "\nAt {} (a frame of 16.7 ms): our fixed-step methods stable at one step a frame, and the cheapest method "
+        "x substeps a frame whose err_pos_max meets each target, with its {} per frame "
+        "(stepbench advise --problem P --hz HZ --tol X for other rates and targets).\n",
+        hz_text(60), timed ? "measured time" : "force evaluations");
+    out += render_text(tb);
+  }
+  out += "\nFindings:\n";
+  for (const auto& f : v.findings) out += "  - " + f + "\n";
+  return out;
+}
+
+std::string format_verdict_agreement(const verdict_agreement& a) {
+  std::string out = fmt::format(
+      "Equal-error verdicts (fastest of ours against the fastest peer): {} of {} problem-and-target pairs decided "
+      "(ahead or behind beyond the timing noise) in both files agree; {} decided in one file are within the noise in "
+      "the "
+      "other.\n",
+      a.agree, a.both_decided, a.decided_in_one);
+  for (const auto& f : a.flips) out += "  flips: " + f + "\n";
+  return out;
+}
+
+}  // namespace stepbench

@@ -1,0 +1,17 @@
+#pragma once
+// The frame-rate study (study/verdict.hpp says what it answers): our fixed-step methods at
+// whole frames of each rate, n substeps a frame, measured at the frame ends.
+#include <vector>
+
+#include "study/study.hpp"
+
+namespace stepbench {
+
+// Runs the frame-rate study on every problem of `s` (their truths are rebuilt at the frame
+// ends of the fastest rate). A problem whose horizon holds no whole frame is left out.
+// The truth at every stride-th sample of `t` (the frame ends of a slower rate).
+truth_table every_nth(const truth_table& t, std::size_t stride);
+
+std::vector<frame_rate_study> run_frame_rates(const study& s, const frame_rate_options& opts);
+
+}  // namespace stepbench

@@ -1,0 +1,37 @@
+#pragma once
+// A scan's runs (study/scan.hpp says what it answers): its axes parsed and checked, its
+// grid, its shards and their merge.
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "study/scan.hpp"
+
+namespace stepbench {
+
+// Parses `P.name=lo:hi:count[:log]` for problem P; throws std::invalid_argument with a
+// one-line reason (another problem, an unknown parameter, a bound outside the parameter's
+// declared range, count < 1 or above 10^5, log with a bound <= 0).
+scan_axis parse_scan_axis(std::string_view text, const std::string& problem);
+
+// Checks the options; throws std::invalid_argument with a one-line reason.
+void validate(const scan_options& opts);
+
+// The scans of the full study: stiff_spring over k_s 1e1 .. 1e7 N/m (25 points, log), the
+// pendulum over its release angle 1 .. 179.9 deg (12 points) and spring_chain over 8 .. 4096
+// masses x k_s 1e2 .. 1e5 N/m (4 x 4, log), each at 30 .. 240 Hz with 1 .. 64 substeps;
+// `quick`: the stiff spring's 13 points at 60 Hz only (the CI study).
+std::vector<scan_options> default_scans(bool quick = false);
+
+scan_result run_scan(const scan_options& opts);
+
+// The grid points in order: the first axis varies slowest.
+std::vector<std::vector<double>> scan_grid(const std::vector<scan_axis>& axes);
+
+// The grid points of shard k of n (0-based), in grid order: each point's size is counted
+// as its problem's coordinates (the force work of a step grows with them), and the points,
+// largest first (ties in grid order), go each to the shard with the least so far (ties to
+// the lowest shard). Deterministic: every machine computes the same split.
+std::vector<std::size_t> scan_shard(const scan_options& opts, int k, int n);
+
+}  // namespace stepbench

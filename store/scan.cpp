@@ -1,0 +1,415 @@
+#include "store/scan.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <filesystem>
+
+#include "store/h5.hpp"
+#include "store/schema.hpp"
+
+namespace stepbench {
+namespace {
+
+// The names of a comma-separated attribute ("" : none; the names hold no commas).
+std::vector<std::string> names_of(const std::string& text) {
+  std::vector<std::string> out;
+  if (text.empty()) return out;
+  for (std::size_t start = 0; start <= text.size();) {
+    const auto comma = std::min(text.find(',', start), text.size());
+    out.push_back(text.substr(start, comma - start));
+    start = comma + 1;
+  }
+  return out;
+}
+
+}  // namespace
+
+scan_result read_scan(const std::string& path, const std::string& name) {
+  H5::Exception::dontPrint();  // errors become one line, not HDF5's stack
+  scan_result s;
+  try {
+    if (!std::filesystem::exists(path)) throw std::runtime_error("no such file");
+    if (!H5::H5File::isHdf5(path)) throw std::runtime_error("not an HDF5 file");
+    const H5::H5File file(path, H5F_ACC_RDONLY);
+    if (!h5::is_group(file, "scan")) throw std::runtime_error("it holds no scan (/scan is absent)");
+    const H5::Group all = file.openGroup("scan");
+    const auto names = h5::children(all);
+    std::string which = name;
+    if (which.empty()) {
+      if (names.size() != 1)
+        throw std::invalid_argument(
+            fmt::format("'{}' holds {} scans; name one with --name ({})", path, names.size(), fmt::join(names, ", ")));
+      which = names.front();
+    }
+    if (!h5::is_group(all, which))
+      throw std::invalid_argument(
+          fmt::format("'{}' has no scan '{}' (it has: {})", path, which, fmt::join(names, ", ")));
+    const H5::Group g = all.openGroup(which);
+    auto& o = s.options;
+    o.name = which;
+    o.problem = h5::string_attr(g, "problem");
+    s.unit = h5::string_attr(g, "unit");
+    o.tol = h5::double_attr(g, "tol");
+    const auto lo = h5::double_array_attr(g, "axis_lo"), hi = h5::double_array_attr(g, "axis_hi");
+    const auto count = h5::int_array_attr(g, "axis_count"), log = h5::int_array_attr(g, "axis_log");
+    const std::vector<std::string> axis_names = names_of(h5::string_attr(g, "axes"));
+    if (axis_names.size() != lo.size() || lo.size() != hi.size() || hi.size() != count.size() ||
+        count.size() != log.size())
+      throw std::runtime_error(fmt::format("scan '{}': its axis attributes differ in length", which));
+    for (std::size_t k = 0; k < axis_names.size(); ++k)
+      o.axes.push_back({axis_names[k], lo[k], hi[k], static_cast<int>(count[k]), log[k] != 0, false});
+    o.hz = h5::double_array_attr(g, "hz");
+    o.substeps.clear();  // the file's counts replace the defaults, not extend them
+    for (long n : h5::int_array_attr(g, "substeps")) o.substeps.push_back(static_cast<int>(n));
+    o.methods = names_of(h5::string_attr(g, "methods"));
+    const auto fixed_names = names_of(h5::string_attr(g, "fixed_params"));
+    const auto fixed_values = h5::double_array_attr(g, "fixed_values");
+    if (fixed_names.size() != fixed_values.size())
+      throw std::runtime_error(fmt::format("scan '{}': {} fixed_params but {} fixed_values", which, fixed_names.size(),
+                                           fixed_values.size()));
+    for (std::size_t k = 0; k < fixed_names.size(); ++k) o.fixed[fixed_names[k]] = fixed_values[k];
+    o.ref_tol.rtol = h5::double_attr(g, "reference_rtol");
+    o.ref_tol.atol = h5::double_attr(g, "reference_atol");
+    o.limits.work_budget = h5::double_attr(g, "work_budget");
+    o.reference_budget = h5::double_attr(g, "reference_budget");
+    s.wall_seconds = h5::double_attr(g, "wall_seconds");
+    const H5::Group values = g.openGroup("values");
+    std::vector<std::vector<double>> columns;
+    for (const auto& a : o.axes) columns.push_back(h5::read_vector(values.openDataSet(a.param)));
+    s.grid_points = static_cast<std::size_t>(h5::long_attr(g, "grid_points"));
+    double product = 1.0;  // in doubles: a damaged count cannot overflow it
+    for (const auto& a : o.axes) product *= a.count;
+    if (static_cast<double>(s.grid_points) != product)
+      throw std::runtime_error(fmt::format("scan '{}': grid_points {} is not the product of its axes' counts, {:.0f}",
+                                           which, s.grid_points, product));
+    o.shard_index = static_cast<int>(h5::long_attr(g, "shard_index"));
+    o.shard_count = static_cast<int>(h5::long_attr(g, "shard_count"));
+    const h5::table_data points = h5::read_table(g.openDataSet("points"));
+    const auto& index = points.ints("point");
+    std::map<std::int64_t, std::size_t> local_of;  // grid index -> row
+    const auto& trusted = points.ints("trusted");
+    const auto& source = points.strings("truth_source");
+    const auto& note = points.strings("note");
+    const auto horizon = points.doubles("horizon"), scale = points.doubles("pos_scale");
+    for (std::size_t i = 0; i < points.rows(); ++i) {
+      scan_point p;
+      for (const auto& c : columns) {
+        if (c.size() != points.rows())
+          throw std::runtime_error(fmt::format("scan '{}': values/ and points differ in length", which));
+        p.values.push_back(c[i]);
+      }
+      if (index[i] < 0 || static_cast<std::size_t>(index[i]) >= s.grid_points || local_of.count(index[i]))
+        throw std::runtime_error(
+            fmt::format("scan '{}': point {} is outside its grid of {} or repeated", which, index[i], s.grid_points));
+      local_of[index[i]] = i;
+      p.index = static_cast<std::size_t>(index[i]);
+      p.trusted = trusted[i] != 0;
+      p.truth_source = source[i];
+      p.note = note[i];
+      p.horizon = horizon[i];
+      p.pos_scale = scale[i];
+      s.points.push_back(std::move(p));
+    }
+    const h5::table_data runs = h5::read_table(g.openDataSet("runs"));
+    const auto& point = runs.ints("point");
+    const auto hz = runs.doubles("hz"), dt = runs.doubles("dt"), err = runs.doubles("err_pos_max"),
+               evals = runs.doubles("force_evals"), newton = runs.doubles("newton_iterations");
+    const auto& method = runs.strings("method");
+    const auto &substeps = runs.ints("substeps"), &steps = runs.ints("steps");
+    const auto &diverged = runs.ints("diverged"), &failed = runs.ints("failed"), &skipped = runs.ints("skipped");
+    const auto& run_note = runs.strings("note");
+    for (std::size_t i = 0; i < runs.rows(); ++i) {
+      const auto at = local_of.find(point[i]);
+      if (at == local_of.end())
+        throw std::runtime_error(
+            fmt::format("scan '{}': run {} names point {}, which its points table lacks", which, i, point[i]));
+      scan_run r;
+      r.point = at->second;
+      r.hz = hz[i];
+      r.method = method[i];
+      r.substeps = static_cast<int>(substeps[i]);
+      r.row.param = dt[i];
+      r.row.steps = steps[i];
+      r.row.work.force_evals = static_cast<long>(evals[i]);
+      r.row.work.newton_iterations = static_cast<long>(newton[i]);
+      r.row.metrics.err_pos_max = err[i];
+      r.row.metrics.diverged = diverged[i] != 0;
+      r.row.metrics.failed = failed[i] != 0;
+      r.row.metrics.skipped = skipped[i] != 0;
+      r.row.metrics.note = run_note[i];
+      s.runs.push_back(std::move(r));
+    }
+    compute_best(s);
+    s.source = path;
+  } catch (const std::invalid_argument&) {
+    throw;
+  } catch (const H5::Exception& e) {
+    throw std::runtime_error(fmt::format("cannot read the scan in '{}': {}", path, e.getDetailMsg()));
+  } catch (const std::exception& e) {
+    throw std::runtime_error(fmt::format("cannot read the scan in '{}': {}", path, e.what()));
+  }
+  return s;
+}
+
+std::vector<scan_result> read_scans(const std::string& path) {
+  std::vector<std::string> names;
+  try {
+    if (!std::filesystem::exists(path)) throw std::runtime_error("no such file");
+    if (!H5::H5File::isHdf5(path)) throw std::runtime_error("not an HDF5 file");
+    const H5::H5File file(path, H5F_ACC_RDONLY);
+    if (!h5::is_group(file, "scan")) throw std::runtime_error("it holds no scan (/scan is absent)");
+    names = h5::children(file.openGroup("scan"));
+  } catch (const H5::Exception& e) {
+    throw std::runtime_error(fmt::format("cannot read the scans in '{}': {}", path, e.getDetailMsg()));
+  } catch (const std::exception& e) {
+    throw std::runtime_error(fmt::format("cannot read the scans in '{}': {}", path, e.what()));
+  }
+  std::vector<scan_result> out;
+  for (const auto& name : names) out.push_back(read_scan(path, name));
+  return out;
+}
+
+std::string file_build(const std::string& path) {
+  H5::Exception::dontPrint();
+  try {
+    if (!std::filesystem::exists(path)) throw std::runtime_error("no such file");
+    if (!H5::H5File::isHdf5(path)) throw std::runtime_error("not an HDF5 file");
+    const H5::H5File file(path, H5F_ACC_RDONLY);
+    // The compiler and the libraries too: another GSL or SUNDIALS is another truth.
+    return fmt::format("format_version {}, commit {}, {} build, flags {}, {}, {}",
+                       h5::long_attr(file, "format_version"), h5::string_attr(file, "git_commit"),
+                       h5::string_attr(file, "build_type"), h5::string_attr(file, "build_flags"),
+                       h5::string_attr(file, "compiler"), h5::string_attr(file, "dependencies"));
+  } catch (const H5::Exception& e) {
+    throw std::runtime_error(fmt::format("cannot read the build of '{}': {}", path, e.getDetailMsg()));
+  } catch (const std::exception& e) {
+    throw std::runtime_error(fmt::format("cannot read the build of '{}': {}", path, e.what()));
+  }
+}
+
+void write_scans(H5::Group& root, const std::vector<scan_result>& scans) {
+  using h5::attr;
+  if (scans.empty()) return;
+  H5::Group all = root.createGroup("scan");
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (const auto& sc : scans) {
+    const auto& o = sc.options;
+    H5::Group g = all.createGroup(o.name.empty() ? o.problem : o.name);
+    attr(g, "problem", o.problem);
+    attr(g, "unit", sc.unit);
+    attr(g, "tol", o.tol);
+    std::vector<std::string> axis_names;
+    std::vector<double> lo, hi;
+    std::vector<int> count, log;
+    for (const auto& a : o.axes) {
+      axis_names.push_back(a.param);
+      lo.push_back(a.lo);
+      hi.push_back(a.hi);
+      count.push_back(a.count);
+      log.push_back(a.log ? 1 : 0);
+    }
+    attr(g, "axes", fmt::format("{}", fmt::join(axis_names, ",")));  // parameter names have no commas
+    attr(g, "axis_lo", lo);
+    attr(g, "axis_hi", hi);
+    attr(g, "axis_count", count);
+    attr(g, "axis_log", log);
+    attr(g, "hz", o.hz);
+    attr(g, "substeps", std::vector<int>(o.substeps.begin(), o.substeps.end()));
+    attr(g, "methods", fmt::format("{}", fmt::join(o.methods, ",")));  // the methods run; names have no commas
+    std::vector<std::string> fixed_names;
+    std::vector<double> fixed_values;
+    for (const auto& [name, value] : o.fixed) {
+      fixed_names.push_back(name);
+      fixed_values.push_back(value);
+    }
+    attr(g, "fixed_params", fmt::format("{}", fmt::join(fixed_names, ",")));
+    attr(g, "fixed_values", fixed_values);
+    attr(g, "reference_rtol", o.ref_tol.rtol);
+    attr(g, "reference_atol", o.ref_tol.atol);
+    attr(g, "work_budget", o.limits.work_budget);
+    attr(g, "reference_budget", o.reference_budget);
+    attr(g, "range_answer", sc.range_answer);
+    attr(g, "wall_seconds", sc.wall_seconds);
+    attr(g, "grid_points", static_cast<long>(sc.grid_points));
+    attr(g, "shard_index", o.shard_index);
+    attr(g, "shard_count", o.shard_count);
+    // The grid: one 1-D dataset per axis under values/, a value per point.
+    H5::Group values = g.createGroup("values");
+    for (std::size_t k = 0; k < o.axes.size(); ++k) {
+      std::vector<double> column;
+      for (const auto& p : sc.points) column.push_back(p.values[k]);
+      h5::dataset(values, o.axes[k].param, column);
+    }
+    {
+      std::vector<std::int64_t> point;
+      std::vector<std::int8_t> trusted;
+      std::vector<std::string> source, note;
+      std::vector<double> horizon, scale;
+      for (std::size_t i = 0; i < sc.points.size(); ++i) {
+        const auto& p = sc.points[i];
+        point.push_back(static_cast<std::int64_t>(p.index));
+        trusted.push_back(p.trusted ? 1 : 0);
+        source.push_back(p.truth_source);
+        horizon.push_back(p.horizon);
+        scale.push_back(p.pos_scale);
+        note.push_back(p.note);
+      }
+      h5::table t;
+      t.add("point", point);
+      t.add("trusted", trusted);
+      t.add("truth_source", source);
+      t.add("horizon", horizon);
+      t.add("pos_scale", scale);
+      t.add("note", note);
+      t.write(g, "points", schema::find("scan_points"));
+    }
+    {
+      std::vector<std::int64_t> point, substeps, steps;
+      std::vector<double> hz, dt, err, evals, newton;
+      std::vector<std::int8_t> completed, diverged, failed, skipped;
+      std::vector<std::string> method, note;
+      for (const auto& r : sc.runs) {
+        const auto& m = r.row.metrics;
+        point.push_back(static_cast<std::int64_t>(sc.points[r.point].index));
+        hz.push_back(r.hz);
+        method.push_back(r.method);
+        substeps.push_back(r.substeps);
+        dt.push_back(r.row.param);
+        completed.push_back(m.completed() ? 1 : 0);
+        diverged.push_back(m.diverged ? 1 : 0);
+        failed.push_back(m.failed ? 1 : 0);
+        skipped.push_back(m.skipped ? 1 : 0);
+        err.push_back(m.completed() ? m.err_pos_max : nan);
+        steps.push_back(r.row.steps);
+        evals.push_back(static_cast<double>(r.row.work.force_evals));
+        newton.push_back(static_cast<double>(r.row.work.newton_iterations));
+        note.push_back(m.note);
+      }
+      h5::table t;
+      t.add("point", point);
+      t.add("hz", hz);
+      t.add("method", method);
+      t.add("substeps", substeps);
+      t.add("dt", dt);
+      t.add("completed", completed);
+      t.add("diverged", diverged);
+      t.add("failed", failed);
+      t.add("skipped", skipped);
+      t.add("err_pos_max", err);
+      t.add("steps", steps);
+      t.add("force_evals", evals);
+      t.add("newton_iterations", newton);
+      t.add("note", note);
+      t.write(g, "runs", schema::find("scan_runs"));
+    }
+    {
+      std::vector<std::int64_t> point, substeps;
+      std::vector<double> hz, err, cost;
+      std::vector<std::string> method;
+      for (const auto& b : sc.best) {
+        point.push_back(static_cast<std::int64_t>(sc.points[b.point].index));
+        hz.push_back(b.hz);
+        method.push_back(b.method);
+        substeps.push_back(b.substeps);
+        err.push_back(b.err_pos_max);
+        cost.push_back(b.force_evals_per_frame);
+      }
+      h5::table t;
+      t.add("point", point);
+      t.add("hz", hz);
+      t.add("method", method);
+      t.add("substeps", substeps);
+      t.add("err_pos_max", err);
+      t.add("force_evals_per_frame", cost);
+      t.write(g, "best", schema::find("scan_best"));
+    }
+  }
+}
+
+scan_result merge_scans(const std::vector<scan_result>& shards, bool partial, std::vector<std::size_t>& missing) {
+  if (shards.empty()) throw std::invalid_argument("merge: no shard");
+  const auto& first = shards.front();
+  // What makes two shards one scan, each as text: doubles in fmt's shortest form that
+  // reads back exactly, so equal text is equal values, and the refusal can show both.
+  const auto described = [](const scan_result& s) {
+    const auto& o = s.options;
+    std::vector<std::string> axes, fixed;
+    for (const auto& a : o.axes)
+      axes.push_back(fmt::format("{}={}:{}:{}{}", a.param, a.lo, a.hi, a.count, a.log ? ":log" : ""));
+    for (const auto& [name, value] : o.fixed) fixed.push_back(fmt::format("{}={}", name, value));
+    return std::vector<std::pair<std::string_view, std::string>>{
+        {"problem", o.problem},
+        {"axes", fmt::format("{}", fmt::join(axes, " x "))},
+        {"frame rates", fmt::format("{} Hz", fmt::join(o.hz, ","))},
+        {"substeps", fmt::format("{}", fmt::join(o.substeps, ","))},
+        {"methods", fmt::format("{}", fmt::join(o.methods, ","))},
+        {"tolerance", fmt::format("{}", o.tol)},
+        {"fixed parameters (--set)", fixed.empty() ? "none" : fmt::format("{}", fmt::join(fixed, ","))},
+        {"reference tolerances", fmt::format("rtol {} atol {}", o.ref_tol.rtol, o.ref_tol.atol)},
+        {"reference budget", fmt::format("{}", o.reference_budget)},
+        {"work budget", fmt::format("{}", o.limits.work_budget)},
+        {"grid", fmt::format("{} points", s.grid_points)}};
+  };
+  const auto label = [](const scan_result& s, std::size_t k) {
+    return s.source.empty() ? fmt::format("shard {}", k + 1) : fmt::format("'{}'", s.source);
+  };
+  const auto want = described(first);
+  for (std::size_t k = 1; k < shards.size(); ++k) {
+    const auto have = described(shards[k]);
+    for (std::size_t i = 0; i < want.size(); ++i)
+      if (have[i].second != want[i].second)
+        throw std::invalid_argument(fmt::format("merge: scan '{}': the shards differ in their {}: {} has {}, {} has {}",
+                                                first.options.name, want[i].first, label(first, 0), want[i].second,
+                                                label(shards[k], k), have[i].second));
+  }
+  // Every point once: the first shard holding it, refusing a second.
+  std::vector<std::pair<const scan_result*, std::size_t>> owner(first.grid_points, {nullptr, 0});
+  for (const auto& s : shards)
+    for (std::size_t i = 0; i < s.points.size(); ++i) {
+      const std::size_t g = s.points[i].index;
+      if (g >= owner.size())
+        throw std::invalid_argument(
+            fmt::format("merge: scan '{}' has point {} beyond its grid of {}", first.options.name, g, owner.size()));
+      if (owner[g].first)
+        throw std::invalid_argument(fmt::format("merge: scan '{}': grid point {} is in two shards (overlapping shards)",
+                                                first.options.name, g));
+      owner[g] = {&s, i};
+    }
+  missing.clear();
+  for (std::size_t g = 0; g < owner.size(); ++g)
+    if (!owner[g].first) missing.push_back(g);
+  if (!missing.empty() && !partial)
+    throw std::invalid_argument(
+        fmt::format("merge: scan '{}': {} of {} grid points are in no shard (first: {}); "
+                    "--partial merges what there is",
+                    first.options.name, missing.size(), owner.size(), missing.front()));
+  // Each shard's runs by its local point, to carry them over in grid order.
+  scan_result out;
+  out.options = first.options;
+  out.options.shard_index = 0;
+  out.options.shard_count = 1;
+  out.unit = first.unit;
+  out.grid_points = first.grid_points;
+  std::map<const scan_result*, std::vector<std::vector<const scan_run*>>> runs_of;
+  for (const auto& s : shards) {
+    auto& by_point = runs_of[&s];
+    by_point.resize(s.points.size());
+    for (const auto& r : s.runs) by_point.at(r.point).push_back(&r);
+  }
+  for (std::size_t g = 0; g < owner.size(); ++g) {
+    const auto [s, i] = owner[g];
+    if (!s) continue;
+    const std::size_t local = out.points.size();
+    out.points.push_back(s->points[i]);
+    for (const scan_run* r : runs_of[s][i]) {
+      out.runs.push_back(*r);
+      out.runs.back().point = local;
+    }
+  }
+  for (const auto& s : shards) out.wall_seconds += s.wall_seconds;
+  compute_best(out);
+  return out;
+}
+
+}  // namespace stepbench

@@ -1,0 +1,425 @@
+#include "store/study_file.hpp"
+
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <stdexcept>
+
+#include "build_info.hpp"
+#include "judge/rows.hpp"
+#include "run/machine.hpp"
+#include "run/sweep.hpp"
+#include "store/h5.hpp"
+#include "store/temp_file_guard.hpp"
+#include "study/energy.hpp"
+#include "study/loop.hpp"
+#include "study/stability.hpp"
+#include "study/substeps.hpp"
+#include "study/verdict.hpp"
+
+namespace stepbench {
+namespace {
+
+using h5::attr;
+
+std::string metric_unit(const std::string& metric, std::string_view unit) {
+  return metric == "err_vel_final" ? std::string(unit) + "/s" : std::string(unit);
+}
+
+void write_reference(H5::Group& parent, const reference_check& ref, const std::string& truth_source, int dim) {
+  H5::Group g = parent.createGroup(ref.source);
+  attr(g, "status", ref.status);
+  attr(g, "reason", ref.reason);
+  attr(g, "is_truth", static_cast<int>(ref.source == truth_source));
+  const auto& sol = ref.solution;
+  if (ref.status != "failed" && !sol.y.empty()) {
+    const auto& y = sol.y.back();
+    h5::dataset(g, "position", std::vector<double>(y.begin(), y.begin() + dim));
+    h5::dataset(g, "velocity", std::vector<double>(y.begin() + dim, y.end()));
+    h5::dataset(g, "state", sol.y);  // [x; v] at the problem's sample_times
+  }
+  attr(g, "steps", sol.stats.steps);
+  attr(g, "failed_steps", sol.stats.failed_steps);
+  attr(g, "rhs_evals", sol.stats.rhs_evals);
+  attr(g, "lin_rhs_evals", sol.stats.lin_rhs_evals);
+  attr(g, "jac_evals", sol.stats.jac_evals);
+  attr(g, "rhs_evals_counted", sol.stats.rhs_evals_counted);
+  attr(g, "rtol", sol.stats.rtol);
+  attr(g, "atol", sol.stats.atol);
+  attr(g, "wall_seconds", sol.stats.wall_seconds);
+  attr(g, "compared_with", ref.compared_with);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  attr(g, "err_pos_rel", ref.compared_with.empty() ? nan : ref.vs.pos_rel);
+  attr(g, "err_vel_rel", ref.compared_with.empty() ? nan : ref.vs.vel_rel);
+}
+
+void write_method(H5::Group& parent, const method_study& ms, bool timed) {
+  H5::Group g = parent.createGroup(ms.info.name);
+  const auto& info = ms.info;
+  attr(g, "origin", std::string(to_string(info.origin)));
+  attr(g, "kind", std::string(to_string(info.kind)));
+  attr(g, "param_kind", std::string(param_name(info.kind)));
+  attr(g, "declared_order", info.declared_order);
+  attr(g, "description", info.description);
+  attr(g, "library", info.library);
+  attr(g, "symplectic", static_cast<int>(info.traits.symplectic));
+  attr(g, "reuses_last_force", static_cast<int>(info.traits.reuses_last_force));
+  attr(g, "needs_jacobian", static_cast<int>(info.traits.needs_jacobian));
+  attr(g, "error_estimate", static_cast<int>(info.traits.error_estimate));
+  attr(g, "dense_output", static_cast<int>(info.traits.dense_output));
+  // The fit: observed order against dt for fixed-step methods; for adaptive ones the
+  // slope of the error against the tolerance (1: the error follows the tolerance).
+  attr(g, "fit_status", to_string(ms.fit.state));
+  attr(g, "fit_metric", "err_pos_max");
+  attr(g, "fit_param", std::string(param_name(info.kind)));
+  attr(g, "fit_slope", ms.fit.order);
+  attr(g, "observed_order",
+       info.kind == method_kind::fixed_step ? ms.fit.order : std::numeric_limits<double>::quiet_NaN());
+  attr(g, "fit_levels", ms.fit.levels);
+  attr(g, "fit_residual_log10",
+       ms.fit.state == fit_result::status::fitted ? ms.fit.residual : std::numeric_limits<double>::quiet_NaN());
+  attr(g, "fit_note", ms.fit.note);
+  attr(g, "exact_for_problem", static_cast<int>(ms.fit.state == fit_result::status::exact));
+  attr(g, "declared_order_holds", ms.declared_order_holds);
+  attr(g, "ladder_end", ms.ladder_end);
+
+  runs_table(ms.rows, timed).write(g, "runs", schema::find("runs"));
+}
+
+// The equal-error table: for each metric and target, every method that reaches it with
+// its cost at equal error interpolated on its measured curve, ranked (core/work_precision.hpp).
+void write_equal_error(H5::Group& g, const problem_study& ps, bool timed) {
+  std::vector<std::string> metric, method, origin, cost_kind, kind;
+  std::vector<double> target, param, error, cost, cost_lo, cost_hi, time_ns, force_evals;
+  std::vector<std::int64_t> rank;
+  std::vector<std::int8_t> interpolated, is_answer;
+  for (const char* m : {"err_pos_max", "err_pos_final"}) {
+    const auto methods = work_precision_input(ps, m);
+    for (double tgt : equal_error_targets()) {
+      const auto r = cheapest(methods, tgt, timed, m, metric_unit(m, ps.problem->position_unit()));
+      const auto answer = r.answer(methods);
+      for (std::size_t k = 0; k < r.ranked.size(); ++k) {
+        const auto& p = r.ranked[k];
+        const auto& wm = methods[p.method];
+        metric.emplace_back(m);
+        target.push_back(tgt);
+        rank.push_back(static_cast<std::int64_t>(k + 1));
+        method.push_back(wm.name);
+        origin.emplace_back(to_string(wm.origin));
+        kind.emplace_back(to_string(wm.kind));
+        param.push_back(p.param);
+        error.push_back(p.error);
+        cost_kind.push_back(r.cost);
+        cost.push_back(p.cost);
+        cost_lo.push_back(p.cost_lo);
+        cost_hi.push_back(p.cost_hi);
+        time_ns.push_back(p.time_ns);
+        force_evals.push_back(p.force_evals);
+        interpolated.push_back(static_cast<std::int8_t>(p.interpolated));
+        is_answer.push_back(static_cast<std::int8_t>(answer && answer->method == p.method));
+      }
+    }
+  }
+  h5::table t;
+  t.add("metric", metric);
+  t.add("target", target);
+  t.add("rank", rank);
+  t.add("method", method);
+  t.add("origin", origin);
+  t.add("kind", kind);
+  t.add("param", param);
+  t.add("error", error);
+  t.add("cost_kind", cost_kind);
+  t.add("cost", cost);
+  t.add("cost_lo", cost_lo);
+  t.add("cost_hi", cost_hi);
+  t.add("time_ns", time_ns);
+  t.add("force_evals", force_evals);
+  t.add("interpolated", interpolated);
+  t.add("is_answer", is_answer);
+  t.write(g, "equal_error", schema::find("equal_error"));
+}
+
+void write_front(H5::Group& g, const problem_study& ps, bool by_time, bool timed) {
+  const auto methods = work_precision_input(ps, "err_pos_max");
+  std::vector<std::string> method;
+  std::vector<double> param, cost, error;
+  for (const auto& p : pareto_front(methods, by_time, timed)) {
+    method.push_back(methods[p.method].name);
+    param.push_back(methods[p.method].rows[p.row].param);
+    cost.push_back(p.cost);
+    error.push_back(p.error);
+  }
+  h5::table t;
+  t.add("method", method);
+  t.add("param", param);
+  t.add("cost", cost);
+  t.add("err_pos_max", error);
+  t.write(g, by_time ? "front_time" : "front_force_evals", schema::find("front"));
+}
+
+void write_problem(H5::Group& parent, const problem_study& ps, const std::optional<timing_settings>& timing) {
+  const bool timed = timing.has_value();
+  const auto& p = *ps.problem;
+  H5::Group g = parent.createGroup(std::string(p.name()));
+  // The machine that ran (and timed) this problem: the root's in a study run on one
+  // machine; in a merge of shards, each problem keeps its shard's (stepbench merge).
+  write_machine(g, timing);
+  parameters_table(p.params()).write(g, "parameters", schema::find("parameters"));
+  attr(g, "horizon", ps.horizon);
+  attr(g, "dim", p.dim());
+  attr(g, "position_unit", std::string(p.position_unit()));
+  attr(g, "description", std::string(p.description()));
+  attr(g, "has_closed_form", static_cast<int>(p.has_closed_form()));
+  attr(g, "has_energy", static_cast<int>(p.has_energy()));
+  attr(g, "has_jacobian", static_cast<int>(p.has_jacobian()));
+  attr(g, "has_angular_momentum", static_cast<int>(p.has_angular_momentum()));
+  attr(g, "angmom_scale", ps.truth.angmom_scale);
+  // Contacts: the mode, and the exact contacts up to the horizon (-1 and empty without).
+  attr(g, "contact_mode", std::string(p.contact_mode()));
+  attr(g, "contacts_exact", ps.truth.contact_count);
+  if (!ps.truth.contact_times.empty()) h5::dataset(g, "contact_times", ps.truth.contact_times);
+  // Every method that runs on the problem, so a reader can tell a method that does not
+  // apply (the baseline off its two problems) from one missing from a damaged file.
+  std::string applies;
+  for (const auto& m : p.methods()) applies += (applies.empty() ? "" : ",") + m.name;
+  attr(g, "methods", applies);
+  attr(g, "truth_source", ps.truth.source);
+  attr(g, "truth_trusted", static_cast<int>(ps.truth.trusted));
+  attr(g, "truth_note", ps.truth.note);
+  attr(g, "agreement_limit", ps.truth.agreement_limit);
+  attr(g, "pos_scale", ps.truth.pos_scale);
+  attr(g, "vel_scale", ps.truth.vel_scale);
+  attr(g, "energy_scale", ps.truth.energy_scale);
+  h5::dataset(g, "sample_times", ps.truth.times);
+  h5::dataset(g, "truth_state", ps.truth.y);
+  H5::Group refs = g.createGroup("reference");
+  for (const auto& ref : ps.truth.references) write_reference(refs, ref, ps.truth.source, p.dim());
+  H5::Group methods = g.createGroup("methods");
+  for (const auto& ms : ps.methods) write_method(methods, ms, timed);
+  write_equal_error(g, ps, timed);
+  write_front(g, ps, false, timed);
+  if (timed) write_front(g, ps, true, timed);
+}
+
+}  // namespace
+
+void write_problems(H5::Group& root, const study& s) {
+  H5::Group problems = root.createGroup("problems");
+  for (const auto& ps : s.problems) write_problem(problems, ps, s.timed);
+}
+
+void write_machine(H5::H5Object& obj, const std::optional<timing_settings>& timing) {
+  attr(obj, "cpu", cpu_model());
+  attr(obj, "cores", core_count());
+  if (timing) {
+    attr(obj, "num_cpus", timing->num_cpus);
+    attr(obj, "mhz_per_cpu", timing->mhz_per_cpu);
+    attr(obj, "cpu_scaling_enabled", timing->cpu_scaling_enabled);
+  }
+}
+
+namespace {
+
+std::string temp_path_for(const std::string& path) { return fmt::format("{}.tmp.{}", path, ::getpid()); }
+
+// Writes `bytes` to a new file at `path`; 0, or the errno of the call that failed
+// (ENOSPC, EDQUOT, EFBIG under temp_file_guard).
+int write_whole(const std::string& path, const std::vector<unsigned char>& bytes) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd < 0) return errno;
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int error = n < 0 ? errno : EIO;
+      ::close(fd);
+      return error;
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  return ::close(fd) == 0 ? 0 : errno;
+}
+
+}  // namespace
+
+void write_root_attributes(H5::H5File& file, const study& s, const std::string& described_options) {
+  attr(file, "format_version", study_format_version);
+  attr(file, "version", build_info::version);
+  attr(file, "git_commit", build_info::git_commit);
+  attr(file, "compiler", build_info::compiler);
+  attr(file, "build_type", build_info::build_type);
+  attr(file, "dependencies", build_info::dependencies);
+  attr(file, "build_flags", build_info::build_flags);
+  attr(file, "created_utc", utc_now_iso8601());
+  attr(file, "cpu", cpu_model());
+  attr(file, "cores", core_count());
+  if (s.swept) {
+    // Which problems the study selected and which share of them this file holds
+    // (sweep --shard K/N, stepbench_bench --shard=K/N); stepbench merge reads these.
+    attr(file, "selection", fmt::format("{}", fmt::join(selected_problems(s.options), ",")));
+    attr(file, "shard_index", s.options.shard_index);
+    attr(file, "shard_count", s.options.shard_count);
+    attr(file, "sweep_options", described_options);
+  }
+  attr(file, "levels", s.options.levels);
+  attr(file, "max_levels", s.options.max_levels);
+  attr(file, "base_steps", s.options.base_steps);
+  attr(file, "sample_count", s.options.sample_count);
+  attr(file, "tolerances", s.options.tolerances);
+  attr(file, "reference_rtol", s.options.tol.rtol);
+  attr(file, "reference_atol", s.options.tol.atol);
+  attr(file, "fit_metric", "err_pos_max");
+  attr(file, "divergence_factor", blowup_factor);
+  attr(file, "work_budget", s.options.limits.work_budget);
+  attr(file, "max_adaptive_steps", s.options.limits.max_steps);
+  attr(file, "equal_error_targets", equal_error_targets());
+  attr(file, "wall_seconds", s.wall_seconds);
+  attr(file, "timing", static_cast<int>(s.timed.has_value()));
+  if (s.timed) {
+    const auto& t = *s.timed;
+    attr(file, "benchmark_mode", t.mode);
+    attr(file, "benchmark_min_time_s", t.min_time_s);
+    attr(file, "benchmark_repetitions", t.repetitions);
+    attr(file, "benchmark_case_budget_s", t.case_budget_s);
+    attr(file, "benchmark_wall_seconds", t.wall_seconds);
+    attr(file, "cpu_scaling_enabled", t.cpu_scaling_enabled);
+    attr(file, "num_cpus", t.num_cpus);
+    attr(file, "mhz_per_cpu", t.mhz_per_cpu);
+  }
+}
+
+h5::table parameters_table(const std::vector<param_value>& params) {
+  std::vector<std::string> name, unit, kind, value_name, allowed, description;
+  std::vector<double> value, default_value;
+  for (const auto& q : params) {
+    name.push_back(q.name);
+    value.push_back(q.value);
+    unit.push_back(q.unit);
+    kind.emplace_back(q.kind());
+    value_name.push_back(q.value_name());
+    default_value.push_back(q.default_value);
+    allowed.push_back(q.allowed.text());
+    description.push_back(q.description);
+  }
+  h5::table t;
+  t.add("name", std::move(name));
+  t.add("value", std::move(value));
+  t.add("unit", std::move(unit));
+  t.add("kind", std::move(kind));
+  t.add("value_name", std::move(value_name));
+  t.add("default", std::move(default_value));
+  t.add("allowed", std::move(allowed));
+  t.add("description", std::move(description));
+  return t;
+}
+
+h5::table runs_table(const std::vector<method_row>& rows, bool timed) {
+  h5::table t;
+  auto col = [&](auto get) {
+    using T = decltype(get(rows.front()));
+    std::vector<T> v;
+    for (const auto& r : rows) v.push_back(get(r));
+    return v;
+  };
+  t.add("param", col([](const method_row& r) { return r.param; }));
+  t.add("steps", col([](const method_row& r) { return std::int64_t{r.steps}; }));
+  t.add("rejected_steps", col([](const method_row& r) { return std::int64_t{r.rejected_steps}; }));
+  t.add("force_evals", col([](const method_row& r) { return std::int64_t{r.work.force_evals}; }));
+  t.add("jacobian_evals", col([](const method_row& r) { return std::int64_t{r.work.jacobian_evals}; }));
+  t.add("newton_iterations", col([](const method_row& r) { return std::int64_t{r.work.newton_iterations}; }));
+  t.add("linear_solves", col([](const method_row& r) { return std::int64_t{r.work.linear_solves}; }));
+  t.add("err_pos_final", col([](const method_row& r) { return r.metrics.err_pos_final; }));
+  t.add("err_vel_final", col([](const method_row& r) { return r.metrics.err_vel_final; }));
+  t.add("err_pos_max", col([](const method_row& r) { return r.metrics.err_pos_max; }));
+  t.add("err_pos_rms", col([](const method_row& r) { return r.metrics.err_pos_rms; }));
+  t.add("energy_drift", col([](const method_row& r) { return r.metrics.energy_drift; }));
+  t.add("energy_err_max", col([](const method_row& r) { return r.metrics.energy_err_max; }));
+  t.add("angmom_drift", col([](const method_row& r) { return r.metrics.angmom_drift; }));
+  t.add("angmom_err_max", col([](const method_row& r) { return r.metrics.angmom_err_max; }));
+  t.add("constraint_violation_max", col([](const method_row& r) { return r.metrics.constraint_violation_max; }));
+  t.add("contacts", col([](const method_row& r) { return std::int64_t{r.metrics.contacts}; }));
+  t.add("contact_count_err", col([](const method_row& r) { return r.metrics.contact_count_err; }));
+  t.add("contact_time_err", col([](const method_row& r) { return r.metrics.contact_time_err; }));
+  t.add("contact_pos_err", col([](const method_row& r) { return r.metrics.contact_pos_err; }));
+  t.add("tunnelled", col([](const method_row& r) { return std::int64_t{r.metrics.tunnelled}; }));
+  t.add("max_penetration", col([](const method_row& r) { return r.metrics.max_penetration; }));
+  t.add("diverged", col([](const method_row& r) { return static_cast<std::int8_t>(r.metrics.diverged); }));
+  t.add("failed", col([](const method_row& r) { return static_cast<std::int8_t>(r.metrics.failed); }));
+  t.add("skipped", col([](const method_row& r) { return static_cast<std::int8_t>(r.metrics.skipped); }));
+  t.add("note", col([](const method_row& r) { return r.metrics.note; }));
+  // Timing fields only in a timed study, so an untimed file does not carry columns of
+  // NaN that a reader could mistake for measurements.
+  if (timed) {
+    t.add("time_ns", col([](const method_row& r) { return r.time.time_ns; }));
+    t.add("time_ns_min", col([](const method_row& r) { return r.time.time_ns_min; }));
+    t.add("time_ns_max", col([](const method_row& r) { return r.time.time_ns_max; }));
+    t.add("repetitions", col([](const method_row& r) { return std::int64_t{r.time.repetitions}; }));
+    t.add("cut", col([](const method_row& r) { return static_cast<std::int8_t>(r.time.cut); }));
+  }
+  return t;
+}
+
+void check_writable(const std::string& path) {
+  if (path.empty()) throw std::runtime_error("cannot write results file '': empty path");
+  if (std::filesystem::is_directory(path))
+    throw std::runtime_error(fmt::format("cannot write results file '{}': it is a directory", path));
+  const std::string tmp = temp_path_for(path);
+  std::FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (!f) throw std::runtime_error(fmt::format("cannot write results file '{}': {}", path, std::strerror(errno)));
+  std::fclose(f);
+  std::remove(tmp.c_str());
+}
+
+void write_study_file(const std::string& path, const std::function<void(H5::H5File&)>& fill) {
+  check_writable(path);
+  H5::Exception::dontPrint();
+  std::vector<unsigned char> image;
+  try {
+    H5::H5File file = in_memory_file(path);
+    fill(file);
+    image = file_image(file);
+    file.close();
+  } catch (const H5::Exception& e) {
+    throw std::runtime_error(fmt::format("cannot write results file '{}': HDF5: {}", path, e.getDetailMsg()));
+  }
+  write_image(image, path);
+}
+
+H5::H5File in_memory_file(const std::string& path) {
+  H5::FileAccPropList in_memory;
+  in_memory.setCore(std::size_t{1} << 20, false);
+  return H5::H5File(temp_path_for(path), H5F_ACC_TRUNC, H5::FileCreatPropList::DEFAULT, in_memory);
+}
+
+std::vector<unsigned char> file_image(H5::H5File& file) {
+  file.flush(H5F_SCOPE_GLOBAL);
+  const ssize_t size = H5Fget_file_image(file.getId(), nullptr, 0);
+  std::vector<unsigned char> image(size > 0 ? static_cast<std::size_t>(size) : 0);
+  if (size <= 0 || H5Fget_file_image(file.getId(), image.data(), image.size()) != size)
+    throw H5::FileIException("H5Fget_file_image", "cannot take the file's image");
+  return image;
+}
+
+void write_image(const std::vector<unsigned char>& image, const std::string& path) {
+  const std::string tmp = temp_path_for(path);
+  const temp_file_guard guard(tmp);
+  if (const int error = write_whole(tmp, image)) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error(fmt::format("cannot write results file '{}': {}", path, std::strerror(error)));
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error(fmt::format("cannot write results file '{}': {}", path, ec.message()));
+  }
+}
+
+}  // namespace stepbench

@@ -1,0 +1,52 @@
+#pragma once
+// The study file (HDF5): the public format users script against. Layout documented in
+// docs/study-format.md; bump study_format_version when it changes incompatibly.
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/work_precision.hpp"
+#include "store/h5.hpp"
+#include "study/study.hpp"
+
+namespace stepbench {
+
+inline constexpr int study_format_version = schema::format_version;
+
+// Throws std::runtime_error ("cannot write results file '<path>': <reason>") when the
+// path cannot be created; leaves nothing behind. Call before a long run.
+void check_writable(const std::string& path);
+
+// Builds a study file in memory with `fill` and writes it to a temporary file beside
+// `path`, renamed into place when whole: an existing file is replaced whole or not at all
+// (parts/study.hpp write_study fills it with the root attributes and every part).
+void write_study_file(const std::string& path, const std::function<void(H5::H5File&)>& fill);
+
+// The root attributes of a study file: format, build, machine, the sweep's settings
+// (`described_options`: the parts' describe lines), timing.
+void write_root_attributes(H5::H5File& file, const study& s, const std::string& described_options);
+
+// /problems: the sweep's rows, each problem's truth, references, equal-error table and
+// fronts.
+void write_problems(H5::Group& root, const study& s);
+
+// The machine a study ran on (run/machine.hpp), as attributes of `obj`: cpu, cores,
+// and with timings num_cpus, mhz_per_cpu, cpu_scaling_enabled (Google Benchmark's context).
+void write_machine(H5::H5Object& obj, const std::optional<timing_settings>& timing);
+
+// A file built in memory (HDF5's core driver, no backing store) and named after a
+// temporary path beside `path`; its image; and the image written to a temporary file
+// beside `path`, renamed into place when whole (as write_study writes).
+H5::H5File in_memory_file(const std::string& path);
+std::vector<unsigned char> file_image(H5::H5File& file);
+void write_image(const std::vector<unsigned char>& image, const std::string& path);
+
+// The `runs` table of a method's rows (docs/study-format.md); timing fields when timed.
+// A problem's declared parameters (core/parameter.hpp) as the /problems/<p>/parameters
+// table: name, value, unit, kind, value_name (the name of the value, where it has one),
+// default, allowed (the constraint in words), description.
+h5::table parameters_table(const std::vector<param_value>& params);
+h5::table runs_table(const std::vector<method_row>& rows, bool timed);
+
+}  // namespace stepbench

@@ -1,0 +1,29 @@
+#pragma once
+// /verdict and /frame_rates of a study file (docs/study-format.md): written from the
+// study, and the verdict read back.
+#include <string>
+#include <vector>
+
+#include "store/h5.hpp"
+#include "study/study.hpp"
+
+namespace stepbench {
+
+// /verdict, as judged into the study (nothing when it holds no verdict), and
+// /frame_rates/<problem> (docs/study-format.md).
+void write_verdict(H5::Group& root, const study& s);
+void write_frame_rates(H5::Group& root, const study& s);
+
+// Reads /verdict back from a study file (`stepbench advise --hz`); throws
+// std::runtime_error naming what is missing.
+verdict_tables read_verdict(const std::string& path);
+verdict_tables read_verdict(const H5::Group& root);  // the file's root; errors without the path
+
+// From a study file's /substeps/<p>/verdict and /problems/<p>/methods, for `problems` in
+// that order.
+// A problem's frame-rate runs (/frame_rates/<problem>) and the verdict's cost kind.
+// Throws std::invalid_argument for a problem the file lacks (naming what it has) and
+// std::runtime_error when the file cannot be read.
+frame_rate_runs read_frame_rate_runs(const std::string& path, const std::string& problem);
+finding_inputs read_finding_inputs(const H5::Group& root, const std::vector<std::string>& problems);
+}  // namespace stepbench

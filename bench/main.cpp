@@ -17,7 +17,6 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
@@ -34,7 +33,6 @@
 #include "run/sweep.hpp"
 #include "store/bench_merge.hpp"
 #include "store/study_file.hpp"
-#include "store/temp_file_guard.hpp"
 #include "study/verdict.hpp"
 
 using namespace stepbench;
@@ -71,27 +69,6 @@ std::size_t count_selected(char* program) {
   int run_argc = 2;
   benchmark::Initialize(&run_argc, run_args);
   return n;
-}
-
-// Writes `text` to a temporary file beside `path` and renames it into place, as the
-// study file is written: an interrupted run leaves the previous file and nothing else.
-void write_whole_file(const std::string& path, const std::string& text) {
-  const std::string tmp = fmt::format("{}.tmp.{}", path, ::getpid());
-  const temp_file_guard guard(tmp);
-  std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-  out << text;
-  out.close();
-  if (!out) {
-    const int error = errno;
-    std::remove(tmp.c_str());
-    throw std::runtime_error(fmt::format("cannot write results file '{}': {}", path, std::strerror(error)));
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error(fmt::format("cannot write results file '{}': {}", path, ec.message()));
-  }
 }
 
 std::size_t run_count(const study& s) {
@@ -205,7 +182,10 @@ int main(int argc, char** argv) {
     // The study first, then bench.json: a signal between the two leaves the new study
     // whole and the previous bench.json (the study is what the other commands read).
     write_study(s, opts.study_out);
-    if (!bench_json.empty()) write_whole_file(bench_json, json_text.str());
+    if (!bench_json.empty()) {
+      const std::string text = json_text.str();
+      write_image({text.begin(), text.end()}, bench_json);  // whole or not at all, as the study file
+    }
     std::fflush(stdout);
     fmt::print(stderr,
                "stepbench_bench: wrote {}{} ({} mode, {} timed) in {}; `stepbench ratios --study {}` prints the "

@@ -21,6 +21,15 @@
 namespace stepbench {
 namespace {
 
+// The Small Steps designs, named after the methods they run, by the methods' own names (a
+// renamed method renames its design, never drops it from the verdict).
+struct small_steps_designs {
+  std::string xpbd_substeps = xpbd::describe().name + "_substeps";
+  std::string xpbd_passes = xpbd_iterations::describe().name;
+  std::string explicit_substeps = std::string(semi_implicit_euler::name) + "_substeps";
+  std::string implicit_step = std::string(implicit_euler::name);
+};
+
 // The median of `repeats` timings of a whole run, in ns (one untimed run first).
 double median_ns(const std::function<void()>& run, int repeats = 5) {
   run();
@@ -158,22 +167,25 @@ void small_steps_of(const P& p, const challenge_options& o, std::vector<small_st
     last = s.s;
   };
   typename P::vec x = s0.x, v = s0.v;
+  const small_steps_designs design;
   for (int n : o.small_steps_counts) {
-    small_steps_row r{
-        .problem = std::string(P::name), .design = "xpbd_substeps", .n = n, .work_per_frame = static_cast<double>(n)};
+    small_steps_row r{.problem = std::string(P::name),
+                      .design = design.xpbd_substeps,
+                      .n = n,
+                      .work_per_frame = static_cast<double>(n)};
     r.ns_per_frame = median_ns([&] { xpbd_run(n, 1, x, v); }, 3) / frames;
     finish(r, x, v, &last);
-    r.design = "xpbd_iterations";
+    r.design = design.xpbd_passes;
     r.ns_per_frame = median_ns([&] { xpbd_run(1, n, x, v); }, 3) / frames;
     finish(r, x, v, &last);
-    r.design = "semi_implicit_euler_substeps";
+    r.design = design.explicit_substeps;
     drive_result<typename P::vec> d;
     r.ns_per_frame =
         median_ns([&] { d = drive(p, semi_implicit_euler{}, frame / n, o.small_steps_time, {}); }, 3) / frames;
     finish(r, d.final_state.x, d.final_state.v);
   }
   drive_result<typename P::vec> d;
-  small_steps_row r{.problem = std::string(P::name), .design = "implicit_euler", .n = 1};
+  small_steps_row r{.problem = std::string(P::name), .design = design.implicit_step, .n = 1};
   r.ns_per_frame = median_ns([&] { d = drive(p, implicit_euler{}, frame, o.small_steps_time, {}); }, 3) / frames;
   r.work_per_frame = static_cast<double>(d.work.force_evals) / frames;
   finish(r, d.final_state.x, d.final_state.v);
@@ -185,13 +197,14 @@ std::string small_steps_verdict(const std::vector<small_steps_row>& rows, const 
       if (r.problem == problem && r.design == design && r.n == n) return &r;
     return nullptr;
   };
-  const small_steps_row* ie = find("implicit_euler", 1);
+  const small_steps_designs design;
+  const small_steps_row* ie = find(design.implicit_step, 1);
   int n_max = 0;
   for (const auto& r : rows)
     if (r.problem == problem) n_max = std::max(n_max, r.n);
-  const auto* sub = find("xpbd_substeps", n_max);
-  const auto* it = find("xpbd_iterations", n_max);
-  const auto* sie = find("semi_implicit_euler_substeps", n_max);
+  const auto* sub = find(design.xpbd_substeps, n_max);
+  const auto* it = find(design.xpbd_passes, n_max);
+  const auto* sie = find(design.explicit_substeps, n_max);
   if (!ie || !sub || !it || !sie) return problem + ": incomplete";
   auto err = [](const small_steps_row& r) {
     return r.diverged ? std::string("diverged") : fmt::format("{:.3g} m (links {:.2g})", r.err_pos, r.link_err);
@@ -228,7 +241,7 @@ challenge_result run_challenge(const challenge_options& o, void (*progress)(cons
     if (progress) progress(s);
   };
   n_pendulum scene;
-  auto p = make_problem("n_pendulum");
+  auto p = make_problem(n_pendulum::name);
   const truth_table truth = build_truth(*p, frame_ends(o.hz, o.horizon), {});
   const double n = scene.links;
   out.energy_scale = scene.mass_kg * scene.gravity * scene.length_m * n * (n + 1) / 2;
@@ -250,15 +263,16 @@ challenge_result run_challenge(const challenge_options& o, void (*progress)(cons
     if (!e.stable) e.note = "the energy error reached the energy scale";
   };
 
-  say("challenge: xpbd");
-  const ladder_point xp = measure_at(*p, truth, "xpbd", o.xpbd_substeps, o.hz, o.horizon);
-  challenge_entry x{.method = "xpbd",
+  const std::string xpbd_name = xpbd::describe().name;
+  say("challenge: " + xpbd_name);
+  const ladder_point xp = measure_at(*p, truth, xpbd_name, o.xpbd_substeps, o.hz, o.horizon);
+  challenge_entry x{.method = xpbd_name,
                     .steps_per_frame = o.xpbd_substeps,
                     .ns_per_frame = xp.ns_per_frame,
                     .err_pos_max = xp.err,
                     .note = xp.note};
   x.link_err_max = xpbd_link_error(scene, o.hz, o.xpbd_substeps, o.horizon);
-  energy_of(x, "xpbd", 1.0 / (o.hz * o.xpbd_substeps));
+  energy_of(x, xpbd_name, 1.0 / (o.hz * o.xpbd_substeps));
   x.ns_per_frame_at_xpbd_error = x.ns_per_frame;
   out.entries.push_back(x);
 
@@ -348,8 +362,8 @@ challenge_result run_challenge(const challenge_options& o, void (*progress)(cons
   small_steps_of(scene, o, out.small_steps);
   say("small steps: spring_chain");
   small_steps_of(spring_chain{}, o, out.small_steps);
-  out.small_steps_verdicts = {small_steps_verdict(out.small_steps, "n_pendulum"),
-                              small_steps_verdict(out.small_steps, "spring_chain")};
+  out.small_steps_verdicts = {small_steps_verdict(out.small_steps, std::string(n_pendulum::name)),
+                              small_steps_verdict(out.small_steps, std::string(spring_chain::name))};
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }

@@ -38,6 +38,14 @@ void validate(const sweep_options& opts) {
   for (double tol : opts.tolerances)
     if (!(tol > 0.0 && tol < 1.0)) throw std::invalid_argument(fmt::format("tolerance {:g} is not in (0, 1)", tol));
   for (const auto& name : opts.methods) find_method(name);
+  // The parts' own method and problem lists name registry entries: a renamed method or
+  // problem fails here, at the start, instead of dropping out of a part unseen.
+  for (const auto* names : {&opts.loop.methods, &opts.substeps.explicit_methods, &opts.substeps.implicit_methods,
+                            &opts.challenge.competitors, &opts.energy.methods})
+    for (const auto& name : *names) find_method(name);
+  for (const auto* names : {&opts.loop.problems, &opts.substeps.problems})
+    for (const auto& name : *names) make_problem(name);
+  for (const auto& scene : opts.energy.scenes) make_problem(scene.problem);
   // The frame-rate study's truth is built at the fastest rate's frame ends and read at
   // every rate's: each rate must divide the fastest.
   if (!opts.frame_rates.hz.empty()) {

@@ -250,15 +250,23 @@ def _whole_params(reader, f, problem):
 
 
 def load(path):
-    """The scans of the study at `path` (read after study.load accepted the file), or None."""
+    """The scans of the study at `path` (read after study.load accepted the file), or None.
+    Read in a child process bounded as study.load's are (study.read_in_child): study.load
+    does not read /scan, and a damaged /scan can make HDF5 loop or crash as well."""
     from . import study  # the reader; imported here, as study.py imports the sections
+    return study.read_in_child(path, lambda: _read_file(path))
+
+
+def _read_file(path):
+    from . import study
     f = study._open(path)
     try:
         with f:
             return read(study._Reader(path, f), f)
     except study.StudyError:
         raise
-    except (OSError, KeyError, ValueError, RuntimeError, TypeError, MemoryError) as e:
+    # h5py's errors on a damaged object; MemoryError is the reading child's to name.
+    except (OSError, KeyError, ValueError, RuntimeError, TypeError) as e:
         raise study._error(path, f"damaged or truncated HDF5 file: {study._first_line(e)}") from None
 
 

@@ -37,7 +37,7 @@ WORKERS = min(2, os.cpu_count() or 1)
 COMMAND_TIMEOUT = 120  # s
 REPORT_TIMEOUT_PER_COPY = 3  # s, beside REPORT_TIMEOUT_BASE
 REPORT_TIMEOUT_BASE = 60  # s
-# The report reader's bounds in this test (study.READ_CPU_SECONDS, study.READ_MEMORY):
+# The report reader's bounds in this test (child_read.READ_CPU_SECONDS, READ_MEMORY):
 # tighter than a user's 20 s and 3 GiB, the same code paths. The copies are of a 1.5 MB
 # study that reads in 0.1 s and under 100 MB, and a copy that makes HDF5 allocate up to
 # 3 GiB spends 10 to 15 s doing it (three such among 200 copies at seed 16).
@@ -48,8 +48,8 @@ REPORT_READER = """
 import sys
 sys.path.insert(0, sys.argv[1])
 cpu_seconds, memory = int(sys.argv[2]), int(sys.argv[3])
-from stepbench_report import range_answer, scan, study
-study.READ_CPU_SECONDS, study.READ_MEMORY = cpu_seconds, memory
+from stepbench_report import child_read, range_answer, scan, study
+child_read.READ_CPU_SECONDS, child_read.READ_MEMORY = cpu_seconds, memory
 for path in sys.argv[4:]:
     print(path, flush=True)
     try:

@@ -251,14 +251,14 @@ def _whole_params(reader, f, problem):
 
 def load(path):
     """The scans of the study at `path` (read after study.load accepted the file), or None.
-    Read in a child process bounded as study.load's are (study.read_in_child): study.load
-    does not read /scan, and a damaged /scan can make HDF5 loop or crash as well."""
-    from . import study  # the reader; imported here, as study.py imports the sections
-    return study.read_in_child(path, lambda: _read_file(path))
+    Read in a child process bounded as study.load's are (child_read.py): study.load does
+    not read /scan, and a damaged /scan can make HDF5 loop or crash as well."""
+    from . import child_read
+    return child_read.read_in_child(path, lambda: _read_file(path))
 
 
 def _read_file(path):
-    from . import study
+    from . import study  # the reader; imported here, as study.py imports the sections
     f = study._open(path)
     try:
         with f:

@@ -8,12 +8,7 @@ attribute, field or dataset is a StudyError naming the file and what is missing.
 Nothing is filled in with a default.
 """
 import ctypes
-import faulthandler
-import fcntl
 import os
-import pickle
-import resource
-import signal
 import sys
 from dataclasses import dataclass, field
 
@@ -22,6 +17,7 @@ import numpy as np
 from h5py import h5, h5a, h5d, h5i, h5o, h5p, h5s, h5t
 
 from . import challenge as challenge_section
+from . import child_read
 from . import energy_runs as energy_section
 from . import loop as loop_section
 from . import schema
@@ -75,13 +71,11 @@ STABILITY_ATTRS = ("oscillator", "decay", "adaptive_tolerance", "y_min", "y_max"
 LIMIT_FIELDS = schema.fields("stability_limits")
 STABILITY_TESTS = ("oscillator", "decay")
 
+# Raised by every reader of a study file; defined beside the child that reads it.
+StudyError = child_read.StudyError
+
 # The optional root groups have their own readers: /loop (loop.py), /energy
 # (energy_runs.py), /substeps (substeps.py), /challenge (challenge.py).
-
-
-class StudyError(Exception):
-    """The file is missing, not HDF5, damaged, of another format_version, or lacks
-    something the format requires. The message is one line and names the file."""
 
 
 # One str object for each value: a full study holds some 30000 strings of 450 values,
@@ -523,25 +517,13 @@ def _merged(shares):
 # reads in 60 % of the time one child takes.
 READERS = min(2, os.cpu_count() or 1)
 
-# Bounds on what reading a file may make HDF5 do in the child that reads it (read_in_child),
-# as the C++ reader bounds its own (study/study_reader.cpp): a whole study reads in about a
-# second of CPU time and a few hundred MB, so past these the file is damaged. A damaged
-# B-tree can make HDF5 loop for ever, a damaged length can make it allocate gigabytes.
-READ_CPU_SECONDS = 20
-# Address space the child may map beyond what it was forked with (a bound relative to the
-# parent's, so that a large parent, a notebook holding other data, still reads a good file).
-READ_MEMORY = 3 << 30  # bytes
-
 
 def load(path):
     """The study at `path`, checked; StudyError (one line, naming the file) otherwise.
 
-    HDF5 1.10 trusts sizes stored in the file where h5py cannot check them first (a
-    global heap object's length, an attribute message's size): a damaged file can crash
-    it, make it loop or make it allocate what a damaged length says. So the file is read
-    in child processes (read_in_child), bounded in CPU time and memory, which hand back
-    what they read (or the error) pickled; a child that crashed or ran out of its bounds
-    is a damaged file, not a dead or hung report.
+    The file is read in child processes bounded in CPU time and memory (child_read.py): a
+    damaged file can make HDF5 crash, loop or allocate what a damaged length says, and a
+    child that crashed or ran out of its bounds is a damaged file, not a dead or hung report.
     READERS children read at once, each its share of the problems (the bulk of the file;
     Reader.study). Which error a damaged file raises depends on the order it is read in,
     so when a share fails the file is read again by one child, in order, for the error."""
@@ -557,101 +539,9 @@ def load(path):
 def _read_shares(path, shares):
     """Each of the `shares` shares of the study at `path` (or the exception reading it
     raised), read by a child process of its own, all at once."""
-    children = [_start_child(path, lambda share=share: _read(path, _open(path), share, shares))
+    children = [child_read.start(path, lambda share=share: _read(path, _open(path), share, shares))
                 for share in range(shares)]
-    return [_finish_child(path, *child) for child in children]
-
-
-def read_in_child(path, read):
-    """`read()` (which reads the file at `path`) run in a child process bounded as load's
-    readers are; its result, or StudyError (one line, naming the file). For every reader of
-    a study file besides load (scan.load, range_answer.range_answers)."""
-    result = _finish_child(path, *_start_child(path, read))
-    if isinstance(result, Exception):
-        raise result
-    return result
-
-
-def _start_child(path, read):
-    """Forks a child that calls `read()` on the file `path` within READ_CPU_SECONDS of CPU
-    time and READ_MEMORY more address space, and sends its result (or the exception it
-    raised) pickled down a pipe; (its pid, the pipe)."""
-    readable, writable = os.pipe()
-    try:  # a full study in a few writes, not the 90 of a pipe's default 64 KiB
-        fcntl.fcntl(writable, fcntl.F_SETPIPE_SZ, 1 << 20)
-    except (AttributeError, OSError):  # not Linux, or above its /proc/sys/fs/pipe-max-size
-        pass
-    pid = os.fork()
-    if pid == 0:
-        status = 1  # whatever happens here, the child ends here and never returns into its parent's code
-        try:
-            try:
-                os.close(readable)
-                os.dup2(os.open(os.devnull, os.O_WRONLY), 2)  # HDF5's own diagnostics: the error says it
-                faulthandler.disable()  # nor Python's traceback of a crash (pytest's, PYTHONFAULTHANDLER's)
-                _bound_this_process()
-                # The file stays open: the child ends by os._exit, so HDF5 need not spend ~12 ms
-                # closing it (freeing every cached object header) before the parent has the study.
-                result = read()
-            except MemoryError:  # past READ_MEMORY: an allocation of a size the damaged file gave
-                result = _error(path, f"damaged: reading it needs more than {READ_MEMORY / (1 << 30):g} GiB of memory")
-            except Exception as e:  # noqa: BLE001 -- raised again in the parent
-                result = e
-            with os.fdopen(writable, "wb") as out:
-                pickle.dump(result, out, protocol=pickle.HIGHEST_PROTOCOL)
-            status = 0
-        finally:
-            os._exit(status)
-    os.close(writable)
-    return pid, readable
-
-
-def _bound_this_process():
-    """READ_CPU_SECONDS of CPU time (a forked child starts at none), then SIGXCPU, which
-    ends it; READ_MEMORY more address space than it has, past which allocations fail; no
-    core file of a child so ended. Lower bounds it inherited are kept."""
-    signal.signal(signal.SIGXCPU, signal.SIG_DFL)
-    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGXCPU})
-    # SIGKILL a second later: at a hard limit equal to the soft one Linux sends SIGKILL, not SIGXCPU.
-    _lower_limit(resource.RLIMIT_CPU, READ_CPU_SECONDS, READ_CPU_SECONDS + 1)
-    try:
-        with open("/proc/self/statm") as statm:
-            mapped = int(statm.read().split()[0]) * resource.getpagesize()
-    except OSError:  # not Linux: no bound on memory
-        mapped = None
-    if mapped is not None:
-        _lower_limit(resource.RLIMIT_AS, mapped + READ_MEMORY, mapped + READ_MEMORY)
-    _lower_limit(resource.RLIMIT_CORE, 0, None)
-
-
-def _lower_limit(which, soft, hard):
-    """setrlimit(which) to (soft, hard), or to what it is where that is lower; hard None:
-    kept as it is."""
-    old_soft, old_hard = resource.getrlimit(which)
-    hard = old_hard if hard is None or (old_hard != resource.RLIM_INFINITY and old_hard < hard) else hard
-    soft = min(soft, hard) if hard != resource.RLIM_INFINITY else soft
-    if old_soft != resource.RLIM_INFINITY:
-        soft = min(soft, old_soft)
-    resource.setrlimit(which, (soft, hard))
-
-
-def _finish_child(path, pid, readable):
-    """What the child `pid` sent down `readable`; a StudyError if it ended before sending
-    it: out of CPU time (SIGXCPU, or the SIGKILL after it), or crashed."""
-    with os.fdopen(readable, "rb") as inp:
-        try:  # unpickled as it arrives, while the child is still pickling
-            result = pickle.load(inp)
-        except (EOFError, pickle.UnpicklingError):  # nothing, or not all of it
-            result = None
-    status, usage = os.wait4(pid, 0)[1:]
-    if os.WIFSIGNALED(status) and (os.WTERMSIG(status) == signal.SIGXCPU or (
-            os.WTERMSIG(status) == signal.SIGKILL and usage.ru_utime + usage.ru_stime >= READ_CPU_SECONDS)):
-        return _error(path, f"damaged: reading it did not end within {READ_CPU_SECONDS} s of CPU time "
-                            "(HDF5 looping on it)")
-    if os.WIFSIGNALED(status) or result is None:
-        end = signal.Signals(os.WTERMSIG(status)).name if os.WIFSIGNALED(status) else f"exit {status >> 8}"
-        return _error(path, f"damaged: reading it crashes the HDF5 library ({end})")
-    return result
+    return [child_read.finish(path, *child) for child in children]
 
 
 def _open(path):
@@ -676,13 +566,12 @@ def _read(path, f, share, shares):
         return _Reader(path, f).study(share, shares)
     except StudyError:
         raise
-    # h5py's errors on a damaged object; MemoryError is the child's to name (_start_child).
+    # h5py's errors on a damaged object; MemoryError is the reading child's to name (child_read.py).
     except (OSError, KeyError, ValueError, RuntimeError, TypeError) as e:
         raise _error(path, f"damaged or truncated HDF5 file: {_first_line(e)}") from None
 
 
-def _error(path, what):
-    return StudyError(f"cannot read study file '{path}': {what}")
+_error = child_read.error
 
 
 TRANSFER_BUFFER = 64 << 10  # bytes

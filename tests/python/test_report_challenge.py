@@ -385,12 +385,10 @@ def test_readme_and_markdown_carry_the_small_steps_table(challenge_study, tmp_pa
     assert block.index(f"- {lines[-1]}\n") < block.index(caption) < block.index(f"Study `{challenge_study}`")
 
 
-def test_a_study_without_challenge_has_no_such_section(plain_study, tmp_path):
+def test_a_study_without_challenge_has_no_such_section(plain_study, reports, tmp_path):
     with h5py.File(plain_study, "r") as f:
         assert "challenge" not in f  # --quick leaves it out
-    out = tmp_path / "report"
-    p = run_report(plain_study, out)
-    assert p.returncode == 0, p.stderr
+    out = reports["plain"][1]  # drawn once a session (conftest.py), exit 0 checked there
     md = report_text(out)
     assert "pendulum challenge (XPBD" not in md and "Small Steps: substeps against iterations" not in md
     assert not (out / FIGURE).exists()

@@ -23,7 +23,9 @@ with open(os.path.join(ROOT, "scripts", "stepbench_report", "schema.json")) as _
 METRIC_TITLES = {"err_pos_final": "by final error", "err_pos_max": "by max error over the run"}
 
 
-def run_report(study, out, jobs=1, cwd=None):
+def run_report(study, out, jobs=2, cwd=None):
+    """scripts/report of `study` into `out`; two figure processes, as the report's own
+    default on two cores: most of a whole report's 20 s is its figures."""
     return subprocess.run([PYTHON, REPORT, str(study), "--out", str(out), "--jobs", str(jobs)], capture_output=True,
                           text=True, cwd=cwd, timeout=120)
 

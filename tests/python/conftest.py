@@ -32,7 +32,8 @@ def pytest_addoption(parser):
 
 @pytest.fixture(scope="session")
 def stepbench(request):
-    return request.config.getoption("--stepbench")
+    # Absolute: some tests run it from a temporary working directory.
+    return os.path.abspath(request.config.getoption("--stepbench"))
 
 
 @pytest.fixture(scope="session")

@@ -4,8 +4,11 @@ A small study (`stepbench sweep --quick`, one problem) is copied COPIES times wi
 fixed seed, each copy with 1 to 64 random bytes changed or (one in eight) cut short;
 every reading command (advise, compare both ways, ratios) reads each copy and must
 end by an exit status it documents, never by a signal, with at most one line on
-stderr. The report's reader (scripts/stepbench_report/study.py) loads every copy in one
-child process, which must end normally too.
+stderr. The report's readers (scripts/stepbench_report: study.load, and on a copy it
+accepts scan.load and the range answers, as the report reads them) read every copy in
+one child process, which must end normally too, each refusal one line naming the copy.
+No run may hang: each has a timeout, past which it is a failure. The runs go two at a
+time (WORKERS).
 
 usage: fuzz_read_test.py path/to/stepbench COPIES
 """
@@ -15,6 +18,8 @@ import signal
 import subprocess
 import sys
 import tempfile
+import time
+from concurrent.futures import ThreadPoolExecutor
 
 SEED = 16
 PROBLEM = "damped_spring"
@@ -23,19 +28,42 @@ PROBLEM = "damped_spring"
 ALLOWED = {"advise": (0, 1, 2, 3), "compare": (0, 1, 2), "ratios": (0, 1, 2)}
 SCRIPTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scripts")
 
+# Runs at once: the commands of different copies and the report's reader. Each reads a
+# copy in well under a second, so two keep two cores busy; more only share them.
+WORKERS = min(2, os.cpu_count() or 1)
+# Wall-clock bounds past which a run is a hang. Each reader bounds its own reading of a
+# file to 20 s of CPU time (the report's reader here to REPORT_CPU_SECONDS), so a run that
+# reaches these is stuck where no bound reaches it.
+COMMAND_TIMEOUT = 120  # s
+REPORT_TIMEOUT_PER_COPY = 3  # s, beside REPORT_TIMEOUT_BASE
+REPORT_TIMEOUT_BASE = 60  # s
+# The report reader's bounds in this test (child_read.READ_CPU_SECONDS, READ_MEMORY):
+# tighter than a user's 20 s and 3 GiB, the same code paths. The copies are of a 1.5 MB
+# study that reads in 0.1 s and under 100 MB, and a copy that makes HDF5 allocate up to
+# 3 GiB spends 10 to 15 s doing it (three such among 200 copies at seed 16).
+REPORT_CPU_SECONDS = 5
+REPORT_MEMORY = 512 << 20  # bytes
+
 REPORT_READER = """
-import resource, sys
-# A damaged string length makes HDF5 allocate what it says: a bound turns that into an
-# error instead of gigabytes taken from a shared machine.
-resource.setrlimit(resource.RLIMIT_AS, (3 << 30, 3 << 30))
+import sys
 sys.path.insert(0, sys.argv[1])
-from stepbench_report.study import StudyError, load
-for path in sys.argv[2:]:
+cpu_seconds, memory = int(sys.argv[2]), int(sys.argv[3])
+from stepbench_report import child_read, range_answer, scan, study
+child_read.READ_CPU_SECONDS, child_read.READ_MEMORY = cpu_seconds, memory
+for path in sys.argv[4:]:
     print(path, flush=True)
     try:
-        load(path)
-    except StudyError as e:
-        assert "\\n" not in str(e), repr(str(e))
+        study.load(path)
+        # What the report reads beside the study once study.load accepted the file:
+        # /scan, and for --markdown and --readme the range answers (which verdict.py
+        # reads as none on OSError and KeyError).
+        scan.load(path)
+        try:
+            range_answer.range_answers(path)
+        except (OSError, KeyError):
+            pass
+    except study.StudyError as e:
+        assert "\\n" not in str(e) and f"'{path}'" in str(e), repr(str(e))
 """
 
 
@@ -50,8 +78,20 @@ def mutate(data, rng):
     return bytes(out)
 
 
-def outcome(returncode):
-    return f"signal {signal.Signals(-returncode).name}" if returncode < 0 else f"exit {returncode}"
+def run(command, timeout, env=None):
+    """The finished `command` (stdout and stderr as text); returncode None when it did not
+    end within `timeout` seconds (it is killed)."""
+    try:
+        return subprocess.run(command, capture_output=True, text=True, errors="replace", env=env, timeout=timeout)
+    except subprocess.TimeoutExpired as e:
+        text = [b.decode(errors="replace") if isinstance(b, bytes) else b or "" for b in (e.stdout, e.stderr)]
+        return subprocess.CompletedProcess(command, None, *text)
+
+
+def outcome(done, timeout):
+    if done.returncode is None:
+        return f"no end within {timeout} s (a hang)"
+    return f"signal {signal.Signals(-done.returncode).name}" if done.returncode < 0 else f"exit {done.returncode}"
 
 
 def main():
@@ -76,26 +116,34 @@ def main():
         with open(suppressions, "w") as f:
             f.write("leak:libhdf5\n")
         env = dict(os.environ, LSAN_OPTIONS=f"suppressions={suppressions}:print_suppressions=0")
-        counts = {}
-        for path in paths:
-            for name, args in (("advise", ["advise", "--problem", PROBLEM, "--tol", "1e-6", "--study", path]),
-                               ("compare", ["compare", base, path]), ("compare", ["compare", path, base]),
-                               ("ratios", ["ratios", "--study", path])):
-                run = subprocess.run([stepbench] + args, capture_output=True, text=True, errors="replace", env=env)
-                counts[(name, run.returncode)] = counts.get((name, run.returncode), 0) + 1
-                lines = run.stderr.splitlines()
-                if run.returncode not in ALLOWED[name] or len(lines) > 1:
-                    failures.append(f"{' '.join(args)}: {outcome(run.returncode)}, stderr: {run.stderr.strip()!r}")
-        report = subprocess.run([sys.executable, "-c", REPORT_READER, SCRIPTS] + paths, capture_output=True,
-                                text=True)
+        commands = [(name, args) for path in paths for name, args in (
+            ("advise", ["advise", "--problem", PROBLEM, "--tol", "1e-6", "--study", path]),
+            ("compare", ["compare", base, path]), ("compare", ["compare", path, base]),
+            ("ratios", ["ratios", "--study", path]))]
+        report_timeout = REPORT_TIMEOUT_BASE + REPORT_TIMEOUT_PER_COPY * copies
+        start = time.monotonic()
+        with ThreadPoolExecutor(WORKERS) as pool:
+            # The report reader first: the longest run, the commands fill the other worker.
+            report = pool.submit(run, [sys.executable, "-c", REPORT_READER, SCRIPTS, str(REPORT_CPU_SECONDS),
+                                       str(REPORT_MEMORY)] + paths, report_timeout)
+            runs = pool.map(lambda command: run([stepbench] + command[1], COMMAND_TIMEOUT, env), commands)
+            counts = {}
+            for (name, args), done in zip(commands, runs):
+                key = (name, outcome(done, COMMAND_TIMEOUT))
+                counts[key] = counts.get(key, 0) + 1
+                if done.returncode not in ALLOWED[name] or len(done.stderr.splitlines()) > 1:
+                    failures.append(f"{' '.join(args)}: {outcome(done, COMMAND_TIMEOUT)}, "
+                                    f"stderr: {done.stderr.strip()!r}")
+            report = report.result()
         if report.returncode != 0:
             last = report.stdout.split()[-1:] or ["(before the first copy)"]
-            failures.append(f"report reader: {outcome(report.returncode)} at {last[0]}: "
+            failures.append(f"report reader: {outcome(report, report_timeout)} at {last[0]}: "
                             f"{report.stderr.strip().splitlines()[-1:]}")
-        print(f"{copies} damaged copies of a {len(data)}-byte study (seed {SEED}):")
-        for (name, code), n in sorted(counts.items()):
-            print(f"  {name:8} exit {code}: {n}")
-        print(f"  report reader: {outcome(report.returncode)}")
+        print(f"{copies} damaged copies of a {len(data)}-byte study (seed {SEED}), read in "
+              f"{time.monotonic() - start:.0f} s by {WORKERS} workers:")
+        for (name, end), n in sorted(counts.items()):
+            print(f"  {name:8} {end}: {n}")
+        print(f"  report reader: {outcome(report, report_timeout)}")
     for f in failures:
         print("FAIL:", f)
     return 1 if failures else 0

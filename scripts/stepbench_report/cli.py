@@ -77,6 +77,9 @@ def _answers(s, args, argv):
         print(f"report: error: cannot write '{e.filename or args.markdown or args.readme}': {e.strerror}",
               file=sys.stderr)
         return 1
+    except study.StudyError as e:  # the range answers, read from the file's /scan (range_answer.py)
+        print(f"report: error: {e}", file=sys.stderr)
+        return 1
     for path in (args.markdown, args.readme):
         if path:
             print(f"report: wrote {path}")

@@ -9,7 +9,14 @@ def _text(v):
 
 def range_answers(path):
     """(name, range answer) of each /scan/<name> that stores one (`range_answer`, written by
-    stepbench with the scan), in the file's order; [] without /scan."""
+    stepbench with the scan), in the file's order; [] without /scan. Read in a child
+    process bounded as study.load's are (child_read.py): a damaged file can make HDF5 loop
+    or crash; that is a StudyError."""
+    from . import child_read
+    return child_read.read_in_child(path, lambda: _read_file(path))
+
+
+def _read_file(path):
     import h5py
     with h5py.File(path, "r") as f:
         if "scan" not in f:

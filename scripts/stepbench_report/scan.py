@@ -250,7 +250,14 @@ def _whole_params(reader, f, problem):
 
 
 def load(path):
-    """The scans of the study at `path` (read after study.load accepted the file), or None."""
+    """The scans of the study at `path` (read after study.load accepted the file), or None.
+    Read in a child process bounded as study.load's are (child_read.py): study.load does
+    not read /scan, and a damaged /scan can make HDF5 loop or crash as well."""
+    from . import child_read
+    return child_read.read_in_child(path, lambda: _read_file(path))
+
+
+def _read_file(path):
     from . import study  # the reader; imported here, as study.py imports the sections
     f = study._open(path)
     try:
@@ -258,7 +265,8 @@ def load(path):
             return read(study._Reader(path, f), f)
     except study.StudyError:
         raise
-    except (OSError, KeyError, ValueError, RuntimeError, TypeError, MemoryError) as e:
+    # h5py's errors on a damaged object; MemoryError is the reading child's to name.
+    except (OSError, KeyError, ValueError, RuntimeError, TypeError) as e:
         raise study._error(path, f"damaged or truncated HDF5 file: {study._first_line(e)}") from None
 
 

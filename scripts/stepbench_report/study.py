@@ -8,10 +8,7 @@ attribute, field or dataset is a StudyError naming the file and what is missing.
 Nothing is filled in with a default.
 """
 import ctypes
-import fcntl
 import os
-import pickle
-import signal
 import sys
 from dataclasses import dataclass, field
 
@@ -20,6 +17,7 @@ import numpy as np
 from h5py import h5, h5a, h5d, h5i, h5o, h5p, h5s, h5t
 
 from . import challenge as challenge_section
+from . import child_read
 from . import energy_runs as energy_section
 from . import loop as loop_section
 from . import schema
@@ -73,13 +71,11 @@ STABILITY_ATTRS = ("oscillator", "decay", "adaptive_tolerance", "y_min", "y_max"
 LIMIT_FIELDS = schema.fields("stability_limits")
 STABILITY_TESTS = ("oscillator", "decay")
 
+# Raised by every reader of a study file; defined beside the child that reads it.
+StudyError = child_read.StudyError
+
 # The optional root groups have their own readers: /loop (loop.py), /energy
 # (energy_runs.py), /substeps (substeps.py), /challenge (challenge.py).
-
-
-class StudyError(Exception):
-    """The file is missing, not HDF5, damaged, of another format_version, or lacks
-    something the format requires. The message is one line and names the file."""
 
 
 # One str object for each value: a full study holds some 30000 strings of 450 values,
@@ -525,10 +521,9 @@ READERS = min(2, os.cpu_count() or 1)
 def load(path):
     """The study at `path`, checked; StudyError (one line, naming the file) otherwise.
 
-    HDF5 1.10 trusts sizes stored in the file where h5py cannot check them first (a
-    global heap object's length, an attribute message's size): a damaged file can crash
-    it. So the file is read in child processes, which hand back what they read (or the
-    error) pickled; a child ended by a signal is a damaged file, not a dead report.
+    The file is read in child processes bounded in CPU time and memory (child_read.py): a
+    damaged file can make HDF5 crash, loop or allocate what a damaged length says, and a
+    child that crashed or ran out of its bounds is a damaged file, not a dead or hung report.
     READERS children read at once, each its share of the problems (the bulk of the file;
     Reader.study). Which error a damaged file raises depends on the order it is read in,
     so when a share fails the file is read again by one child, in order, for the error."""
@@ -544,47 +539,9 @@ def load(path):
 def _read_shares(path, shares):
     """Each of the `shares` shares of the study at `path` (or the exception reading it
     raised), read by a child process of its own, all at once."""
-    children = [_start_reader(path, share, shares) for share in range(shares)]
-    return [_finish_reader(path, *child) for child in children]
-
-
-def _start_reader(path, share, shares):
-    """Forks a child that reads share `share` of `shares` of the study at `path` and sends
-    it (or the exception reading it raised) pickled down a pipe; (its pid, the pipe)."""
-    readable, writable = os.pipe()
-    try:  # a full study in a few writes, not the 90 of a pipe's default 64 KiB
-        fcntl.fcntl(writable, fcntl.F_SETPIPE_SZ, 1 << 20)
-    except (AttributeError, OSError):  # not Linux, or above its /proc/sys/fs/pipe-max-size
-        pass
-    pid = os.fork()
-    if pid == 0:
-        os.close(readable)
-        os.dup2(os.open(os.devnull, os.O_WRONLY), 2)  # HDF5's own diagnostics: the error says it
-        try:
-            # The file stays open: the child ends by os._exit, so HDF5 need not spend ~12 ms
-            # closing it (freeing every cached object header) before the parent has the study.
-            result = _read(path, _open(path), share, shares)
-        except Exception as e:  # noqa: BLE001 -- raised again in the parent
-            result = e
-        with os.fdopen(writable, "wb") as out:
-            pickle.dump(result, out, protocol=pickle.HIGHEST_PROTOCOL)
-        os._exit(0)
-    os.close(writable)
-    return pid, readable
-
-
-def _finish_reader(path, pid, readable):
-    """What the child `pid` sent down `readable`; a StudyError if it died before sending it."""
-    with os.fdopen(readable, "rb") as inp:
-        try:  # unpickled as it arrives, while the child is still pickling
-            result = pickle.load(inp)
-        except (EOFError, pickle.UnpicklingError):  # nothing, or not all of it
-            result = None
-    status = os.waitpid(pid, 0)[1]
-    if os.WIFSIGNALED(status) or result is None:
-        end = signal.Signals(os.WTERMSIG(status)).name if os.WIFSIGNALED(status) else f"exit {status >> 8}"
-        return StudyError(f"cannot read study file '{path}': damaged: reading it crashes the HDF5 library ({end})")
-    return result
+    children = [child_read.start(path, lambda share=share: _read(path, _open(path), share, shares))
+                for share in range(shares)]
+    return [child_read.finish(path, *child) for child in children]
 
 
 def _open(path):
@@ -609,12 +566,12 @@ def _read(path, f, share, shares):
         return _Reader(path, f).study(share, shares)
     except StudyError:
         raise
-    except (OSError, KeyError, ValueError, RuntimeError, TypeError, MemoryError) as e:  # h5py's on a damaged object
+    # h5py's errors on a damaged object; MemoryError is the reading child's to name (child_read.py).
+    except (OSError, KeyError, ValueError, RuntimeError, TypeError) as e:
         raise _error(path, f"damaged or truncated HDF5 file: {_first_line(e)}") from None
 
 
-def _error(path, what):
-    return StudyError(f"cannot read study file '{path}': {what}")
+_error = child_read.error
 
 
 TRANSFER_BUFFER = 64 << 10  # bytes

@@ -1,11 +1,17 @@
-"""Shared fixtures: the executables, and two real study files made once per session, a
-plain sweep and a quick timed study (every method, every problem), that the study-file,
-report and benchmark tests all read."""
+"""Shared fixtures: the executables, two real study files made once per session, a plain
+sweep and a quick timed study (every method, every problem), that the study-file, report
+and benchmark tests all read, and the report of each, drawn once per session, that the
+report, scan, challenge and browser tests read."""
 import os
+import re
 import subprocess
 import time
 
 import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+REPORT = os.path.join(ROOT, "scripts", "report")
+PYTHON = "/usr/bin/python3"
 
 # The exit code of a study that was written whole: 0, also where a method failed on a
 # case (a finding, recorded with its reason and summed up on stderr; exit 3 only with
@@ -26,7 +32,8 @@ def pytest_addoption(parser):
 
 @pytest.fixture(scope="session")
 def stepbench(request):
-    return request.config.getoption("--stepbench")
+    # Absolute: some tests run it from a temporary working directory.
+    return os.path.abspath(request.config.getoption("--stepbench"))
 
 
 @pytest.fixture(scope="session")
@@ -53,3 +60,24 @@ def timed_study(bench, tmp_path_factory):
     done = run_study([bench, "--quick", f"--study_out={path}"], capture_output=True, text=True, timeout=300)
     print(f"\nquick timed study: {time.monotonic() - start:.1f} s")  # the figure the README quotes
     return path, done
+
+
+@pytest.fixture(scope="session")
+def reports(plain_study, timed_study, tmp_path_factory):
+    """A report of each study, "plain" and "timed" -> (the study, its report folder), drawn
+    side by side (one figure process each). A whole report takes some 20 s of CPU time to
+    draw, so every test that reads the report of an unchanged study reads these; a test
+    that changes a folder works on a copy."""
+    d = tmp_path_factory.mktemp("report")
+    studies = {"plain": plain_study, "timed": timed_study[0]}
+    procs = {shape: subprocess.Popen([PYTHON, REPORT, str(path), "--out", str(d / shape), "--jobs", "1"],
+                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+             for shape, path in studies.items()}
+    out = {}
+    for shape, proc in procs.items():
+        stdout, stderr = proc.communicate(timeout=120)
+        assert proc.returncode == 0, stderr
+        assert re.search(r"report written in \d+(\.\d+)? s", stdout), stdout
+        assert stderr == "", stderr  # a complete study: no warning
+        out[shape] = (studies[shape], d / shape)
+    return out

@@ -15,38 +15,19 @@ import subprocess
 import h5py
 import numpy as np
 import pytest
-from conftest import run_study
+from conftest import PYTHON, REPORT, ROOT, run_study
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-REPORT = os.path.join(ROOT, "scripts", "report")
-PYTHON = "/usr/bin/python3"
 TARGETS = (1e-2, 1e-4, 1e-6)
 with open(os.path.join(ROOT, "scripts", "stepbench_report", "schema.json")) as _f:
     FORMAT_VERSION = json.load(_f)["format_version"]
 METRIC_TITLES = {"err_pos_final": "by final error", "err_pos_max": "by max error over the run"}
 
 
-def run_report(study, out, jobs=1, cwd=None):
+def run_report(study, out, jobs=2, cwd=None):
+    """scripts/report of `study` into `out`; two figure processes, as the report's own
+    default on two cores: most of a whole report's 20 s is its figures."""
     return subprocess.run([PYTHON, REPORT, str(study), "--out", str(out), "--jobs", str(jobs)], capture_output=True,
                           text=True, cwd=cwd, timeout=120)
-
-
-@pytest.fixture(scope="module")
-def reports(plain_study, timed_study, tmp_path_factory):
-    """A report of each study, drawn side by side (one figure process each)."""
-    d = tmp_path_factory.mktemp("report")
-    studies = {"plain": plain_study, "timed": timed_study[0]}
-    procs = {shape: subprocess.Popen([PYTHON, REPORT, str(path), "--out", str(d / shape), "--jobs", "1"],
-                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-             for shape, path in studies.items()}
-    out = {}
-    for shape, proc in procs.items():
-        stdout, stderr = proc.communicate(timeout=120)
-        assert proc.returncode == 0, stderr
-        assert re.search(r"report written in \d+(\.\d+)? s", stdout), stdout
-        assert stderr == "", stderr  # a complete study: no warning
-        out[shape] = (studies[shape], d / shape)
-    return out
 
 
 # --- reading the outputs ----------------------------------------------------------------------

@@ -12,7 +12,7 @@ import shutil
 import subprocess
 
 import pytest
-from test_report import PYTHON, REPORT
+from conftest import PYTHON, REPORT
 
 WIDTH, HEIGHT = 1400, 900
 CHROMIUM = next((c for c in ("chromium", "chromium-browser", "google-chrome") if shutil.which(c)), None)
@@ -63,14 +63,19 @@ def measure(index):
 
 
 @pytest.fixture(scope="module")
-def pages(plain_study, timed_study, tmp_path_factory):
+def pages(plain_study, timed_study, tmp_path_factory, request):
     """The measurements of the report of each study, the timed one with its figures
-    inlined (--self-contained), and of a report of one problem."""
+    inlined (--self-contained), and of a report of one problem. The plain study's is
+    conftest.py's report, drawn once a session (measured in a copy: measure writes beside
+    index.html)."""
     if CHROMIUM is None:
         pytest.skip("Chromium is not installed (scripts/install-deps.sh installs it)")
     d = tmp_path_factory.mktemp("browser")
     out = {}
-    for shape, study, extra in (("plain", plain_study, []), ("timed", timed_study[0], ["--self-contained"]),
+    plain = d / "plain"
+    shutil.copytree(request.getfixturevalue("reports")["plain"][1], plain)
+    out["plain"] = measure(plain / "index.html")
+    for shape, study, extra in (("timed", timed_study[0], ["--self-contained"]),
                                 ("one problem", plain_study, ["--problem", "pendulum"])):
         folder = d / shape.replace(" ", "_")
         p = subprocess.run([PYTHON, REPORT, str(study), "--out", str(folder), "--jobs", "2"] + extra,

@@ -304,11 +304,20 @@ def test_the_figure_exists_and_fits(challenge_report):
     assert "(b) Small Steps (" not in sec
 
 
-def test_markdown_and_readme_carry_the_verdicts(challenge_study, tmp_path):
-    readme, results = tmp_path / "README.md", tmp_path / "results.md"
+@pytest.fixture(scope="module")
+def challenge_answers(challenge_study, tmp_path_factory):
+    """`scripts/report --markdown results.md --readme README.md` of challenge_study, once:
+    (the finished process, README.md, results.md)."""
+    d = tmp_path_factory.mktemp("challenge_answers")
+    readme, results = d / "README.md", d / "results.md"
     readme.write_text("# project\n\n<!-- results:begin -->\nold\n<!-- results:end -->\n")
     p = subprocess.run([PYTHON, REPORT, str(challenge_study), "--markdown", str(results), "--readme", str(readme)],
                        capture_output=True, text=True, timeout=60)
+    return p, readme, results
+
+
+def test_markdown_and_readme_carry_the_verdicts(challenge_study, challenge_answers):
+    p, readme, results = challenge_answers
     assert p.returncode == 0, p.stderr
     answer = [line for c in ("accuracy", "stability", "speed") for line in verdicts(challenge_study, c)]
     small = verdicts(challenge_study, "small_steps")
@@ -335,15 +344,12 @@ def small_steps_table(doc):
     return caption, head, rows
 
 
-def test_readme_and_markdown_carry_the_small_steps_table(challenge_study, tmp_path):
+def test_readme_and_markdown_carry_the_small_steps_table(challenge_study, challenge_answers):
     """The README block and --markdown carry Small Steps as one table: a row per problem
     and n (1, 4, 16, 64 of the study's n), a column per design, each cell the file's error
     and time a frame ("0.0144 m, 6.74 us", three digits) or "diverged"; implicit Euler's
     one step at n = 1 only."""
-    readme, results = tmp_path / "README.md", tmp_path / "results.md"
-    readme.write_text("# project\n\n<!-- results:begin -->\nold\n<!-- results:end -->\n")
-    p = subprocess.run([PYTHON, REPORT, str(challenge_study), "--markdown", str(results), "--readme", str(readme)],
-                       capture_output=True, text=True, timeout=60)
+    p, readme, results = challenge_answers
     assert p.returncode == 0, p.stderr
     block = readme.read_text()
     with h5py.File(challenge_study, "r") as f:
@@ -385,12 +391,10 @@ def test_readme_and_markdown_carry_the_small_steps_table(challenge_study, tmp_pa
     assert block.index(f"- {lines[-1]}\n") < block.index(caption) < block.index(f"Study `{challenge_study}`")
 
 
-def test_a_study_without_challenge_has_no_such_section(plain_study, tmp_path):
+def test_a_study_without_challenge_has_no_such_section(plain_study, reports, tmp_path):
     with h5py.File(plain_study, "r") as f:
         assert "challenge" not in f  # --quick leaves it out
-    out = tmp_path / "report"
-    p = run_report(plain_study, out)
-    assert p.returncode == 0, p.stderr
+    out = reports["plain"][1]  # drawn once a session (conftest.py), exit 0 checked there
     md = report_text(out)
     assert "pendulum challenge (XPBD" not in md and "Small Steps: substeps against iterations" not in md
     assert not (out / FIGURE).exists()

@@ -22,12 +22,9 @@ def text(v):
 
 
 @pytest.fixture(scope="module")
-def scan_report(plain_study, tmp_path_factory):
-    out = tmp_path_factory.mktemp("scan_report") / "report"
-    p = subprocess.run([PYTHON, REPORT, str(plain_study), "--out", str(out), "--jobs", "2"], capture_output=True,
-                       text=True, timeout=180)
-    assert p.returncode == 0, p.stderr
-    return plain_study, out
+def scan_report(reports):
+    """(the quick study, its report): conftest.py's, drawn once a session."""
+    return reports["plain"]
 
 
 def section(md):

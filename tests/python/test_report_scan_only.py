@@ -42,7 +42,7 @@ def scan_files(stepbench, tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
-def reports(scan_files, tmp_path_factory):
+def scan_reports(scan_files, tmp_path_factory):
     d = tmp_path_factory.mktemp("scan_only_reports")
     out = {}
     for kind, path in scan_files.items():
@@ -68,8 +68,8 @@ def text(v):
 
 
 @pytest.mark.parametrize("kind", ["whole", "partial", "shard"])
-def test_the_page_is_the_scan_alone(reports, kind):
-    path, folder = reports[kind]
+def test_the_page_is_the_scan_alone(scan_reports, kind):
+    path, folder = scan_reports[kind]
     name, attrs, points, root = the_scan(path)
     assert name == "stiff_spring"
     md = report_text(folder)
@@ -116,10 +116,10 @@ def test_the_page_is_the_scan_alone(reports, kind):
 
 
 @pytest.mark.parametrize("kind", ["whole", "partial", "shard"])
-def test_the_overlay_is_named_not_drawn(reports, kind):
+def test_the_overlay_is_named_not_drawn(scan_reports, kind):
     """A scan file's /stability is empty: no red bars, no limit column, and one sentence
     saying what the overlay needs."""
-    path, folder = reports[kind]
+    path, folder = scan_reports[kind]
     with h5py.File(path) as f:
         assert "stability" not in f or len(f["stability/limits"]) == 0
     md = report_text(folder)
@@ -129,22 +129,22 @@ def test_the_overlay_is_named_not_drawn(reports, kind):
     assert "Red bars" not in md
 
 
-def test_the_partial_merge_and_the_shard_say_what_they_lack(reports):
-    _, attrs, points, _ = the_scan(reports["partial"][0])
-    md = report_text(reports["partial"][1])
+def test_the_partial_merge_and_the_shard_say_what_they_lack(scan_reports):
+    _, attrs, points, _ = the_scan(scan_reports["partial"][0])
+    md = report_text(scan_reports["partial"][1])
     grid = int(attrs["grid_points"])
     assert (f"A partial merge (`stepbench merge --partial`): {grid - len(points)} of the grid's {grid} points are "
             f"missing") in md
-    _, attrs, points, _ = the_scan(reports["shard"][0])
-    md = report_text(reports["shard"][1])
+    _, attrs, points, _ = the_scan(scan_reports["shard"][0])
+    md = report_text(scan_reports["shard"][1])
     assert (f"This file is shard {int(attrs['shard_index']) + 1} of {int(attrs['shard_count'])} of the scan "
             f"(`stepbench scan --shard 2/3`): it holds {len(points)} of the grid's {grid} points") in md
 
 
-def test_the_first_failure_is_the_files(reports):
+def test_the_first_failure_is_the_files(scan_reports):
     """The table under the map of the whole scan: the first k_s whose run at one step a
     frame did not complete, per method, as the file's runs say."""
-    path, folder = reports["whole"]
+    path, folder = scan_reports["whole"]
     md = report_text(folder)
     head, rows = md_table(md, next(x for x in md.splitlines() if x.startswith("Where each method stops completing")))
     shown = {r[0]: r[1] for r in rows}
@@ -280,14 +280,14 @@ def test_a_two_axis_scan_has_a_map_per_method(stepbench, tmp_path):
         assert "Stability is judged there" in md
 
 
-def test_the_range_answer_is_stored_and_quoted(scan_files, reports, stepbench):
+def test_the_range_answer_is_stored_and_quoted(scan_files, scan_reports, stepbench):
     """The range answer is computed by stepbench when it writes the scan (`range_answer`),
     equal to what `advise --scan` prints at the scan's tolerance, and the report opens the
     scan's section with it, verbatim; the README's cut keeps the choices and the 60 Hz lines."""
     import sys
     sys.path.insert(0, os.path.join(os.path.dirname(REPORT)))
     from stepbench_report import range_answer as scan_mod
-    path, out = reports["whole"]
+    path, out = scan_reports["whole"]
     with h5py.File(path) as f:
         stored = f["scan/stiff_spring"].attrs["range_answer"]
         stored = stored.decode() if isinstance(stored, bytes) else stored

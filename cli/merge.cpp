@@ -12,6 +12,7 @@
 
 #include "cli/args.hpp"
 #include "cli/commands.hpp"
+#include "parts/part.hpp"
 #include "parts/study.hpp"
 #include "store/bench_merge.hpp"
 #include "store/scan.hpp"
@@ -33,7 +34,7 @@ int run_study_merge(const merge_args& a) {
   // The benchmark JSON is joined once the study merge is checked and built, and written
   // after the study (as stepbench_bench writes them): a refusal writes neither.
   bench_join_result joined;
-  const auto r = merge_studies(a.inputs, a.out, a.partial, [&] {
+  const auto r = merge_studies(a.inputs, a.out, a.partial, merged_groups(), [&] {
     if (a.bench.empty()) return;
     joined = join_bench_json(a.bench, a.inputs);
     check_writable(a.bench_out);

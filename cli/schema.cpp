@@ -5,13 +5,14 @@
 #include <cstdio>
 
 #include "cli/commands.hpp"
+#include "parts/part.hpp"
 
 namespace stepbench::cli {
 
 command add_schema(CLI::App& app) {
   auto* sub = app.add_subcommand("schema", "print the study file's schema (format version, tables, fields) as JSON");
   return {sub, [] {
-            std::fputs(schema::to_json().c_str(), stdout);
+            std::fputs(schema::to_json(parts_tables()).c_str(), stdout);
             return 0;
           }};
 }

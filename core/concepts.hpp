@@ -176,6 +176,9 @@ struct capabilities {
   bool needs_jacobian = false;     // solves with dF/dx, dF/dv (implicit methods)
   bool error_estimate = false;     // estimates its local error (adaptive methods)
   bool dense_output = false;       // interpolates inside its last step
+  // One constraint pass a step on its own particles (XPBD small steps, Macklin et al.
+  // 2019): its dt ladder at a frame is a substep count, judged as such by the verdict.
+  bool small_steps = false;
 };
 
 // The work an integrator reports beyond force evaluations (implicit and adaptive

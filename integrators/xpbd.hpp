@@ -98,7 +98,7 @@ struct xpbd_method {
             .origin = method_origin::ours,
             .declared_order = 1.0,
             .evals_per_step = static_cast<double>(Iterations),
-            .traits = {},
+            .traits = {.small_steps = small_steps},
             .library = "stepbench"};
   }
   template <problem P>

@@ -13,6 +13,7 @@
 #include "core/work_precision.hpp"
 #include "judge/loop.hpp"
 #include "judge/substeps.hpp"
+#include "registry/registry.hpp"
 
 namespace stepbench {
 
@@ -132,9 +133,13 @@ std::vector<std::string> findings_of(const verdict_tables& v, const finding_inpu
   // ladder): the claim that rigid links stay stable at every substep count, and
   // XPBD's projection only removing energy, as the study's own runs show them. The energy
   // is the run's at its end (energy_drift), not its largest excursion: the text says so.
-  {
+  std::vector<std::string> ladder_methods;
+  for (const auto& l : in.small_steps_ladders)
+    if (!contains(ladder_methods, l.method)) ladder_methods.push_back(l.method);
+  for (const auto& method : ladder_methods) {
     std::string parts;
-    for (const auto& [problem, runs] : in.xpbd_ladders) {
+    for (const auto& [m, problem, runs] : in.small_steps_ladders) {
+      if (m != method) continue;
       int ran = 0, completed = 0, diverged = 0, failed = 0;
       double dt_max = 0.0, dt_min = std::numeric_limits<double>::infinity();
       const ladder_run *coarsest = nullptr, *finest = nullptr;  // of the completed runs
@@ -168,10 +173,10 @@ std::vector<std::string> findings_of(const verdict_tables& v, const finding_inpu
     }
     if (!parts.empty())
       out.push_back(fmt::format(
-          "xpbd over its dt ladder (final energy drift: the energy at the run's end against the truth's, of the "
+          "{} over its dt ladder (final energy drift: the energy at the run's end against the truth's, of the "
           "problem's energy scale, at the coarsest and the finest completed dt and the largest over the completed; "
           "|C|/L: the largest relative length error of a rigid link, the stretch of a spring, over the run): {}.",
-          parts));
+          method, parts));
   }
   // Stability at 60 Hz, one step a frame.
   {
@@ -193,25 +198,44 @@ std::vector<std::string> findings_of(const verdict_tables& v, const finding_inpu
   return out;
 }
 
+namespace {
+const method_info* registered(std::string_view name) {
+  const auto& all = all_methods();
+  const auto it = std::find_if(all.begin(), all.end(), [&](const method_info& m) { return m.name == name; });
+  return it == all.end() ? nullptr : &*it;  // a file may hold a method this build lacks
+}
+}  // namespace
+
+bool is_first_order_pair(const substep_verdict& sv) {
+  const method_info* im = registered(sv.implicit_method);
+  const method_info* em = registered(sv.explicit_method);
+  return im && em && im->declared_order == 1.0 && im->traits.needs_jacobian && !im->traits.symplectic &&
+         em->declared_order == 1.0 && em->traits.symplectic && !em->traits.needs_jacobian;
+}
+
+bool judges_ladder_as_substeps(std::string_view method) {
+  const method_info* m = registered(method);
+  return m && m->traits.small_steps;
+}
+
 finding_inputs finding_inputs_of(const study& s) {
   finding_inputs in;
   for (const auto& st : s.results.get<std::vector<substep_study>>())
     for (const auto& sv : substep_verdicts(st, s.timed.has_value()))
-      if (sv.implicit_method == "implicit_euler" && sv.explicit_method == "semi_implicit_euler")
-        in.substeps.push_back({st.problem, st.frame_dt, sv});
+      if (is_first_order_pair(sv)) in.substeps.push_back({st.problem, st.frame_dt, sv});
   for (const auto& ps : s.problems)
     for (const auto& ms : ps.methods)
       if (ms.info.origin == method_origin::peer && ms.declared_order_holds == 0)
         in.broken_orders[ms.info.name].insert(std::string(ps.problem->name()));
   for (const auto& ps : s.problems)
     for (const auto& ms : ps.methods) {
-      if (ms.info.name != "xpbd") continue;
-      ladder_finding f{std::string(ps.problem->name()), {}};
+      if (!ms.info.traits.small_steps) continue;
+      ladder_finding f{ms.info.name, std::string(ps.problem->name()), {}};
       for (const auto& r : ms.rows) {
         const auto& m = r.metrics;
         f.runs.push_back({r.param, m.diverged, m.failed, m.skipped, m.energy_drift, m.constraint_violation_max});
       }
-      in.xpbd_ladders.push_back(std::move(f));
+      in.small_steps_ladders.push_back(std::move(f));
     }
   return in;
 }

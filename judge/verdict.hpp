@@ -15,6 +15,12 @@ inline constexpr const char* verdict_metric = "err_pos_max";
 verdict_tables compute_verdict(const study& s);
 
 finding_inputs finding_inputs_of(const study& s);
+// The substep pair the findings quote: the lecture's backward Euler (implicit, first
+// order, not symplectic) against symplectic Euler (explicit, first order), picked by
+// their registry entries' order and capabilities, not their names.
+bool is_first_order_pair(const substep_verdict& sv);
+// A method whose dt ladder the findings judge as substeps (capabilities::small_steps).
+bool judges_ladder_as_substeps(std::string_view method);
 std::vector<std::string> findings_of(const verdict_tables& v, const finding_inputs& in);
 
 // The problem named `name` in the study's sweep, or nullptr.

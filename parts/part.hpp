@@ -19,9 +19,13 @@
 // keeps it in `results`, keyed by that type) and one line of parts/registry.cpp;
 // docs/analyses.md shows one.
 #include <functional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "store/merge.hpp"
+#include "store/schema.hpp"
 
 namespace H5 {
 class Group;
@@ -31,14 +35,6 @@ namespace stepbench {
 
 struct study;
 struct sweep_options;
-
-// How the shards of a study (sweep --shard K/N) hold a part, and so how merge joins it.
-enum class merge_rule {
-  per_problem,          // one child a problem, in the shard that ran the problem
-  same_in_every_shard,  // computed from the build, not the problems: the first shard's
-  in_one_shard,         // each child (a scan, the challenge) in the one shard whose problem it is
-  judged_again,         // joined in the study's order, its answers judged again on the whole
-};
 
 // What a part's run gets besides the study: the problems of this run (the selection, or
 // its shard's share), and where its progress and warnings go.
@@ -51,8 +47,14 @@ struct part_context {
 
 struct study_part {
   std::string_view name;
-  std::string_view summary;  // what it answers, one line (`stepbench list --parts`)
-  merge_rule merge = merge_rule::per_problem;
+  std::string_view summary;                    // what it answers, one line (`stepbench list --parts`)
+  std::string_view group;                      // its group under the file's root ("problems", "scan", ...)
+  merge_rule merge = merge_rule::per_problem;  // how the shards of a study hold it (store/merge.hpp)
+  // judged_again: what spans problems, judged again on the merged file.
+  void (*judge_again)(H5::Group& root, const std::vector<std::string>& problems) = nullptr;
+  // The tables it writes that store/schema.cpp does not declare: a part's own, declared in
+  // its file (`stepbench schema` lists them; merge joins a judged_again part's by them).
+  std::span<const schema::table> tables = {};
   std::string (*describe)(const sweep_options&) = nullptr;
   void (*run)(study&, const part_context&) = nullptr;
   void (*judge)(study&) = nullptr;  // nullptr: nothing to judge
@@ -64,6 +66,10 @@ std::string list_or_all(const std::vector<std::string>& names);
 
 // Every part, in the study's order.
 const std::vector<study_part>& study_parts();
+// Their groups of the study file and how merge joins each, in the same order.
+std::vector<merged_group> merged_groups();
+// The tables the parts declare in their own files (study_part::tables), in their order.
+std::vector<const schema::table*> parts_tables();
 // Throws std::invalid_argument naming the unknown part and the known ones.
 const study_part& find_part(std::string_view name);
 // The parts `opts` selects (opts.parts, or every part), in the study's order.

@@ -13,7 +13,7 @@
 namespace stepbench {
 
 extern const study_part sweep_part, stability_part, substeps_part, frame_rates_part, loop_part, energy_part, scans_part,
-    challenge_part, verdict_part;
+    challenge_part, work_per_step_part, verdict_part;
 
 std::string list_or_all(const std::vector<std::string>& names) {
   return names.empty() ? std::string("all") : fmt::format("{}", fmt::join(names, ","));
@@ -21,17 +21,31 @@ std::string list_or_all(const std::vector<std::string>& names) {
 
 const std::vector<study_part>& study_parts() {
   static const std::vector<study_part> parts{
-      sweep_part,        // /problems: every method on every problem over its ladder
-      stability_part,    // /stability: our steps' stability limits and regions
-      substeps_part,     // /substeps: an implicit step against explicit substeps, a frame
-      frame_rates_part,  // /frame_rates: our fixed-step methods at whole frames of 30 .. 240 Hz
-      loop_part,         // /loop: the game loop around the integrator, as the player sees it
-      energy_part,       // /energy: energy over 10^4 periods
-      scans_part,        // /scan: a scene's whole parameter range
-      challenge_part,    // /challenge: the pendulum challenge and Small Steps
-      verdict_part,      // /verdict: the answer, judged from all the above
+      sweep_part,          // /problems: every method on every problem over its ladder
+      stability_part,      // /stability: our steps' stability limits and regions
+      substeps_part,       // /substeps: an implicit step against explicit substeps, a frame
+      frame_rates_part,    // /frame_rates: our fixed-step methods at whole frames of 30 .. 240 Hz
+      challenge_part,      // /challenge: the pendulum challenge and Small Steps
+      energy_part,         // /energy: energy over 10^4 periods
+      loop_part,           // /loop: the game loop around the integrator, as the player sees it
+      scans_part,          // /scan: a scene's whole parameter range
+      work_per_step_part,  // /work_per_step: counted force evaluations a step against the declared
+      verdict_part,        // /verdict: the answer, judged from all the above
   };
   return parts;
+}
+
+std::vector<merged_group> merged_groups() {
+  std::vector<merged_group> out;
+  for (const auto& p : study_parts()) out.push_back({p.group, p.merge, p.judge_again, p.tables});
+  return out;
+}
+
+std::vector<const schema::table*> parts_tables() {
+  std::vector<const schema::table*> out;
+  for (const auto& p : study_parts())
+    for (const auto& t : p.tables) out.push_back(&t);
+  return out;
 }
 
 const study_part& find_part(std::string_view name) {

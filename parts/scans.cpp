@@ -67,6 +67,7 @@ extern const study_part scans_part{
     .name = "scans",
     .summary =
         "over a scene's parameter range: the cheapest method and substeps within tolerance, and where each breaks",
+    .group = "scan",
     .merge = merge_rule::in_one_shard,
     .describe = describe,
     .run = run,

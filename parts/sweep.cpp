@@ -67,6 +67,7 @@ void write(H5::Group& root, const study& s) { write_problems(root, s); }
 extern const study_part sweep_part{
     .name = "sweep",
     .summary = "every method on every problem over its dt or tolerance ladder, measured against the truth",
+    .group = "problems",
     .merge = merge_rule::per_problem,
     .describe = describe,
     .run = run,

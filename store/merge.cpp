@@ -160,7 +160,7 @@ std::pair<std::string, std::string> first_difference(const std::string& a, const
 // A study-level table (/verdict/<name>), a row per problem, joined from the shards in the
 // study's problem order, each problem's rows in its shard's order; fields by the schema.
 void join_table(const std::vector<shard_file>& shards, H5::Group& dst, const std::string& where,
-                const std::string& name, const std::string& schema_name, const std::vector<std::string>& order) {
+                const std::string& name, const schema::table& spec, const std::vector<std::string>& order) {
   std::vector<h5::table_data> parts;
   for (const auto& s : shards) parts.push_back(h5::read_table(s.file.openDataSet(where + "/" + name)));
   std::map<std::string, std::size_t> rank;
@@ -179,7 +179,6 @@ void join_table(const std::vector<shard_file>& shards, H5::Group& dst, const std
   std::stable_sort(rows.begin(), rows.end(),
                    [](const auto& a, const auto& b) { return std::get<0>(a) < std::get<0>(b); });
   h5::table t;
-  const auto& spec = schema::find(schema_name);
   for (const auto& group : spec.groups) {
     if (group.timed_only && !parts.front().has(std::string(group.fields.front().name))) continue;
     for (const auto& f : group.fields) {
@@ -224,8 +223,27 @@ void join_table(const std::vector<shard_file>& shards, H5::Group& dst, const std
   t.write(dst, name, spec);
 }
 
-// The groups whose children are problems, each copied from the shard that ran it.
-constexpr const char* per_problem_groups[] = {"problems", "substeps", "frame_rates", "energy", "loop"};
+// A group whose children are problems: each copied from the shard that ran it, in the
+// study's order; the group's own attributes from the first shard that has it, its
+// wall_seconds summed.
+void merge_per_problem(const std::vector<const shard_file*>& having, H5::H5File& dst, const std::string& top,
+                       const std::vector<std::string>& problems,
+                       const std::map<std::string, const shard_file*>& owner) {
+  H5::Group g = dst.createGroup(top);
+  const H5::Group src = having.front()->file.openGroup(top);
+  copy_attrs(src, g);
+  if (has_attr(src, "wall_seconds")) {
+    double sum = 0.0;
+    for (const auto* s : having) sum += h5::double_attr(s->file.openGroup(top), "wall_seconds");
+    replace_attr(g, "wall_seconds", sum);
+  }
+  for (const auto& p : problems)
+    if (const auto& s = *owner.at(p); h5::is_group(s.file, top + "/" + p)) copy_object(s.file, dst, top + "/" + p);
+  for (const auto* s : having)
+    for (const auto& child : h5::children(s->file.openGroup(top)))
+      if (!owner.count(child) || owner.at(child) != s)
+        throw std::runtime_error(fmt::format("'{}': /{}/{} is not one of its problems", s->path, top, child));
+}
 
 std::string machine_of(const H5::Group& g) {
   return fmt::format("{} ({} cores)", h5::string_attr(g, "cpu"), h5::long_attr(g, "cores"));
@@ -250,7 +268,7 @@ bool is_study_file(const std::string& path) {
 held_shards held_shards_of(const std::string& path) { return read_shard(path).held; }
 
 study_merge_result merge_studies(const std::vector<std::string>& paths, const std::string& out, bool partial,
-                                 const std::function<void()>& before_write) {
+                                 const std::vector<merged_group>& groups, const std::function<void()>& before_write) {
   H5::Exception::dontPrint();
   std::vector<shard_file> shards;
   for (const auto& path : paths) shards.push_back(read_shard(path));
@@ -339,58 +357,45 @@ study_merge_result merge_studies(const std::vector<std::string>& paths, const st
     replace_attr(dst, "wall_seconds", wall);
     if (has_attr(dst, "benchmark_wall_seconds")) replace_attr(dst, "benchmark_wall_seconds", bench_wall);
     replace_attr(dst, "created_utc", utc_now_iso8601());
-    // Identical in every shard of one build: the first's.
-    if (h5::is_group(first.file, "stability")) copy_object(first.file, dst, "stability");
-    // Each problem's parts from the shard that ran it, in the study's order; the groups'
-    // own attributes from the first shard that has them, their wall_seconds summed.
-    for (const char* top : per_problem_groups) {
+    // Each part's group by its rule, in the study's order.
+    for (const merged_group& part : groups) {
+      const std::string top(part.name);
       std::vector<const shard_file*> having;
       for (const auto& s : shards)
         if (h5::is_group(s.file, top)) having.push_back(&s);
       if (having.empty()) continue;
-      H5::Group g = dst.createGroup(top);
-      const H5::Group src = having.front()->file.openGroup(top);
-      copy_attrs(src, g);
-      if (has_attr(src, "wall_seconds")) {
-        double sum = 0.0;
-        for (const auto* s : having) sum += h5::double_attr(s->file.openGroup(top), "wall_seconds");
-        replace_attr(g, "wall_seconds", sum);
-      }
-      for (const auto& p : result.problems) {
-        const auto& s = *owner.at(p);
-        if (h5::is_group(s.file, std::string(top) + "/" + p)) copy_object(s.file, dst, std::string(top) + "/" + p);
-      }
-      for (const auto* s : having)
-        for (const auto& child : h5::children(s->file.openGroup(top)))
-          if (!owner.count(child) || owner.at(child) != s)
-            throw std::runtime_error(fmt::format("'{}': /{}/{} is not one of its problems", s->path, top, child));
-    }
-    // The scans (each of one problem, so of one shard) and the challenge (with n_pendulum).
-    for (const auto& s : shards) {
-      if (h5::is_group(s.file, "scan")) {
-        if (!h5::is_group(dst, "scan")) dst.createGroup("scan");
-        for (const auto& name : h5::children(s.file.openGroup("scan"))) {
-          if (h5::has_link(dst.openGroup("scan"), name))
-            throw std::invalid_argument(fmt::format("merge: scan '{}' is in two shards (overlapping shards)", name));
-          copy_object(s.file, dst, "scan/" + name);
+      switch (part.rule) {
+        case merge_rule::same_in_every_shard:  // identical in every shard of one build: the first's
+          copy_object(having.front()->file, dst, top);
+          break;
+        case merge_rule::per_problem:
+          merge_per_problem(having, dst, top, result.problems, owner);
+          break;
+        case merge_rule::in_one_shard: {
+          H5::Group g = dst.createGroup(top);
+          copy_attrs(having.front()->file.openGroup(top), g);
+          for (const auto* s : having)
+            for (const auto& name : h5::children(s->file.openGroup(top))) {
+              if (h5::has_link(g, name))
+                throw std::invalid_argument(
+                    fmt::format("merge: {} '{}' is in two shards (overlapping shards)", top, name));
+              copy_object(s->file, dst, top + "/" + name);
+            }
+          break;
+        }
+        case merge_rule::judged_again: {
+          H5::Group g = dst.createGroup(top);
+          copy_attrs(having.front()->file.openGroup(top), g);
+          std::vector<const schema::table*> tables;
+          for (const auto& t : schema::tables()) tables.push_back(&t);
+          for (const auto& t : part.tables) tables.push_back(&t);
+          for (const auto* table : tables)
+            if (table->where.starts_with("/" + top + "/"))
+              join_table(shards, g, top, std::string(table->where.substr(top.size() + 2)), *table, selection);
+          if (part.judge_again) part.judge_again(dst, result.problems);
+          break;
         }
       }
-      if (h5::is_group(s.file, "challenge")) {
-        if (h5::is_group(dst, "challenge"))
-          throw std::invalid_argument("merge: the challenge is in two shards (overlapping shards)");
-        copy_object(s.file, dst, "challenge");
-      }
-    }
-    // The verdict: its tables joined in the study's order, its findings generated again.
-    {
-      H5::Group g = dst.createGroup("verdict");
-      copy_attrs(first.file.openGroup("verdict"), g);
-      join_table(shards, g, "verdict", "equal_error", "verdict_equal_error", selection);
-      join_table(shards, g, "verdict", "frame_rate", "verdict_frame_rate", selection);
-      join_table(shards, g, "verdict", "frame_answer", "verdict_frame_answer", selection);
-      const verdict_tables v = read_verdict(dst);
-      const auto findings = findings_of(v, read_finding_inputs(dst, result.problems));
-      replace_attr(g, "findings", fmt::format("{}", fmt::join(findings, "\n")));
     }
     // The machines: each problem records its own; the root names every CPU model when
     // the shards ran on more than one.

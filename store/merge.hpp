@@ -1,19 +1,43 @@
 #pragma once
 // Joining the shards of a study (`stepbench sweep --shard K/N`, `stepbench_bench
-// --shard=K/N`; issue 20) into the study file an unsharded run writes. Each part of a
-// study belongs to one problem (its /problems, /substeps, /frame_rates, /energy and /loop
-// groups, its scans, the challenge with n_pendulum) and is copied whole from the shard that
-// ran the problem; /stability, the same in every shard, from the first; the /verdict tables,
-// a row per problem, are joined in the study's problem order, and the findings, which span
-// problems, are generated again from the joined file by the code that wrote them
-// (study/verdict.hpp). A timed study keeps the machine of each problem on /problems/<p>.
+// --shard=K/N`; issue 20) into the study file an unsharded run writes. Each part of the
+// study (parts/part.hpp) names its group of the file and how its shards hold it (its
+// merge_rule); merge walks that list in the study's order. A timed study keeps the
+// machine of each problem on /problems/<p>.
 #include <cstddef>
 #include <functional>
+#include <span>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
+#include "store/schema.hpp"
+
+namespace H5 {
+class Group;
+}
+
 namespace stepbench {
+
+// How the shards of a study hold a part's group, and so how merge joins it.
+enum class merge_rule {
+  per_problem,          // a child a problem, copied from the shard that ran the problem
+  same_in_every_shard,  // computed from the build, not the problems: the first shard's
+  in_one_shard,         // each child (a scan, a table of the challenge) from the one shard that holds it
+  judged_again,         // its tables (a row a problem) joined in the study's order, then judged again
+};
+
+// A part's group of the study file, as merge joins it.
+struct merged_group {
+  std::string_view name;  // under the root: "problems", "stability", "scan", "verdict", ...
+  merge_rule rule = merge_rule::per_problem;
+  // judged_again: what spans the problems, judged again on the merged file (`root`,
+  // every group joined) for the problems it holds, in the study's order.
+  void (*judge_again)(H5::Group& root, const std::vector<std::string>& problems) = nullptr;
+  // judged_again: its tables beyond store/schema.cpp's (the part's own).
+  std::span<const schema::table> tables = {};
+};
 
 // True when the file is a study written by a sweep (it has the root attribute `selection`);
 // false for a file of scans alone (`stepbench scan`, a merge of scan shards). Throws
@@ -49,7 +73,9 @@ struct study_merge_result {
 // holds (`merged_shards`), so a later merge with the missing shards completes the study.
 // `before_write`, when given, runs once the merge is checked and built, before anything
 // is written: what it throws leaves `out` as it was.
+// `groups` are the study's parts' groups in its order (parts/study.hpp merged_groups).
 study_merge_result merge_studies(const std::vector<std::string>& paths, const std::string& out, bool partial,
+                                 const std::vector<merged_group>& groups,
                                  const std::function<void()>& before_write = {});
 
 }  // namespace stepbench

@@ -255,14 +255,18 @@ const table& find(std::string_view name) {
   throw std::logic_error("the study schema has no table named " + std::string(name));
 }
 
-std::string to_json() {
+std::string to_json(std::span<const table* const> own) {
   nlohmann::ordered_json out;
   out["format_version"] = format_version;
   out["row_incomplete_flags"] = row_incomplete_flags;
   for (const auto k : {method_kind::fixed_step, method_kind::adaptive})
     out["param_kind"][std::string(to_string(k))] = param_name(k);
   out["parameter_kinds"] = {"real", "whole", "named"};
-  for (const auto& t : all_tables) {
+  std::vector<const table*> every;
+  for (const auto& t : all_tables) every.push_back(&t);
+  every.insert(every.end(), own.begin(), own.end());
+  for (const table* tp : every) {
+    const table& t = *tp;
     nlohmann::ordered_json groups = nlohmann::ordered_json::array();
     for (const auto& g : t.groups) {
       nlohmann::ordered_json fields = nlohmann::ordered_json::array();

@@ -45,7 +45,8 @@ const table& find(std::string_view name);
 // (core/measure.hpp's row_completed is the same rule in C++).
 inline constexpr std::array<std::string_view, 3> row_incomplete_flags{"diverged", "failed", "skipped"};
 
-// The whole schema as JSON text (`stepbench schema`; scripts/stepbench_report/schema.json).
-std::string to_json();
+// The whole schema as JSON text (`stepbench schema`; scripts/stepbench_report/schema.json):
+// these tables, then `own`, those a study part declares in its own file (parts/part.hpp).
+std::string to_json(std::span<const table* const> own = {});
 
 }  // namespace stepbench::schema

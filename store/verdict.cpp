@@ -26,12 +26,13 @@ finding_inputs read_finding_inputs(const H5::Group& root, const std::vector<std:
                  ec = t.doubles("explicit_cost"), ee = t.doubles("explicit_error"), ed = t.doubles("explicit_damping"),
                  ctm = t.doubles("cost_to_match");
       const auto &at_cost = t.ints("substeps_at_equal_cost"), &to_match = t.ints("substeps_to_match");
-      for (std::size_t i = 0; i < t.rows(); ++i)
-        if (im[i] == "implicit_euler" && em[i] == "semi_implicit_euler")
-          in.substeps.push_back(
-              {p, frame_dt,
-               substep_verdict{p, im[i], em[i], kind[i], ic[i], ie[i], id[i], static_cast<int>(at_cost[i]), ec[i],
-                               ee[i], ed[i], static_cast<int>(to_match[i]), ctm[i], summary[i]}});
+      for (std::size_t i = 0; i < t.rows(); ++i) {
+        substep_verdict sv{p,      im[i],     em[i], kind[i],
+                           ic[i],  ie[i],     id[i], static_cast<int>(at_cost[i]),
+                           ec[i],  ee[i],     ed[i], static_cast<int>(to_match[i]),
+                           ctm[i], summary[i]};
+        if (is_first_order_pair(sv)) in.substeps.push_back({p, frame_dt, std::move(sv)});
+      }
     }
     if (h5::is_group(root, "problems/" + p + "/methods")) {
       const H5::Group methods = root.openGroup("problems/" + p + "/methods");
@@ -40,21 +41,29 @@ finding_inputs read_finding_inputs(const H5::Group& root, const std::vector<std:
         if (h5::string_attr(g, "origin") == "peer" && h5::long_attr(g, "declared_order_holds") == 0)
           in.broken_orders[m].insert(p);
       }
-      if (h5::is_group(methods, "xpbd")) {
-        const auto t = h5::read_table(methods.openGroup("xpbd").openDataSet("runs"));
+      for (const auto& m : h5::children(methods)) {
+        if (!judges_ladder_as_substeps(m)) continue;
+        const auto t = h5::read_table(methods.openGroup(m).openDataSet("runs"));
         const auto dt = t.doubles("param"), drift = t.doubles("energy_drift");
         // A study written before the field reads as NaN (as study_reader.cpp does).
         const auto constraint = t.has("constraint_violation_max") ? t.doubles("constraint_violation_max")
                                                                   : std::vector<double>(t.rows(), nan);
         const auto &diverged = t.ints("diverged"), &failed = t.ints("failed"), &skipped = t.ints("skipped");
-        ladder_finding f{p, {}};
+        ladder_finding f{m, p, {}};
         for (std::size_t i = 0; i < t.rows(); ++i)
           f.runs.push_back({dt[i], diverged[i] != 0, failed[i] != 0, skipped[i] != 0, drift[i], constraint[i]});
-        in.xpbd_ladders.push_back(std::move(f));
+        in.small_steps_ladders.push_back(std::move(f));
       }
     }
   }
   return in;
+}
+
+void judge_findings_again(H5::Group& root, const std::vector<std::string>& problems) {
+  const auto findings = findings_of(read_verdict(root), read_finding_inputs(root, problems));
+  H5::Group g = root.openGroup("verdict");
+  if (g.attrExists("findings")) g.removeAttr("findings");
+  h5::attr(g, "findings", fmt::format("{}", fmt::join(findings, "\n")));
 }
 
 void write_verdict(H5::Group& root, const study& s) {

@@ -19,11 +19,16 @@ void write_frame_rates(H5::Group& root, const study& s);
 verdict_tables read_verdict(const std::string& path);
 verdict_tables read_verdict(const H5::Group& root);  // the file's root; errors without the path
 
-// From a study file's /substeps/<p>/verdict and /problems/<p>/methods, for `problems` in
-// that order.
 // A problem's frame-rate runs (/frame_rates/<problem>) and the verdict's cost kind.
 // Throws std::invalid_argument for a problem the file lacks (naming what it has) and
 // std::runtime_error when the file cannot be read.
 frame_rate_runs read_frame_rate_runs(const std::string& path, const std::string& problem);
+// From a study file's /substeps/<p>/verdict and /problems/<p>/methods, for `problems` in
+// that order.
 finding_inputs read_finding_inputs(const H5::Group& root, const std::vector<std::string>& problems);
+
+// The findings, which span problems, judged again from a merged file's joined tables
+// (/verdict's attribute `findings`): merge's judged_again for the verdict part.
+void judge_findings_again(H5::Group& root, const std::vector<std::string>& problems);
+
 }  // namespace stepbench

@@ -84,13 +84,14 @@ struct ladder_run {
   double energy_drift = 0.0, constraint_violation = 0.0;
 };
 struct ladder_finding {
+  std::string method;  // a method with capabilities::small_steps (xpbd)
   std::string problem;
   std::vector<ladder_run> runs;
 };
 struct finding_inputs {
   std::vector<substep_finding> substeps;                       // in the study's problem order
   std::map<std::string, std::set<std::string>> broken_orders;  // peer -> problems where its declared order fails
-  std::vector<ladder_finding> xpbd_ladders;                    // in the study's problem order
+  std::vector<ladder_finding> small_steps_ladders;             // in the study's problem order
 };
 // Two studies' equal-error verdicts side by side (`stepbench compare`): over the
 // (problem, target) pairs where both say "ahead" or "behind", how many agree and which

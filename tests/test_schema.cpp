@@ -66,7 +66,7 @@ TEST(schema, the_json_is_the_declaration) {
   EXPECT_EQ(j["param_kind"]["fixed_step"], "dt");
   EXPECT_EQ(j["param_kind"]["adaptive"], "tolerance");
   EXPECT_EQ(j["row_incomplete_flags"].size(), 3u);
-  EXPECT_EQ(j["tables"].size(), schema::tables().size());
+  EXPECT_EQ(j["tables"].size(), schema::tables().size());  // the parts' own tables: `stepbench schema`
   const auto& runs = j["tables"]["runs"]["groups"];
   EXPECT_EQ(runs[0]["fields"][0][0], "param");
   EXPECT_TRUE(runs[1]["timed_only"].get<bool>());

@@ -346,15 +346,16 @@ TEST(sweep, xpbd_finding_counts_diverged_failed_and_skipped_runs) {
   EXPECT_EQ(xpbd_finding(), "");
   const double nan = std::numeric_limits<double>::quiet_NaN();
   // dt, diverged, failed, skipped, energy_drift, constraint_violation
-  in.xpbd_ladders.push_back({"rope",
-                             {{0.1, true, true, false, nan, nan},
-                              {0.05, false, true, false, nan, nan},
-                              {0.025, false, false, false, -0.5, 0.25},
-                              {0.0125, false, false, false, 0.1, 0.0625},
-                              {0.00625, false, false, false, -0.25, 0.03125},
-                              {0.003125, false, false, true, 0.0, 0.0}}});
-  in.xpbd_ladders.push_back({"skipped", {{0.1, false, false, true, 0.0, 0.0}}});
-  in.xpbd_ladders.push_back({"merged", {{0.1, false, false, false, nan, nan}}});
+  in.small_steps_ladders.push_back({"xpbd",
+                                    "rope",
+                                    {{0.1, true, true, false, nan, nan},
+                                     {0.05, false, true, false, nan, nan},
+                                     {0.025, false, false, false, -0.5, 0.25},
+                                     {0.0125, false, false, false, 0.1, 0.0625},
+                                     {0.00625, false, false, false, -0.25, 0.03125},
+                                     {0.003125, false, false, true, 0.0, 0.0}}});
+  in.small_steps_ladders.push_back({"xpbd", "skipped", {{0.1, false, false, true, 0.0, 0.0}}});
+  in.small_steps_ladders.push_back({"xpbd", "merged", {{0.1, false, false, false, nan, nan}}});
   EXPECT_EQ(xpbd_finding().substr(xpbd_finding().find("): ") + 3),
             "rope completed 3 of the 5 dt it ran (100 ms to 6.25 ms), diverged at 1, failed at 1, final energy drift "
             "-0.5 at 25 ms and -0.25 at 6.25 ms (largest 0.1), |C|/L within 0.25; merged completed 1 of the 1 dt it "
@@ -515,4 +516,25 @@ TEST(sweep_shard, four_problems_in_three_shards) {
   EXPECT_EQ(sweep_shard(opts, 0, 3), std::vector<std::string>{"projectile"}) << costs;
   EXPECT_EQ(sweep_shard(opts, 1, 3), std::vector<std::string>{"damped_spring"}) << costs;
   EXPECT_EQ(sweep_shard(opts, 2, 3), (std::vector<std::string>{"constant_acceleration", "pendulum"})) << costs;
+}
+
+// The findings pick their methods by the registry's orders and capabilities, not by
+// name: the substep finding quotes backward Euler (implicit, first order, not
+// symplectic) against symplectic Euler; the ladder finding judges the small-steps XPBD.
+TEST(sweep, findings_pick_their_methods_by_capability) {
+  const auto pair = [](std::string implicit, std::string explicit_) {
+    substep_verdict sv;
+    sv.implicit_method = std::move(implicit);
+    sv.explicit_method = std::move(explicit_);
+    return is_first_order_pair(sv);
+  };
+  EXPECT_TRUE(pair("implicit_euler", "semi_implicit_euler"));
+  EXPECT_FALSE(pair("implicit_midpoint", "semi_implicit_euler"));  // second order
+  EXPECT_FALSE(pair("implicit_euler", "velocity_verlet"));         // second order
+  EXPECT_FALSE(pair("implicit_euler", "xpbd"));                    // not symplectic by its traits
+  EXPECT_FALSE(pair("implicit_euler", "no_such_method"));          // a file's method this build lacks
+  EXPECT_TRUE(judges_ladder_as_substeps("xpbd"));
+  EXPECT_FALSE(judges_ladder_as_substeps("xpbd_iterations"));  // ten passes a step
+  EXPECT_FALSE(judges_ladder_as_substeps("semi_implicit_euler"));
+  EXPECT_FALSE(judges_ladder_as_substeps("no_such_method"));
 }

@@ -6,7 +6,7 @@ Mueller's challenge (Ten Minute Physics, 2022): XPBD with 50 substeps a 60 Hz fr
 whole steps a frame whose measured time is at most xpbd's (an adaptive method: the
 tightest of the tolerances 1e-1, 1e-2, ... whose time is). Every number is the study
 file's: the errors, the times, the interpolated time at xpbd's error and the verdict
-lines were computed by stepbench (study/challenge.cpp); the lines are printed verbatim.
+lines were computed by stepbench (run/challenge.cpp); the lines are printed verbatim.
 The only arithmetic here is a unit: nanoseconds shown in microseconds."""
 from dataclasses import dataclass
 

@@ -7,7 +7,7 @@ loop (a damaged B-tree) or make it allocate what a damaged length says. So the r
 runs in a forked child, which hands back what it read (or the exception) pickled down a
 pipe; a child that crashed or ran out of its bounds is a damaged file: a StudyError of
 one line naming the file, not a dead or hung report. The bounds are the C++ reader's
-(study/study_reader.cpp): a whole study reads in about a second of CPU time and a few
+(store/study_reader.cpp): a whole study reads in about a second of CPU time and a few
 hundred MB, so past them the file is damaged.
 
 A leaf of the package: the modules that read a file import it, it imports none of them.

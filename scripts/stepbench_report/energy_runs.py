@@ -1,7 +1,7 @@
 """The long-run energy section of the report: /energy as stored (docs/study-format.md),
 its figure (relative energy error against time on a log time axis, one panel per
 problem) and its table. Every number is the study file's: the largest error, the drift
-per period, the verdict and its sign were computed by stepbench (study/energy.cpp)."""
+per period, the verdict and its sign were computed by stepbench (run/energy.cpp)."""
 from dataclasses import dataclass
 
 import numpy as np

@@ -1,7 +1,7 @@
 """The game-loop section of the report: /loop as stored (docs/study-format.md), its
 figure (shown error against display rate, one panel per problem and design) and its
 tables. Every number is the study file's: the errors, lags and verdicts, the cheapest
-design and the cost verdict were computed by stepbench (study/loop.cpp)."""
+design and the cost verdict were computed by stepbench (run/loop.cpp)."""
 from dataclasses import dataclass
 
 import numpy as np

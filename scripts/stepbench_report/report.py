@@ -200,15 +200,35 @@ def document(study, figs, whole=True, scans=None):
     for p in study.problems:
         _problem(doc, study, p, figs)
     if whole:
-        _stability(doc, study, figs)
-        substeps_section.section(doc, study, figs)
-        challenge_section.section(doc, study, figs)  # nothing for a study without /challenge
-        _energy(doc, study, figs)
-        loop_section.section(doc, study, figs)
-        scan_section.section(doc, study, figs, scans)  # nothing for a study without /scan
+        if study.attrs.get("parts") and (skipped := [p for p in STUDY_SECTIONS if p not in study.attrs["parts"]]):
+            doc.note(f"Not in this study (it ran the parts {', '.join(study.attrs['parts'])}): "
+                     f"{', '.join(skipped)}; `stepbench list` names every part, `--parts` selects them.")
+        for part in study_section_order(study):
+            STUDY_SECTIONS[part](doc, study, figs, scans)  # each draws nothing for a part the file lacks
     _how_made(doc, study)
     _metadata(doc, study)
     return doc
+
+
+# The study-wide sections, by the study part (parts/registry.cpp) whose group each draws.
+STUDY_SECTIONS = {
+    "stability": lambda doc, study, figs, scans: _stability(doc, study, figs),
+    "substeps": lambda doc, study, figs, scans: substeps_section.section(doc, study, figs),
+    "loop": lambda doc, study, figs, scans: loop_section.section(doc, study, figs),
+    "energy": lambda doc, study, figs, scans: _energy(doc, study, figs),
+    "scans": scan_section.section,
+    "challenge": lambda doc, study, figs, scans: challenge_section.section(doc, study, figs),
+}
+# A file written before the root attribute `parts`: the order its report had.
+ORDER_BEFORE_PARTS = ("stability", "substeps", "challenge", "energy", "loop", "scans")
+
+
+def study_section_order(study):
+    """The study-wide sections in the order of the file's parts (its root attribute
+    `parts`, the study's order); the parts with no section of their own (the sweep, frame
+    rates, the verdict) are drawn elsewhere."""
+    parts = study.attrs.get("parts") or ORDER_BEFORE_PARTS
+    return [p for p in parts if p in STUDY_SECTIONS]
 
 
 # The root attributes a scan file's appendix lists (those of the study's META_KEYS a scan

@@ -63,7 +63,7 @@ ORIGINS = ("ours", "peer", "baseline")
 FIT_STATUSES = ("fitted", "exact", "insufficient")
 
 # /stability: the stability limits and regions of our integrators, computed in C++ from
-# their compiled steps (study/stability.cpp).
+# their compiled steps (run/stability.cpp).
 STABILITY_ATTRS = ("oscillator", "decay", "adaptive_tolerance", "y_min", "y_max", "y_unconditional", "per_decade",
                    "rho_tol", "clear_factor", "root_rtol", "run_steps", "envelope_growth", "blowup_factor",
                    "decay_floor", "run_y_start", "run_per_decade", "run_rtol", "confirm_y", "agreement", "region_dt",
@@ -466,6 +466,10 @@ class _Reader:
         missing = f.attrs.get("missing_problems", "")
         attrs["missing_problems"] = [p for p in (missing.decode() if isinstance(missing, bytes) else missing).split(",")
                                      if p]
+        # The parts the study ran, in its order (a file written before the attribute: None).
+        parts = f.attrs.get("parts")
+        attrs["parts"] = None if parts is None else \
+            [p for p in (parts.decode() if isinstance(parts, bytes) else parts).split(",") if p]
         self.need_value(f, "timing", int(attrs["timing"]), (0, 1))
         targets = np.atleast_1d(attrs["equal_error_targets"])
         absent = [t for t in SUMMARY_TARGETS if not np.isclose(targets, t, rtol=1e-9, atol=0).any()]

@@ -3,7 +3,7 @@ Steps in Physics Simulation, SCA 2019): /substeps as stored (docs/study-format.m
 figure (max position error against cost per frame, one panel per scene) and its tables.
 Every number is the study file's: the runs, the artificial damping and the verdict at
 equal cost (its one-line summary included) were computed by stepbench
-(study/substeps.cpp). The only arithmetic here is a unit: the stored costs are those of
+(run/substeps.cpp). The only arithmetic here is a unit: the stored costs are those of
 the whole run, and the figure and table divide them by the run's frames (horizon /
 frame_dt)."""
 from dataclasses import dataclass

@@ -2,7 +2,7 @@
 opens on, each problem's share of them, summary.json, and the Markdown of --markdown
 and --readme. Every number is the study file's: the equal-error costs, the ratios and
 their verdicts, the frame-rate answers and the findings were computed by stepbench
-(study/verdict.cpp). Nothing here interpolates, ranks or selects: rows are looked up
+(judge/verdict.cpp). Nothing here interpolates, ranks or selects: rows are looked up
 by (problem, target) or (problem, hz) and formatted."""
 import math
 from dataclasses import dataclass, replace
@@ -422,7 +422,7 @@ def _range_answers(study):
         return []
 
 
-XPBD_LADDER_FINDING = "xpbd over its dt ladder"  # how study/verdict.cpp's finding on xpbd's runs opens
+XPBD_LADDER_FINDING = "xpbd over its dt ladder"  # how judge/verdict.cpp's finding on xpbd's runs opens
 
 
 def xpbd_ladder_finding(v):

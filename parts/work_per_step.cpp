@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "parts/part.hpp"
-#include "store/h5.hpp"
+#include "store/columns.hpp"
 #include "study/study.hpp"
 
 namespace stepbench {
@@ -58,36 +58,31 @@ work_per_step count(const study& s) {
 }
 
 using enum schema::field_type;
-constexpr schema::field fields[] = {{"problem", str},      {"method", str},       {"declared", f64},
-                                    {"runs", i64},         {"measured_min", f64}, {"measured_max", f64},
-                                    {"extra_max", i64},    {"agrees", i8}};
+constexpr schema::field fields[] = {{"problem", str},      {"method", str},       {"declared", f64},  {"runs", i64},
+                                    {"measured_min", f64}, {"measured_max", f64}, {"extra_max", i64}, {"agrees", i8}};
 constexpr schema::field_group groups[] = {{fields}};
 constexpr schema::table tables[] = {{"work_per_step", "/work_per_step/rows", groups}};
+
+const column_map<work_row>& columns() {
+  using R = work_row;
+  static const auto columns = column_map<R>(tables[0])
+                                  .member("problem", &R::problem)
+                                  .member("method", &R::method)
+                                  .member("declared", &R::declared)
+                                  .member("runs", &R::runs)
+                                  .member("measured_min", &R::measured_min)
+                                  .member("measured_max", &R::measured_max)
+                                  .member("extra_max", &R::extra_max)
+                                  .member("agrees", &R::agrees);
+  return columns;
+}
 
 void write(H5::Group& root, const study& s) {
   const auto* w = s.results.find<work_per_step>();
   if (!w) return;
-  std::vector<std::string> problem, method;
-  std::vector<double> declared, measured_min, measured_max;
-  std::vector<std::int64_t> runs, extra_max;
-  std::vector<std::int8_t> agrees;
-  for (const auto& r : w->rows) {
-    problem.push_back(r.problem), method.push_back(r.method), declared.push_back(r.declared);
-    runs.push_back(r.runs), measured_min.push_back(r.measured_min), measured_max.push_back(r.measured_max);
-    extra_max.push_back(r.extra_max), agrees.push_back(r.agrees);
-  }
-  h5::table t;
-  t.add("problem", std::move(problem));
-  t.add("method", std::move(method));
-  t.add("declared", std::move(declared));
-  t.add("runs", std::move(runs));
-  t.add("measured_min", std::move(measured_min));
-  t.add("measured_max", std::move(measured_max));
-  t.add("extra_max", std::move(extra_max));
-  t.add("agrees", std::move(agrees));
   // Only the rows: an attribute summing them would be a second figure for merge to join.
   H5::Group g = root.createGroup("work_per_step");
-  t.write(g, "rows", tables[0]);
+  columns().write(g, "rows", w->rows);
 }
 
 }  // namespace work_per_step_detail

@@ -1,7 +1,6 @@
 #include "store/challenge.hpp"
 
-#include "store/h5.hpp"
-#include "store/schema.hpp"
+#include "store/columns.hpp"
 
 namespace stepbench {
 
@@ -14,60 +13,38 @@ void write_challenge(H5::Group& root, const challenge_result& r) {
   h5::attr(g, "small_steps_time", r.options.small_steps_time);
   h5::attr(g, "energy_scale", r.energy_scale);
   h5::attr(g, "wall_seconds", r.seconds);
-  {
-    h5::table t;
-    std::vector<std::string> method, note;
-    std::vector<std::int64_t> k;
-    std::vector<double> tol, ns, err, drift, emax, link, ns_eq;
-    std::vector<std::int8_t> stable;
-    for (const auto& e : r.entries) {
-      method.push_back(e.method), note.push_back(e.note), k.push_back(e.steps_per_frame), tol.push_back(e.tolerance);
-      ns.push_back(e.ns_per_frame), err.push_back(e.err_pos_max), drift.push_back(e.energy_drift);
-      emax.push_back(e.energy_err_max), link.push_back(e.link_err_max), ns_eq.push_back(e.ns_per_frame_at_xpbd_error);
-      stable.push_back(e.stable ? 1 : 0);
-    }
-    t.add("method", method);
-    t.add("steps_per_frame", k);
-    t.add("tolerance", tol);
-    t.add("ns_per_frame", ns);
-    t.add("err_pos_max", err);
-    t.add("energy_drift", drift);
-    t.add("energy_err_max", emax);
-    t.add("link_err_max", link);
-    t.add("stable", stable);
-    t.add("ns_per_frame_at_xpbd_error", ns_eq);
-    t.add("note", note);
-    t.write(g, "entries", schema::find("challenge_entries"));
-  }
-  {
-    h5::table t;
-    std::vector<std::string> criterion = r.verdict_criteria, verdict = r.verdicts;
-    for (const auto& v : r.small_steps_verdicts) criterion.push_back("small_steps"), verdict.push_back(v);
-    t.add("criterion", criterion);
-    t.add("verdict", verdict);
-    t.write(g, "verdicts", schema::find("challenge_verdicts"));
-  }
-  {
-    h5::table t;
-    std::vector<std::string> problem, design;
-    std::vector<std::int64_t> n;
-    std::vector<double> err, link, work, ns;
-    std::vector<std::int8_t> diverged;
-    for (const auto& s : r.small_steps) {
-      problem.push_back(s.problem), design.push_back(s.design), n.push_back(s.n), err.push_back(s.err_pos);
-      link.push_back(s.link_err), work.push_back(s.work_per_frame), ns.push_back(s.ns_per_frame);
-      diverged.push_back(s.diverged ? 1 : 0);
-    }
-    t.add("problem", problem);
-    t.add("design", design);
-    t.add("n", n);
-    t.add("err_pos", err);
-    t.add("link_err", link);
-    t.add("work_per_frame", work);
-    t.add("ns_per_frame", ns);
-    t.add("diverged", diverged);
-    t.write(g, "small_steps", schema::find("small_steps"));
-  }
+  using E = challenge_entry;
+  static const auto entries = column_map<E>("challenge_entries")
+                                  .member("method", &E::method)
+                                  .member("steps_per_frame", &E::steps_per_frame)
+                                  .member("tolerance", &E::tolerance)
+                                  .member("ns_per_frame", &E::ns_per_frame)
+                                  .member("err_pos_max", &E::err_pos_max)
+                                  .member("energy_drift", &E::energy_drift)
+                                  .member("energy_err_max", &E::energy_err_max)
+                                  .member("link_err_max", &E::link_err_max)
+                                  .member("stable", &E::stable)
+                                  .member("ns_per_frame_at_xpbd_error", &E::ns_per_frame_at_xpbd_error)
+                                  .member("note", &E::note);
+  entries.write(g, "entries", r.entries);
+  using V = std::pair<std::string, std::string>;
+  static const auto verdicts =
+      column_map<V>("challenge_verdicts").member("criterion", &V::first).member("verdict", &V::second);
+  std::vector<V> lines;
+  for (std::size_t i = 0; i < r.verdicts.size(); ++i) lines.emplace_back(r.verdict_criteria[i], r.verdicts[i]);
+  for (const auto& v : r.small_steps_verdicts) lines.emplace_back("small_steps", v);
+  verdicts.write(g, "verdicts", lines);
+  using S = small_steps_row;
+  static const auto small_steps = column_map<S>("small_steps")
+                                      .member("problem", &S::problem)
+                                      .member("design", &S::design)
+                                      .member("n", &S::n)
+                                      .member("err_pos", &S::err_pos)
+                                      .member("link_err", &S::link_err)
+                                      .member("work_per_frame", &S::work_per_frame)
+                                      .member("ns_per_frame", &S::ns_per_frame)
+                                      .member("diverged", &S::diverged);
+  small_steps.write(g, "small_steps", r.small_steps);
 }
 
 }  // namespace stepbench

@@ -6,6 +6,36 @@
 
 namespace stepbench {
 
+namespace {
+
+const column_map<energy_run>& energy_columns() {
+  using R = energy_run;
+  static const auto columns = column_map<R>("energy_summary")
+                                  .field(
+                                      "method", [](auto& r) -> auto& { return r.info.name; })
+                                  .field(
+                                      "symplectic", [](auto& r) -> auto& { return r.info.traits.symplectic; })
+                                  .member("dt", &R::dt)
+                                  .member("steps", &R::steps)
+                                  .member("force_evals", &R::force_evals)
+                                  .member("completed", &R::completed)
+                                  .member("max_rel_err", &R::max_rel_err)
+                                  .member("final_rel_err", &R::final_rel_err)
+                                  .member("drift_per_period", &R::drift_per_period)
+                                  .member("first_tenth_max", &R::first_tenth_max)
+                                  .member("last_tenth_max", &R::last_tenth_max)
+                                  .member("last_tenth_mean", &R::last_tenth_mean)
+                                  .member("verdict", &R::verdict)
+                                  .member("drift_sign", &R::drift_sign)
+                                  .member("angmom_max_rel_err", &R::angmom_max_rel_err)
+                                  .member("angmom_drift_per_period", &R::angmom_drift_per_period)
+                                  .member("seconds", &R::seconds)
+                                  .member("note", &R::note);
+  return columns;
+}
+
+}  // namespace
+
 void write_energy(H5::Group& root, const energy_study& s) {
   if (s.problems.empty()) return;
   using h5::attr;
@@ -24,39 +54,14 @@ void write_energy(H5::Group& root, const energy_study& s) {
   attr(g, "wall_seconds", s.wall_seconds);
   for (const auto& ep : s.problems) {
     H5::Group pg = g.createGroup(ep.problem);
-    parameters_table(ep.params).write(pg, "parameters", schema::find("parameters"));
+    parameters_columns().write(pg, "parameters", ep.params);
     attr(pg, "period", ep.period);
     attr(pg, "dt", ep.dt);
     attr(pg, "steps_per_period", ep.steps_per_period);
     attr(pg, "horizon", ep.horizon);
     attr(pg, "energy0", ep.e0);
     attr(pg, "angular_momentum0", ep.l0);
-    h5::table t;
-    auto col = [&](auto get) {
-      using T = decltype(get(ep.runs.front()));
-      std::vector<T> v;
-      for (const auto& r : ep.runs) v.push_back(get(r));
-      return v;
-    };
-    t.add("method", col([](const energy_run& r) { return r.info.name; }));
-    t.add("symplectic", col([](const energy_run& r) { return static_cast<std::int8_t>(r.info.traits.symplectic); }));
-    t.add("dt", col([](const energy_run& r) { return r.dt; }));
-    t.add("steps", col([](const energy_run& r) { return std::int64_t{r.steps}; }));
-    t.add("force_evals", col([](const energy_run& r) { return std::int64_t{r.force_evals}; }));
-    t.add("completed", col([](const energy_run& r) { return static_cast<std::int8_t>(r.completed); }));
-    t.add("max_rel_err", col([](const energy_run& r) { return r.max_rel_err; }));
-    t.add("final_rel_err", col([](const energy_run& r) { return r.final_rel_err; }));
-    t.add("drift_per_period", col([](const energy_run& r) { return r.drift_per_period; }));
-    t.add("first_tenth_max", col([](const energy_run& r) { return r.first_tenth_max; }));
-    t.add("last_tenth_max", col([](const energy_run& r) { return r.last_tenth_max; }));
-    t.add("last_tenth_mean", col([](const energy_run& r) { return r.last_tenth_mean; }));
-    t.add("verdict", col([](const energy_run& r) { return r.verdict; }));
-    t.add("drift_sign", col([](const energy_run& r) { return std::int64_t{r.drift_sign}; }));
-    t.add("angmom_max_rel_err", col([](const energy_run& r) { return r.angmom_max_rel_err; }));
-    t.add("angmom_drift_per_period", col([](const energy_run& r) { return r.angmom_drift_per_period; }));
-    t.add("seconds", col([](const energy_run& r) { return r.seconds; }));
-    t.add("note", col([](const energy_run& r) { return r.note; }));
-    t.write(pg, "summary", schema::find("energy_summary"));
+    energy_columns().write(pg, "summary", ep.runs);
     H5::Group series = pg.createGroup("series");
     for (const auto& r : ep.runs) {
       if (!r.completed) continue;

@@ -78,18 +78,7 @@ void compressed_grid(H5::Group& g, const std::string& name, const std::vector<st
       .write(flat.data(), H5::PredType::NATIVE_DOUBLE);
 }
 
-void table::add(std::string name, std::vector<double> values) {
-  columns_.emplace_back(std::move(name), std::move(values));
-}
-void table::add(std::string name, std::vector<std::int64_t> values) {
-  columns_.emplace_back(std::move(name), std::move(values));
-}
-void table::add(std::string name, std::vector<std::int8_t> values) {
-  columns_.emplace_back(std::move(name), std::move(values));
-}
-void table::add(std::string name, std::vector<std::string> values) {
-  columns_.emplace_back(std::move(name), std::move(values));
-}
+void table::add(std::string name, column values) { columns_.emplace_back(std::move(name), std::move(values)); }
 
 void table::check(const std::string& name, const schema::table& spec) const {
   std::size_t c = 0;
@@ -319,6 +308,11 @@ std::vector<double> table_data::doubles(const std::string& field) const {
   if (const auto it = reals_.find(field); it != reals_.end()) return it->second;
   if (const auto it = integers_.find(field); it != integers_.end()) return {it->second.begin(), it->second.end()};
   throw std::runtime_error(fmt::format("missing numeric field '{}' in {}", field, name_));
+}
+const std::vector<double>& table_data::reals(const std::string& field) const {
+  const auto it = reals_.find(field);
+  if (it == reals_.end()) throw std::runtime_error(fmt::format("missing real field '{}' in {}", field, name_));
+  return it->second;
 }
 const std::vector<std::int64_t>& table_data::ints(const std::string& field) const {
   const auto it = integers_.find(field);

@@ -29,22 +29,22 @@ void dataset(H5::Group& g, const std::string& name, const std::vector<std::vecto
 // shuffle and deflate, a quarter of the doubles' size; readers get it converted back.
 void compressed_grid(H5::Group& g, const std::string& name, const std::vector<std::vector<double>>& rows);
 
+// A column of a table: f64, i64, i8 or str (variable-length strings), by the schema's
+// field types (store/schema.hpp).
+using column =
+    std::variant<std::vector<double>, std::vector<std::int64_t>, std::vector<std::int8_t>, std::vector<std::string>>;
+
 // A table under construction: columns of equal length, written as one compound dataset
 // (packed in the file; fields in the order added).
 class table {
  public:
-  void add(std::string name, std::vector<double> values);
-  void add(std::string name, std::vector<std::int64_t> values);
-  void add(std::string name, std::vector<std::int8_t> values);
-  void add(std::string name, std::vector<std::string> values);  // variable-length strings
+  void add(std::string name, column values);
   // Writes the table after checking its columns against the schema's table `spec`
   // (names, order, types; a timed-only group present whole or absent): a mismatch is a
   // bug in the writer, thrown as std::logic_error before anything is written.
   void write(H5::Group& g, const std::string& dataset, const schema::table& spec) const;
 
  private:
-  using column =
-      std::variant<std::vector<double>, std::vector<std::int64_t>, std::vector<std::int8_t>, std::vector<std::string>>;
   void check(const std::string& dataset, const schema::table& spec) const;
   std::vector<std::pair<std::string, column>> columns_;
 };
@@ -68,6 +68,7 @@ class table_data {
   bool has(const std::string& field) const;
   // A missing field (or one of another kind) is an error naming it and the table.
   std::vector<double> doubles(const std::string& field) const;  // a real or integer field
+  const std::vector<double>& reals(const std::string& field) const;
   const std::vector<std::int64_t>& ints(const std::string& field) const;
   const std::vector<std::string>& strings(const std::string& field) const;
 

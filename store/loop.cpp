@@ -6,89 +6,93 @@
 
 #include "core/number.hpp"
 #include "judge/loop.hpp"
-#include "store/h5.hpp"
-#include "store/schema.hpp"
+#include "store/columns.hpp"
 
 namespace stepbench {
 namespace {
 
+// A row of a loop's runs table: the run and its cost verdict.
+struct loop_run {
+  loop_row row;
+  loop_cost cost;
+};
+
 void write_runs(H5::Group& g, const loop_method& m, double step_cost_ns, const std::string& source) {
-  const auto& rows = m.rows;
-  std::vector<loop_cost> costs;
-  for (const auto& r : rows) costs.push_back(cost_verdict(r.config, step_cost_ns, source));
-  auto col = [&](auto get) {
-    using T = decltype(get(rows.front(), costs.front()));
-    std::vector<T> v;
-    for (std::size_t i = 0; i < rows.size(); ++i) v.push_back(get(rows[i], costs[i]));
-    return v;
+  using R = loop_run;
+  using L = loop_row;
+  using S = loop_schedule;
+  const auto run = [](auto... path) {
+    return [=](auto& r) -> auto& { return (r.row.*....*path); };
   };
-  using R = const loop_row&;
-  using C = const loop_cost&;
-  auto i64 = [](auto x) { return static_cast<std::int64_t>(x); };
-  auto i8 = [](bool x) { return static_cast<std::int8_t>(x); };
-  auto variable = [](R r) { return r.config.design == loop_design::variable; };
-  h5::table t;
-  t.add("design", col([](R r, C) { return std::string(to_string(r.config.design)); }));
-  t.add("clock", col([](R r, C) { return r.clock; }));
-  t.add("display_hz", col([](R r, C) { return r.config.display_hz; }));
-  t.add("physics_hz", col([&](R r, C) { return variable(r) ? nan : r.config.physics_hz; }));
-  t.add("dt", col([&](R r, C) { return uses_accumulator(r.config.design) ? r.config.dt() : nan; }));
-  t.add("substeps",
-        col([&](R r, C) { return i64(r.config.design == loop_design::substeps ? r.config.substeps() : 0); }));
-  t.add("clamp_s", col([](R r, C) { return r.config.clamp_s; }));
-  t.add("jitter_seed", col([&](R r, C) { return r.config.jitter_seed ? i64(*r.config.jitter_seed) : i64(-1); }));
-  t.add("stall_at_s", col([](R r, C) { return r.config.stall_at_s; }));
-  t.add("frames", col([&](R r, C) { return i64(r.frames); }));
-  t.add("physics_steps", col([&](R r, C) { return i64(r.physics_steps); }));
-  t.add("force_evals", col([&](R r, C) { return i64(r.force_evals); }));
-  t.add("shown_err_max", col([](R r, C) { return r.shown_err_max; }));
-  t.add("shown_err_rms", col([](R r, C) { return r.shown_err_rms; }));
-  t.add("final_shown_err", col([](R r, C) { return r.final_shown_err; }));
-  t.add("clock_dependence", col([](R r, C) { return r.clock_dependence; }));
-  t.add("physics_clock_dependence", col([](R r, C) { return r.physics_clock_dependence; }));
-  t.add("judder", col([](R r, C) { return r.judder; }));
-  t.add("lag_s", col([](R r, C) { return r.lag_s; }));
-  t.add("lag_clock_s", col([](R r, C) { return r.lag_clock_s; }));
-  t.add("steps_per_frame_mean", col([](R r, C) { return r.steps_per_frame_mean; }));
-  t.add("steps_per_frame_max", col([&](R r, C) { return i64(r.steps_per_frame_max); }));
-  t.add("stall_burst_steps", col([&](R r, C) { return i64(r.stall_burst_steps); }));
-  t.add("clamp_hits", col([&](R r, C) { return i64(r.clamp_hits); }));
-  t.add("alpha_min", col([](R r, C) { return r.alpha_min; }));
-  t.add("alpha_max", col([](R r, C) { return r.alpha_max; }));
-  t.add("physics_t", col([](R r, C) { return r.physics_t; }));
-  t.add("diverged", col([&](R r, C) { return i8(r.diverged); }));
-  t.add("note", col([](R r, C) { return r.note; }));
-  t.add("step_cost_ns", col([](R, C c) { return c.step_cost_ns; }));
-  t.add("frame_budget_ns", col([](R, C c) { return c.schedule.frame_budget_s * 1e9; }));
-  t.add("worst_frame_work_ns", col([](R, C c) { return c.schedule.worst_work_s * 1e9; }));
-  t.add("late_frames", col([&](R, C c) { return i64(c.schedule.late_frames); }));
-  t.add("physics_load", col([](R, C c) { return c.schedule.load; }));
-  t.add("outcome", col([](R, C c) { return std::string(to_string(c.schedule.outcome)); }));
-  t.add("outcome_without_clamp", col([](R, C c) { return std::string(to_string(c.without_clamp)); }));
-  t.add("clamp_prevented_spiral", col([&](R, C c) { return i8(c.clamp_prevented_spiral); }));
-  t.write(g, "runs", schema::find("loop_runs"));
+  const auto cost = [](auto... path) {
+    return [=](auto& r) -> auto& { return (r.cost.*....*path); };
+  };
+  static const auto columns =
+      column_map<R>("loop_runs")
+          .derived("design", [](const R& r) { return to_string(r.row.config.design); })
+          .field("clock", run(&L::clock))
+          .field("display_hz", run(&L::config, &loop_config::display_hz))
+          .derived(
+              "physics_hz",
+              [](const R& r) { return r.row.config.design == loop_design::variable ? nan : r.row.config.physics_hz; })
+          .derived("dt", [](const R& r) { return uses_accumulator(r.row.config.design) ? r.row.config.dt() : nan; })
+          .derived(
+              "substeps",
+              [](const R& r) { return r.row.config.design == loop_design::substeps ? r.row.config.substeps() : 0; })
+          .field("clamp_s", run(&L::config, &loop_config::clamp_s))
+          .derived(
+              "jitter_seed",
+              [](const R& r) { return r.row.config.jitter_seed ? static_cast<long>(*r.row.config.jitter_seed) : -1L; })
+          .field("stall_at_s", run(&L::config, &loop_config::stall_at_s))
+          .field("frames", run(&L::frames))
+          .field("physics_steps", run(&L::physics_steps))
+          .field("force_evals", run(&L::force_evals))
+          .field("shown_err_max", run(&L::shown_err_max))
+          .field("shown_err_rms", run(&L::shown_err_rms))
+          .field("final_shown_err", run(&L::final_shown_err))
+          .field("clock_dependence", run(&L::clock_dependence))
+          .field("physics_clock_dependence", run(&L::physics_clock_dependence))
+          .field("judder", run(&L::judder))
+          .field("lag_s", run(&L::lag_s))
+          .field("lag_clock_s", run(&L::lag_clock_s))
+          .field("steps_per_frame_mean", run(&L::steps_per_frame_mean))
+          .field("steps_per_frame_max", run(&L::steps_per_frame_max))
+          .field("stall_burst_steps", run(&L::stall_burst_steps))
+          .field("clamp_hits", run(&L::clamp_hits))
+          .field("alpha_min", run(&L::alpha_min))
+          .field("alpha_max", run(&L::alpha_max))
+          .field("physics_t", run(&L::physics_t))
+          .field("diverged", run(&L::diverged))
+          .field("note", run(&L::note))
+          .field("step_cost_ns", cost(&loop_cost::step_cost_ns))
+          .derived("frame_budget_ns", [](const R& r) { return r.cost.schedule.frame_budget_s * 1e9; })
+          .derived("worst_frame_work_ns", [](const R& r) { return r.cost.schedule.worst_work_s * 1e9; })
+          .field("late_frames", cost(&loop_cost::schedule, &S::late_frames))
+          .field("physics_load", cost(&loop_cost::schedule, &S::load))
+          .derived("outcome", [](const R& r) { return to_string(r.cost.schedule.outcome); })
+          .derived("outcome_without_clamp", [](const R& r) { return to_string(r.cost.without_clamp); })
+          .field("clamp_prevented_spiral", cost(&loop_cost::clamp_prevented_spiral));
+  std::vector<R> rows;
   std::vector<std::vector<double>> finals;
-  for (const auto& r : rows) finals.push_back(r.final_physics);
+  for (const auto& r : m.rows) {
+    rows.push_back({r, cost_verdict(r.config, step_cost_ns, source)});
+    finals.push_back(r.final_physics);
+  }
+  columns.write(g, "runs", rows);
   h5::dataset(g, "final_physics_state", finals);
 }
 
 void write_cheapest(H5::Group& g, const loop_method& m, const loop_options& opts) {
-  const auto rows = cheapest_designs(m, opts);
-  h5::table t;
-  auto col = [&](auto get) {
-    using T = decltype(get(rows.front()));
-    std::vector<T> v;
-    for (const auto& r : rows) v.push_back(get(r));
-    return v;
-  };
-  t.add("display_hz", col([](const loop_cheapest& c) { return c.display_hz; }));
-  t.add("target", col([](const loop_cheapest& c) { return c.target; }));
-  t.add("found", col([](const loop_cheapest& c) { return static_cast<std::int8_t>(c.found); }));
-  t.add("design", col([](const loop_cheapest& c) { return c.design; }));
-  t.add("physics_hz", col([](const loop_cheapest& c) { return c.physics_hz; }));
-  t.add("steps_per_frame_mean", col([](const loop_cheapest& c) { return c.steps_per_frame_mean; }));
-  t.add("shown_err_max", col([](const loop_cheapest& c) { return c.shown_err_max; }));
-  t.write(g, "cheapest", schema::find("loop_cheapest"));
+  using R = loop_cheapest;
+  static const auto columns = column_map<R>("loop_cheapest")
+                                  .member("display_hz", &R::display_hz)
+                                  .member("target", &R::target)
+                                  .member("found", &R::found)
+                                  .member("design", &R::design)
+                                  .member("physics_hz", &R::physics_hz)
+                                  .member("steps_per_frame_mean", &R::steps_per_frame_mean)
+                                  .member("shown_err_max", &R::shown_err_max);
+  columns.write(g, "cheapest", cheapest_designs(m, opts));
 }
 
 }  // namespace

@@ -5,8 +5,8 @@
 
 #include <filesystem>
 
-#include "store/h5.hpp"
-#include "store/schema.hpp"
+#include "core/number.hpp"
+#include "store/columns.hpp"
 
 namespace stepbench {
 namespace {
@@ -21,6 +21,65 @@ std::vector<std::string> names_of(const std::string& text) {
     start = comma + 1;
   }
   return out;
+}
+
+const column_map<scan_point>& scan_point_columns() {
+  using R = scan_point;
+  static const auto columns = column_map<R>("scan_points")
+                                  .member("point", &R::index)
+                                  .member("trusted", &R::trusted)
+                                  .member("truth_source", &R::truth_source)
+                                  .member("horizon", &R::horizon)
+                                  .member("pos_scale", &R::pos_scale)
+                                  .member("note", &R::note);
+  return columns;
+}
+
+// A run's counts are stored as doubles (a frame's share of them is not whole).
+template <long work_counters::*count>
+double counted(const scan_run& r) {
+  return static_cast<double>(r.row.work.*count);
+}
+template <long work_counters::*count>
+void set_counted(scan_run& r, double v) {
+  r.row.work.*count = static_cast<long>(v);
+}
+
+const column_map<scan_run>& scan_run_columns() {
+  using R = scan_run;
+  using M = run_metrics;
+  static const auto columns =
+      column_map<R>("scan_runs")
+          .member("point", &R::point)
+          .member("hz", &R::hz)
+          .member("method", &R::method)
+          .member("substeps", &R::substeps)
+          .member("dt", &R::row, &method_row::param)
+          .derived("completed", [](const R& r) { return r.row.metrics.completed(); })
+          .member("diverged", &R::row, &method_row::metrics, &M::diverged)
+          .member("failed", &R::row, &method_row::metrics, &M::failed)
+          .member("skipped", &R::row, &method_row::metrics, &M::skipped)
+          .field(
+              "err_pos_max", [](const R& r) { return r.row.metrics.completed() ? r.row.metrics.err_pos_max : nan; },
+              [](R& r, double v) { r.row.metrics.err_pos_max = v; })
+          .member("steps", &R::row, &method_row::steps)
+          .field("force_evals", counted<&work_counters::force_evals>, set_counted<&work_counters::force_evals>)
+          .field("newton_iterations", counted<&work_counters::newton_iterations>,
+                 set_counted<&work_counters::newton_iterations>)
+          .member("note", &R::row, &method_row::metrics, &M::note);
+  return columns;
+}
+
+const column_map<scan_best>& scan_best_columns() {
+  using R = scan_best;
+  static const auto columns = column_map<R>("scan_best")
+                                  .member("point", &R::point)
+                                  .member("hz", &R::hz)
+                                  .member("method", &R::method)
+                                  .member("substeps", &R::substeps)
+                                  .member("err_pos_max", &R::err_pos_max)
+                                  .member("force_evals_per_frame", &R::force_evals_per_frame);
+  return columns;
 }
 
 }  // namespace
@@ -85,60 +144,28 @@ scan_result read_scan(const std::string& path, const std::string& name) {
                                            which, s.grid_points, product));
     o.shard_index = static_cast<int>(h5::long_attr(g, "shard_index"));
     o.shard_count = static_cast<int>(h5::long_attr(g, "shard_count"));
-    const h5::table_data points = h5::read_table(g.openDataSet("points"));
-    const auto& index = points.ints("point");
-    std::map<std::int64_t, std::size_t> local_of;  // grid index -> row
-    const auto& trusted = points.ints("trusted");
-    const auto& source = points.strings("truth_source");
-    const auto& note = points.strings("note");
-    const auto horizon = points.doubles("horizon"), scale = points.doubles("pos_scale");
-    for (std::size_t i = 0; i < points.rows(); ++i) {
-      scan_point p;
+    s.points = scan_point_columns().read(g, "points");
+    std::map<std::size_t, std::size_t> local_of;  // grid index -> row
+    for (std::size_t i = 0; i < s.points.size(); ++i) {
+      auto& p = s.points[i];
       for (const auto& c : columns) {
-        if (c.size() != points.rows())
+        if (c.size() != s.points.size())
           throw std::runtime_error(fmt::format("scan '{}': values/ and points differ in length", which));
         p.values.push_back(c[i]);
       }
-      if (index[i] < 0 || static_cast<std::size_t>(index[i]) >= s.grid_points || local_of.count(index[i]))
-        throw std::runtime_error(
-            fmt::format("scan '{}': point {} is outside its grid of {} or repeated", which, index[i], s.grid_points));
-      local_of[index[i]] = i;
-      p.index = static_cast<std::size_t>(index[i]);
-      p.trusted = trusted[i] != 0;
-      p.truth_source = source[i];
-      p.note = note[i];
-      p.horizon = horizon[i];
-      p.pos_scale = scale[i];
-      s.points.push_back(std::move(p));
+      if (p.index >= s.grid_points || local_of.count(p.index))
+        throw std::runtime_error(fmt::format("scan '{}': point {} is outside its grid of {} or repeated", which,
+                                             static_cast<std::int64_t>(p.index), s.grid_points));
+      local_of[p.index] = i;
     }
-    const h5::table_data runs = h5::read_table(g.openDataSet("runs"));
-    const auto& point = runs.ints("point");
-    const auto hz = runs.doubles("hz"), dt = runs.doubles("dt"), err = runs.doubles("err_pos_max"),
-               evals = runs.doubles("force_evals"), newton = runs.doubles("newton_iterations");
-    const auto& method = runs.strings("method");
-    const auto &substeps = runs.ints("substeps"), &steps = runs.ints("steps");
-    const auto &diverged = runs.ints("diverged"), &failed = runs.ints("failed"), &skipped = runs.ints("skipped");
-    const auto& run_note = runs.strings("note");
-    for (std::size_t i = 0; i < runs.rows(); ++i) {
-      const auto at = local_of.find(point[i]);
+    s.runs = scan_run_columns().read(g, "runs");
+    for (std::size_t i = 0; i < s.runs.size(); ++i) {
+      auto& r = s.runs[i];
+      const auto at = local_of.find(r.point);
       if (at == local_of.end())
-        throw std::runtime_error(
-            fmt::format("scan '{}': run {} names point {}, which its points table lacks", which, i, point[i]));
-      scan_run r;
+        throw std::runtime_error(fmt::format("scan '{}': run {} names point {}, which its points table lacks", which, i,
+                                             static_cast<std::int64_t>(r.point)));
       r.point = at->second;
-      r.hz = hz[i];
-      r.method = method[i];
-      r.substeps = static_cast<int>(substeps[i]);
-      r.row.param = dt[i];
-      r.row.steps = steps[i];
-      r.row.work.force_evals = static_cast<long>(evals[i]);
-      r.row.work.newton_iterations = static_cast<long>(newton[i]);
-      r.row.metrics.err_pos_max = err[i];
-      r.row.metrics.diverged = diverged[i] != 0;
-      r.row.metrics.failed = failed[i] != 0;
-      r.row.metrics.skipped = skipped[i] != 0;
-      r.row.metrics.note = run_note[i];
-      s.runs.push_back(std::move(r));
     }
     compute_best(s);
     s.source = path;
@@ -192,7 +219,6 @@ void write_scans(H5::Group& root, const std::vector<scan_result>& scans) {
   using h5::attr;
   if (scans.empty()) return;
   H5::Group all = root.createGroup("scan");
-  const double nan = std::numeric_limits<double>::quiet_NaN();
   for (const auto& sc : scans) {
     const auto& o = sc.options;
     H5::Group g = all.createGroup(o.name.empty() ? o.problem : o.name);
@@ -241,89 +267,14 @@ void write_scans(H5::Group& root, const std::vector<scan_result>& scans) {
       for (const auto& p : sc.points) column.push_back(p.values[k]);
       h5::dataset(values, o.axes[k].param, column);
     }
-    {
-      std::vector<std::int64_t> point;
-      std::vector<std::int8_t> trusted;
-      std::vector<std::string> source, note;
-      std::vector<double> horizon, scale;
-      for (std::size_t i = 0; i < sc.points.size(); ++i) {
-        const auto& p = sc.points[i];
-        point.push_back(static_cast<std::int64_t>(p.index));
-        trusted.push_back(p.trusted ? 1 : 0);
-        source.push_back(p.truth_source);
-        horizon.push_back(p.horizon);
-        scale.push_back(p.pos_scale);
-        note.push_back(p.note);
-      }
-      h5::table t;
-      t.add("point", point);
-      t.add("trusted", trusted);
-      t.add("truth_source", source);
-      t.add("horizon", horizon);
-      t.add("pos_scale", scale);
-      t.add("note", note);
-      t.write(g, "points", schema::find("scan_points"));
-    }
-    {
-      std::vector<std::int64_t> point, substeps, steps;
-      std::vector<double> hz, dt, err, evals, newton;
-      std::vector<std::int8_t> completed, diverged, failed, skipped;
-      std::vector<std::string> method, note;
-      for (const auto& r : sc.runs) {
-        const auto& m = r.row.metrics;
-        point.push_back(static_cast<std::int64_t>(sc.points[r.point].index));
-        hz.push_back(r.hz);
-        method.push_back(r.method);
-        substeps.push_back(r.substeps);
-        dt.push_back(r.row.param);
-        completed.push_back(m.completed() ? 1 : 0);
-        diverged.push_back(m.diverged ? 1 : 0);
-        failed.push_back(m.failed ? 1 : 0);
-        skipped.push_back(m.skipped ? 1 : 0);
-        err.push_back(m.completed() ? m.err_pos_max : nan);
-        steps.push_back(r.row.steps);
-        evals.push_back(static_cast<double>(r.row.work.force_evals));
-        newton.push_back(static_cast<double>(r.row.work.newton_iterations));
-        note.push_back(m.note);
-      }
-      h5::table t;
-      t.add("point", point);
-      t.add("hz", hz);
-      t.add("method", method);
-      t.add("substeps", substeps);
-      t.add("dt", dt);
-      t.add("completed", completed);
-      t.add("diverged", diverged);
-      t.add("failed", failed);
-      t.add("skipped", skipped);
-      t.add("err_pos_max", err);
-      t.add("steps", steps);
-      t.add("force_evals", evals);
-      t.add("newton_iterations", newton);
-      t.add("note", note);
-      t.write(g, "runs", schema::find("scan_runs"));
-    }
-    {
-      std::vector<std::int64_t> point, substeps;
-      std::vector<double> hz, err, cost;
-      std::vector<std::string> method;
-      for (const auto& b : sc.best) {
-        point.push_back(static_cast<std::int64_t>(sc.points[b.point].index));
-        hz.push_back(b.hz);
-        method.push_back(b.method);
-        substeps.push_back(b.substeps);
-        err.push_back(b.err_pos_max);
-        cost.push_back(b.force_evals_per_frame);
-      }
-      h5::table t;
-      t.add("point", point);
-      t.add("hz", hz);
-      t.add("method", method);
-      t.add("substeps", substeps);
-      t.add("err_pos_max", err);
-      t.add("force_evals_per_frame", cost);
-      t.write(g, "best", schema::find("scan_best"));
-    }
+    scan_point_columns().write(g, "points", sc.points);
+    // Runs and answers name their point by its place in the whole grid.
+    std::vector<scan_run> runs = sc.runs;
+    for (auto& r : runs) r.point = sc.points[r.point].index;
+    scan_run_columns().write(g, "runs", runs);
+    std::vector<scan_best> best = sc.best;
+    for (auto& b : best) b.point = sc.points[b.point].index;
+    scan_best_columns().write(g, "best", best);
   }
 }
 

@@ -1,9 +1,30 @@
 #include "store/stability.hpp"
 
 #include "store/h5.hpp"
-#include "store/schema.hpp"
 
 namespace stepbench {
+
+const column_map<stability_limit>& stability_limit_columns() {
+  using R = stability_limit;
+  static const auto columns = column_map<R>("stability_limits")
+                                  .member("integrator", &R::integrator)
+                                  .field(
+                                      "test", [](const R& l) { return std::string(to_string(l.test)); },
+                                      [](R& l, const std::string& test) {
+                                        for (const auto t : {stability_test::oscillator, stability_test::decay})
+                                          if (test == to_string(t)) return void(l.test = t);
+                                        throw std::runtime_error("unknown stability test '" + test + "'");
+                                      })
+                                  .member("measured", &R::measured)
+                                  .member("theory", &R::theory)
+                                  .derived("rel_difference", [](const R& l) { return l.rel_difference(); })
+                                  .member("unstable_for_all_dt", &R::unstable_for_all_dt)
+                                  .member("unconditionally_stable", &R::unconditionally_stable)
+                                  .member("run_confirms", &R::run_confirms)
+                                  .member("step_failed_at", &R::step_failed_at)
+                                  .member("note", &R::note);
+  return columns;
+}
 
 void write_stability(H5::Group& root, const stability_data& d) {
   using h5::attr;
@@ -34,26 +55,7 @@ void write_stability(H5::Group& root, const stability_data& d) {
   attr(g, "limits_seconds", d.limits_seconds);
   attr(g, "regions_seconds", d.regions_seconds);
 
-  h5::table t;
-  auto col = [&](auto get) {
-    using T = decltype(get(d.limits.front()));
-    std::vector<T> v;
-    for (const auto& l : d.limits) v.push_back(get(l));
-    return v;
-  };
-  t.add("integrator", col([](const stability_limit& l) { return l.integrator; }));
-  t.add("test", col([](const stability_limit& l) { return std::string(to_string(l.test)); }));
-  t.add("measured", col([](const stability_limit& l) { return l.measured; }));
-  t.add("theory", col([](const stability_limit& l) { return l.theory; }));
-  t.add("rel_difference", col([](const stability_limit& l) { return l.rel_difference(); }));
-  t.add("unstable_for_all_dt",
-        col([](const stability_limit& l) { return static_cast<std::int8_t>(l.unstable_for_all_dt); }));
-  t.add("unconditionally_stable",
-        col([](const stability_limit& l) { return static_cast<std::int8_t>(l.unconditionally_stable); }));
-  t.add("run_confirms", col([](const stability_limit& l) { return static_cast<std::int8_t>(l.run_confirms); }));
-  t.add("step_failed_at", col([](const stability_limit& l) { return l.step_failed_at; }));
-  t.add("note", col([](const stability_limit& l) { return l.note; }));
-  t.write(g, "limits", schema::find("stability_limits"));
+  stability_limit_columns().write(g, "limits", d.limits);
 
   const auto& r = d.regions;
   h5::dataset(g, "region_re", r.re);

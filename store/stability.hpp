@@ -1,11 +1,12 @@
 #pragma once
-#include "store/h5.hpp"
+#include "store/columns.hpp"
 #include "study/stability.hpp"
 
 namespace stepbench {
 
 // Writes /stability under `root` (docs/study-format.md): what run_sweep computed with the
 // default settings, in every study file.
+const column_map<stability_limit>& stability_limit_columns();
 void write_stability(H5::Group& root, const stability_data& data);
 
 }  // namespace stepbench

@@ -88,16 +88,43 @@ void write_method(H5::Group& parent, const method_study& ms, bool timed) {
   attr(g, "declared_order_holds", ms.declared_order_holds);
   attr(g, "ladder_end", ms.ladder_end);
 
-  runs_table(ms.rows, timed).write(g, "runs", schema::find("runs"));
+  runs_columns().write(g, "runs", ms.rows, timed);
 }
+
+// A row of the equal-error table: a method's cost at a metric's target, ranked.
+struct equal_error_row {
+  std::string metric;
+  double target = 0.0;
+  long rank = 0;
+  std::string method, origin, kind;
+  wp_pick pick;
+  std::string cost_kind;
+  bool is_answer = false;
+};
 
 // The equal-error table: for each metric and target, every method that reaches it with
 // its cost at equal error interpolated on its measured curve, ranked (core/work_precision.hpp).
 void write_equal_error(H5::Group& g, const problem_study& ps, bool timed) {
-  std::vector<std::string> metric, method, origin, cost_kind, kind;
-  std::vector<double> target, param, error, cost, cost_lo, cost_hi, time_ns, force_evals;
-  std::vector<std::int64_t> rank;
-  std::vector<std::int8_t> interpolated, is_answer;
+  using R = equal_error_row;
+  using P = wp_pick;
+  static const auto columns = column_map<R>("equal_error")
+                                  .member("metric", &R::metric)
+                                  .member("target", &R::target)
+                                  .member("rank", &R::rank)
+                                  .member("method", &R::method)
+                                  .member("origin", &R::origin)
+                                  .member("kind", &R::kind)
+                                  .member("param", &R::pick, &P::param)
+                                  .member("error", &R::pick, &P::error)
+                                  .member("cost_kind", &R::cost_kind)
+                                  .member("cost", &R::pick, &P::cost)
+                                  .member("cost_lo", &R::pick, &P::cost_lo)
+                                  .member("cost_hi", &R::pick, &P::cost_hi)
+                                  .member("time_ns", &R::pick, &P::time_ns)
+                                  .member("force_evals", &R::pick, &P::force_evals)
+                                  .member("interpolated", &R::pick, &P::interpolated)
+                                  .member("is_answer", &R::is_answer);
+  std::vector<R> rows;
   for (const char* m : {"err_pos_max", "err_pos_final"}) {
     const auto methods = work_precision_input(ps, m);
     for (double tgt : equal_error_targets()) {
@@ -106,61 +133,31 @@ void write_equal_error(H5::Group& g, const problem_study& ps, bool timed) {
       for (std::size_t k = 0; k < r.ranked.size(); ++k) {
         const auto& p = r.ranked[k];
         const auto& wm = methods[p.method];
-        metric.emplace_back(m);
-        target.push_back(tgt);
-        rank.push_back(static_cast<std::int64_t>(k + 1));
-        method.push_back(wm.name);
-        origin.emplace_back(to_string(wm.origin));
-        kind.emplace_back(to_string(wm.kind));
-        param.push_back(p.param);
-        error.push_back(p.error);
-        cost_kind.push_back(r.cost);
-        cost.push_back(p.cost);
-        cost_lo.push_back(p.cost_lo);
-        cost_hi.push_back(p.cost_hi);
-        time_ns.push_back(p.time_ns);
-        force_evals.push_back(p.force_evals);
-        interpolated.push_back(static_cast<std::int8_t>(p.interpolated));
-        is_answer.push_back(static_cast<std::int8_t>(answer && answer->method == p.method));
+        rows.push_back({m, tgt, static_cast<long>(k + 1), wm.name, std::string(to_string(wm.origin)),
+                        std::string(to_string(wm.kind)), p, r.cost, answer && answer->method == p.method});
       }
     }
   }
-  h5::table t;
-  t.add("metric", metric);
-  t.add("target", target);
-  t.add("rank", rank);
-  t.add("method", method);
-  t.add("origin", origin);
-  t.add("kind", kind);
-  t.add("param", param);
-  t.add("error", error);
-  t.add("cost_kind", cost_kind);
-  t.add("cost", cost);
-  t.add("cost_lo", cost_lo);
-  t.add("cost_hi", cost_hi);
-  t.add("time_ns", time_ns);
-  t.add("force_evals", force_evals);
-  t.add("interpolated", interpolated);
-  t.add("is_answer", is_answer);
-  t.write(g, "equal_error", schema::find("equal_error"));
+  columns.write(g, "equal_error", rows);
 }
 
+struct front_row {
+  std::string method;
+  double param = 0.0, cost = 0.0, err_pos_max = 0.0;
+};
+
 void write_front(H5::Group& g, const problem_study& ps, bool by_time, bool timed) {
+  using R = front_row;
+  static const auto columns = column_map<R>("front")
+                                  .member("method", &R::method)
+                                  .member("param", &R::param)
+                                  .member("cost", &R::cost)
+                                  .member("err_pos_max", &R::err_pos_max);
   const auto methods = work_precision_input(ps, "err_pos_max");
-  std::vector<std::string> method;
-  std::vector<double> param, cost, error;
-  for (const auto& p : pareto_front(methods, by_time, timed)) {
-    method.push_back(methods[p.method].name);
-    param.push_back(methods[p.method].rows[p.row].param);
-    cost.push_back(p.cost);
-    error.push_back(p.error);
-  }
-  h5::table t;
-  t.add("method", method);
-  t.add("param", param);
-  t.add("cost", cost);
-  t.add("err_pos_max", error);
-  t.write(g, by_time ? "front_time" : "front_force_evals", schema::find("front"));
+  std::vector<R> rows;
+  for (const auto& p : pareto_front(methods, by_time, timed))
+    rows.push_back({methods[p.method].name, methods[p.method].rows[p.row].param, p.cost, p.error});
+  columns.write(g, by_time ? "front_time" : "front_force_evals", rows);
 }
 
 void write_problem(H5::Group& parent, const problem_study& ps, const std::optional<timing_settings>& timing) {
@@ -170,7 +167,7 @@ void write_problem(H5::Group& parent, const problem_study& ps, const std::option
   // The machine that ran (and timed) this problem: the root's in a study run on one
   // machine; in a merge of shards, each problem keeps its shard's (stepbench merge).
   write_machine(g, timing);
-  parameters_table(p.params()).write(g, "parameters", schema::find("parameters"));
+  parameters_columns().write(g, "parameters", p.params());
   attr(g, "horizon", ps.horizon);
   attr(g, "dim", p.dim());
   attr(g, "position_unit", std::string(p.position_unit()));
@@ -295,75 +292,63 @@ void write_root_attributes(H5::H5File& file, const study& s, const std::string& 
   }
 }
 
-h5::table parameters_table(const std::vector<param_value>& params) {
-  std::vector<std::string> name, unit, kind, value_name, allowed, description;
-  std::vector<double> value, default_value;
-  for (const auto& q : params) {
-    name.push_back(q.name);
-    value.push_back(q.value);
-    unit.push_back(q.unit);
-    kind.emplace_back(q.kind());
-    value_name.push_back(q.value_name());
-    default_value.push_back(q.default_value);
-    allowed.push_back(q.allowed.text());
-    description.push_back(q.description);
-  }
-  h5::table t;
-  t.add("name", std::move(name));
-  t.add("value", std::move(value));
-  t.add("unit", std::move(unit));
-  t.add("kind", std::move(kind));
-  t.add("value_name", std::move(value_name));
-  t.add("default", std::move(default_value));
-  t.add("allowed", std::move(allowed));
-  t.add("description", std::move(description));
-  return t;
+const column_map<param_value>& parameters_columns() {
+  using R = param_value;
+  static const auto columns = column_map<R>("parameters")
+                                  .member("name", &R::name)
+                                  .member("value", &R::value)
+                                  .member("unit", &R::unit)
+                                  .derived("kind", [](const R& q) { return q.kind(); })
+                                  .derived("value_name", [](const R& q) { return q.value_name(); })
+                                  .member("default", &R::default_value)
+                                  .derived("allowed", [](const R& q) { return q.allowed.text(); })
+                                  .member("description", &R::description);
+  return columns;
 }
 
-h5::table runs_table(const std::vector<method_row>& rows, bool timed) {
-  h5::table t;
-  auto col = [&](auto get) {
-    using T = decltype(get(rows.front()));
-    std::vector<T> v;
-    for (const auto& r : rows) v.push_back(get(r));
-    return v;
-  };
-  t.add("param", col([](const method_row& r) { return r.param; }));
-  t.add("steps", col([](const method_row& r) { return std::int64_t{r.steps}; }));
-  t.add("rejected_steps", col([](const method_row& r) { return std::int64_t{r.rejected_steps}; }));
-  t.add("force_evals", col([](const method_row& r) { return std::int64_t{r.work.force_evals}; }));
-  t.add("jacobian_evals", col([](const method_row& r) { return std::int64_t{r.work.jacobian_evals}; }));
-  t.add("newton_iterations", col([](const method_row& r) { return std::int64_t{r.work.newton_iterations}; }));
-  t.add("linear_solves", col([](const method_row& r) { return std::int64_t{r.work.linear_solves}; }));
-  t.add("err_pos_final", col([](const method_row& r) { return r.metrics.err_pos_final; }));
-  t.add("err_vel_final", col([](const method_row& r) { return r.metrics.err_vel_final; }));
-  t.add("err_pos_max", col([](const method_row& r) { return r.metrics.err_pos_max; }));
-  t.add("err_pos_rms", col([](const method_row& r) { return r.metrics.err_pos_rms; }));
-  t.add("energy_drift", col([](const method_row& r) { return r.metrics.energy_drift; }));
-  t.add("energy_err_max", col([](const method_row& r) { return r.metrics.energy_err_max; }));
-  t.add("angmom_drift", col([](const method_row& r) { return r.metrics.angmom_drift; }));
-  t.add("angmom_err_max", col([](const method_row& r) { return r.metrics.angmom_err_max; }));
-  t.add("constraint_violation_max", col([](const method_row& r) { return r.metrics.constraint_violation_max; }));
-  t.add("contacts", col([](const method_row& r) { return std::int64_t{r.metrics.contacts}; }));
-  t.add("contact_count_err", col([](const method_row& r) { return r.metrics.contact_count_err; }));
-  t.add("contact_time_err", col([](const method_row& r) { return r.metrics.contact_time_err; }));
-  t.add("contact_pos_err", col([](const method_row& r) { return r.metrics.contact_pos_err; }));
-  t.add("tunnelled", col([](const method_row& r) { return std::int64_t{r.metrics.tunnelled}; }));
-  t.add("max_penetration", col([](const method_row& r) { return r.metrics.max_penetration; }));
-  t.add("diverged", col([](const method_row& r) { return static_cast<std::int8_t>(r.metrics.diverged); }));
-  t.add("failed", col([](const method_row& r) { return static_cast<std::int8_t>(r.metrics.failed); }));
-  t.add("skipped", col([](const method_row& r) { return static_cast<std::int8_t>(r.metrics.skipped); }));
-  t.add("note", col([](const method_row& r) { return r.metrics.note; }));
-  // Timing fields only in a timed study, so an untimed file does not carry columns of
-  // NaN that a reader could mistake for measurements.
-  if (timed) {
-    t.add("time_ns", col([](const method_row& r) { return r.time.time_ns; }));
-    t.add("time_ns_min", col([](const method_row& r) { return r.time.time_ns_min; }));
-    t.add("time_ns_max", col([](const method_row& r) { return r.time.time_ns_max; }));
-    t.add("repetitions", col([](const method_row& r) { return std::int64_t{r.time.repetitions}; }));
-    t.add("cut", col([](const method_row& r) { return static_cast<std::int8_t>(r.time.cut); }));
-  }
-  return t;
+const column_map<method_row>& runs_columns() {
+  using R = method_row;
+  using W = work_counters;
+  using M = run_metrics;
+  using T = timing;
+  static const auto columns = column_map<R>("runs")
+                                  .member("param", &R::param)
+                                  .member("steps", &R::steps)
+                                  .member("rejected_steps", &R::rejected_steps)
+                                  .member("force_evals", &R::work, &W::force_evals)
+                                  .member("jacobian_evals", &R::work, &W::jacobian_evals)
+                                  .member("newton_iterations", &R::work, &W::newton_iterations)
+                                  .member("linear_solves", &R::work, &W::linear_solves)
+                                  .member("err_pos_final", &R::metrics, &M::err_pos_final)
+                                  .member("err_vel_final", &R::metrics, &M::err_vel_final)
+                                  .member("err_pos_max", &R::metrics, &M::err_pos_max)
+                                  .member("err_pos_rms", &R::metrics, &M::err_pos_rms)
+                                  .member("energy_drift", &R::metrics, &M::energy_drift)
+                                  .member("energy_err_max", &R::metrics, &M::energy_err_max)
+                                  .member("angmom_drift", &R::metrics, &M::angmom_drift)
+                                  .member("angmom_err_max", &R::metrics, &M::angmom_err_max)
+                                  // Came within format_version 4 (with xpbd): an older file reads it as NaN, no
+                                  // constraint view measured, so an older study still compares with a newer one.
+                                  .member("constraint_violation_max", &R::metrics, &M::constraint_violation_max)
+                                  .missing_as(std::numeric_limits<double>::quiet_NaN())
+                                  .member("contacts", &R::metrics, &M::contacts)
+                                  .member("contact_count_err", &R::metrics, &M::contact_count_err)
+                                  .member("contact_time_err", &R::metrics, &M::contact_time_err)
+                                  .member("contact_pos_err", &R::metrics, &M::contact_pos_err)
+                                  .member("tunnelled", &R::metrics, &M::tunnelled)
+                                  .member("max_penetration", &R::metrics, &M::max_penetration)
+                                  .member("diverged", &R::metrics, &M::diverged)
+                                  .member("failed", &R::metrics, &M::failed)
+                                  .member("skipped", &R::metrics, &M::skipped)
+                                  .member("note", &R::metrics, &M::note)
+                                  // Timing fields only in a timed study, so an untimed file does not carry columns
+                                  // of NaN that a reader could mistake for measurements.
+                                  .member("time_ns", &R::time, &T::time_ns)
+                                  .member("time_ns_min", &R::time, &T::time_ns_min)
+                                  .member("time_ns_max", &R::time, &T::time_ns_max)
+                                  .member("repetitions", &R::time, &T::repetitions)
+                                  .member("cut", &R::time, &T::cut);
+  return columns;
 }
 
 void check_writable(const std::string& path) {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/work_precision.hpp"
+#include "store/columns.hpp"
 #include "store/h5.hpp"
 #include "study/study.hpp"
 
@@ -42,11 +43,11 @@ H5::H5File in_memory_file(const std::string& path);
 std::vector<unsigned char> file_image(H5::H5File& file);
 void write_image(const std::vector<unsigned char>& image, const std::string& path);
 
-// The `runs` table of a method's rows (docs/study-format.md); timing fields when timed.
 // A problem's declared parameters (core/parameter.hpp) as the /problems/<p>/parameters
 // table: name, value, unit, kind, value_name (the name of the value, where it has one),
 // default, allowed (the constraint in words), description.
-h5::table parameters_table(const std::vector<param_value>& params);
-h5::table runs_table(const std::vector<method_row>& rows, bool timed);
+const column_map<param_value>& parameters_columns();
+// The `runs` table of a method's rows (docs/study-format.md); timing fields when timed.
+const column_map<method_row>& runs_columns();
 
 }  // namespace stepbench

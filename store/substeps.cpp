@@ -6,6 +6,35 @@
 
 namespace stepbench {
 
+const column_map<substep_row>& substep_runs_columns() {
+  using R = substep_row;
+  static const auto columns = column_map<R>("substeps_runs")
+                                  .fields(
+                                      runs_columns(), [](auto& r) -> auto& { return r.row; })
+                                  .member("substeps", &R::substeps)
+                                  .member("extra_damping", &R::extra_damping);
+  return columns;
+}
+
+const column_map<substep_verdict>& substep_verdict_columns() {
+  using R = substep_verdict;
+  static const auto columns = column_map<R>("substeps_verdict")
+                                  .member("implicit_method", &R::implicit_method)
+                                  .member("explicit_method", &R::explicit_method)
+                                  .member("cost_kind", &R::cost_kind)
+                                  .member("implicit_cost", &R::implicit_cost)
+                                  .member("implicit_error", &R::implicit_error)
+                                  .member("implicit_damping", &R::implicit_damping)
+                                  .member("substeps_at_equal_cost", &R::substeps_at_equal_cost)
+                                  .member("explicit_cost", &R::explicit_cost)
+                                  .member("explicit_error", &R::explicit_error)
+                                  .member("explicit_damping", &R::explicit_damping)
+                                  .member("substeps_to_match", &R::substeps_to_match)
+                                  .member("cost_to_match", &R::cost_to_match)
+                                  .member("summary", &R::summary);
+  return columns;
+}
+
 void write_substeps(H5::Group& root, const std::vector<substep_study>& studies, bool timed) {
   if (studies.empty()) return;
   H5::Group top = root.createGroup("substeps");
@@ -17,38 +46,9 @@ void write_substeps(H5::Group& root, const std::vector<substep_study>& studies, 
       H5::Group mg = methods.createGroup(m.info.name);
       h5::attr(mg, "origin", std::string(to_string(m.info.origin)));
       h5::attr(mg, "needs_jacobian", static_cast<int>(m.info.traits.needs_jacobian));
-      std::vector<method_row> rows;
-      std::vector<std::int64_t> n;
-      std::vector<double> damping;
-      for (const auto& r : m.rows) rows.push_back(r.row), n.push_back(r.substeps), damping.push_back(r.extra_damping);
-      h5::table t = runs_table(rows, timed);
-      t.add("substeps", n);
-      t.add("extra_damping", damping);
-      t.write(mg, "runs", schema::find("substeps_runs"));
+      substep_runs_columns().write(mg, "runs", m.rows, timed);
     }
-    const auto verdicts = substep_verdicts(s, timed);
-    h5::table v;
-    auto col = [&](auto get) {
-      using T = decltype(get(verdicts.front()));
-      std::vector<T> out;
-      for (const auto& x : verdicts) out.push_back(get(x));
-      return out;
-    };
-    v.add("implicit_method", col([](const substep_verdict& x) { return x.implicit_method; }));
-    v.add("explicit_method", col([](const substep_verdict& x) { return x.explicit_method; }));
-    v.add("cost_kind", col([](const substep_verdict& x) { return x.cost_kind; }));
-    v.add("implicit_cost", col([](const substep_verdict& x) { return x.implicit_cost; }));
-    v.add("implicit_error", col([](const substep_verdict& x) { return x.implicit_error; }));
-    v.add("implicit_damping", col([](const substep_verdict& x) { return x.implicit_damping; }));
-    v.add("substeps_at_equal_cost",
-          col([](const substep_verdict& x) { return std::int64_t{x.substeps_at_equal_cost}; }));
-    v.add("explicit_cost", col([](const substep_verdict& x) { return x.explicit_cost; }));
-    v.add("explicit_error", col([](const substep_verdict& x) { return x.explicit_error; }));
-    v.add("explicit_damping", col([](const substep_verdict& x) { return x.explicit_damping; }));
-    v.add("substeps_to_match", col([](const substep_verdict& x) { return std::int64_t{x.substeps_to_match}; }));
-    v.add("cost_to_match", col([](const substep_verdict& x) { return x.cost_to_match; }));
-    v.add("summary", col([](const substep_verdict& x) { return x.summary; }));
-    v.write(g, "verdict", schema::find("substeps_verdict"));
+    substep_verdict_columns().write(g, "verdict", substep_verdicts(s, timed));
   }
 }
 

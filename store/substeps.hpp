@@ -1,16 +1,15 @@
 #pragma once
 #include <vector>
 
+#include "store/columns.hpp"
 #include "study/study.hpp"
-
-namespace H5 {
-class Group;
-}
 
 namespace stepbench {
 
 // /substeps/<problem>: attribute frame_dt (frames = the problem's horizon / frame_dt); methods/<m>/runs (the study's
 // row fields plus `substeps` and `extra_damping`); `verdict` (a table of substep_verdict).
+const column_map<substep_row>& substep_runs_columns();
+const column_map<substep_verdict>& substep_verdict_columns();
 void write_substeps(H5::Group& root, const std::vector<substep_study>& studies, bool timed);
 
 }  // namespace stepbench

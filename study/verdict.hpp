@@ -106,8 +106,11 @@ struct frame_option {
   std::string method, note;
   double hz = 0.0;
   int substeps = 1;
+  double dt = 0.0;
   bool completed = false, diverged = false;
-  double err_pos_max = 0.0, cost_per_frame = 0.0;
+  double err_pos_max = 0.0;  // NaN unless completed
+  long steps = 0;
+  double force_evals = 0.0, cost_per_frame = 0.0;
 };
 
 // A problem's frame-rate runs as a study file holds them (store/verdict.hpp reads them).

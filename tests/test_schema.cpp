@@ -53,9 +53,9 @@ TEST(schema, a_missing_renamed_or_retyped_column_is_refused) {
 TEST(schema, the_timing_group_is_whole_or_absent) {
   H5::H5File f = in_memory_file();
   const std::vector<method_row> rows(2);
-  EXPECT_NO_THROW(runs_table(rows, false).write(f, "untimed", schema::find("runs")));
-  EXPECT_NO_THROW(runs_table(rows, true).write(f, "timed", schema::find("runs")));
-  h5::table partial = runs_table(rows, false);
+  EXPECT_NO_THROW(runs_columns().table(rows, false).write(f, "untimed", schema::find("runs")));
+  EXPECT_NO_THROW(runs_columns().table(rows, true).write(f, "timed", schema::find("runs")));
+  h5::table partial = runs_columns().table(rows, false);
   partial.add("time_ns", std::vector<double>{1.0, 2.0});  // the rest of the timing group missing
   EXPECT_THROW(partial.write(f, "partial", schema::find("runs")), std::logic_error);
 }

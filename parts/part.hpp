@@ -17,7 +17,7 @@
 // the report orders its sections by the `parts` the file names. Adding an analysis is
 // one file of parts/ that defines its study_part (its result type is its own: the study
 // keeps it in `results`, keyed by that type) and one line of parts/registry.cpp;
-// docs/analyses.md shows one.
+// docs/architecture.md walks through one (parts/work_per_step.cpp).
 #include <functional>
 #include <span>
 #include <string>

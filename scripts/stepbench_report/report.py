@@ -2,6 +2,7 @@
 and the verdict as summary.json. It opens on the answer (verdict.opening), then one
 section per problem, the study-wide sections, and the study's metadata last."""
 import json
+import multiprocessing
 import os
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import replace
@@ -109,8 +110,20 @@ def draw_figures(study, figdir, workers, names, whole=True, scans=None):
     if workers <= 1:
         _init_worker(study, names, scans)
         return [p for p in map(_draw, jobs) if p]
-    with ProcessPoolExecutor(max_workers=workers, initializer=_init_worker, initargs=(study, names, scans)) as ex:
-        return [p for p in ex.map(_draw, jobs) if p]
+    ex = ProcessPoolExecutor(max_workers=workers, initializer=_init_worker, initargs=(study, names, scans))
+    try:
+        drawn = [p for p in ex.map(_draw, jobs) if p]
+    except BaseException:
+        # An interruption (SIGINT, or SIGTERM as cli.py raises it) can come before the
+        # executor's manager thread has started, and then nothing tells the workers to stop:
+        # shutdown(wait=True) and the interpreter's exit would wait for them forever (seen
+        # in tests/interrupt_test.sh). The workers are ended here, and the error goes on.
+        ex.shutdown(wait=False, cancel_futures=True)
+        for worker in multiprocessing.active_children():
+            worker.kill()  # not SIGTERM: the handler they inherited from cli.py would run in them
+        raise
+    ex.shutdown()
+    return drawn
 
 
 def in_verdict_order(study):

@@ -71,6 +71,15 @@ T value_at(const read_column& c, std::size_t i) {
     return (*std::get<const std::vector<std::string>*>(c))[i];
 }
 
+// obj.*m.*rest...: the member at the end of a path of member pointers.
+template <class T, class M, class... Rest>
+constexpr auto& member_at(T& obj, M m, Rest... rest) {
+  if constexpr (sizeof...(Rest) == 0)
+    return obj.*m;
+  else
+    return member_at(obj.*m, rest...);
+}
+
 h5::column empty_column(schema::field_type type);
 read_column column_of(const h5::table_data& t, const std::string& field, schema::field_type type);
 
@@ -85,9 +94,10 @@ class column_map {
 
   // The field `name` is the member at `path` (member pointers, outermost first): row.*a.*b.
   template <class... Path>
-    requires(std::is_member_object_pointer_v<Path> && ...)
   column_map& member(std::string_view name, Path... path) {
-    return field(name, [=](auto& r) -> auto& { return (r .* ... .* path); });
+    static_assert((std::is_member_object_pointer_v<Path> && ...), "a path of member pointers");
+    return field(
+        name, [=](auto& r) -> auto& { return columns_detail::member_at(r, path...); });
   }
   // The field `name` is the member access(row) refers to; written and read.
   template <class Access>
@@ -120,7 +130,8 @@ class column_map {
       getter get;
       if (b.get)
         get = [g = b.get, access](Row& r, const columns_detail::read_column& c, std::size_t i) { g(access(r), c, i); };
-      add(b.name, b.type, [p = b.put, access](const Row& r, h5::column& c) { p(access(r), c); }, std::move(get));
+      add(
+          b.name, b.type, [p = b.put, access](const Row& r, h5::column& c) { p(access(r), c); }, std::move(get));
       bindings_.back().missing = b.missing;
     }
     return *this;
@@ -176,8 +187,7 @@ class column_map {
     return out;
   }
   std::vector<Row> read(const H5::Group& g, const std::string& dataset) const {
-    if (!h5::is_dataset(g, dataset))
-      throw std::runtime_error("missing dataset '" + dataset + "' in " + g.getObjName());
+    if (!h5::is_dataset(g, dataset)) throw std::runtime_error("missing dataset '" + dataset + "' in " + g.getObjName());
     return read(h5::read_table(g.openDataSet(dataset)));
   }
 

@@ -512,7 +512,9 @@ def _merged(shares):
         problems[_problem_share(k, len(shares))] = share.problems
     study.problems = problems
     study.gaps = _gaps(problems)
-    if study.stability is None and not study.scan_only:
+    # A study that did not run the part (its `parts` lacks it) is not missing it.
+    ran = study.attrs.get("parts")
+    if study.stability is None and not study.scan_only and (ran is None or "stability" in ran):
         study.gaps.append("no /stability group (the stability limits and regions)")
     return study
 

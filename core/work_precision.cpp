@@ -27,6 +27,8 @@ std::string format_param(method_kind kind, double param) {
 
 std::string format_time_ns(double ns) {
   if (!std::isfinite(ns)) return "n/a";
+  // Rounded to three digits before the unit is chosen: 999.7 ns is "1 us", not "1e+03 ns".
+  ns = std::stod(fmt::format("{:.3g}", ns));
   if (ns >= 1e9) return fmt::format("{:.3g} s", ns * 1e-9);
   if (ns >= 1e6) return fmt::format("{:.3g} ms", ns * 1e-6);
   if (ns >= 1e3) return fmt::format("{:.3g} us", ns * 1e-3);

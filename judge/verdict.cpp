@@ -34,6 +34,9 @@ const problem_study* find_problem(const study& s, std::string_view name) {
 
 namespace {
 
+// A ratio in two digits, never in exponent form: 1.5, 12, 120 (not 1.2e+02).
+std::string ratio_text(double r) { return r >= 100 ? fmt::format("{:.0f}", r) : fmt::format("{:.2g}", r); }
+
 cost_at_error cost_of(const std::vector<wp_method>& methods, const wp_pick* p) {
   if (!p) return {};
   const auto& m = methods[p->method];
@@ -104,14 +107,14 @@ std::vector<std::string> findings_of(const verdict_tables& v, const finding_inpu
                           n, n == 1 ? "" : "s", n == 1 ? "s" : "");
     else if (sv.explicit_error <= sv.implicit_error)
       line += fmt::format(
-          "{} semi_implicit_euler substep{} cost as much as one implicit_euler step and are {:.2g}x "
+          "{} semi_implicit_euler substep{} cost as much as one implicit_euler step and are {}x "
           "more accurate",
-          n, n == 1 ? "" : "s", sv.implicit_error / sv.explicit_error);
+          n, n == 1 ? "" : "s", ratio_text(sv.implicit_error / sv.explicit_error));
     else
       line += fmt::format(
-          "{} semi_implicit_euler substep{} cost as much as one implicit_euler step and are {:.2g}x "
+          "{} semi_implicit_euler substep{} cost as much as one implicit_euler step and are {}x "
           "less accurate",
-          n, n == 1 ? "" : "s", sv.explicit_error / sv.implicit_error);
+          n, n == 1 ? "" : "s", ratio_text(sv.explicit_error / sv.implicit_error));
     if (sv.substeps_to_match > 0) line += fmt::format("; {} substeps match its error", sv.substeps_to_match);
     out.push_back(line + ".");
   }

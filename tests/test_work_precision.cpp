@@ -365,3 +365,13 @@ TEST(advise, frame_rates_follow_the_stability_limits_and_agree_with_the_substeps
   EXPECT_THROW(read_frame_rate_runs(path, "nosuch"), std::invalid_argument);
   std::filesystem::remove(path);
 }
+
+// The unit is chosen after rounding to the three digits shown: a cost just under a
+// microsecond reads "1 us", never "1e+03 ns" (the README's table once did).
+TEST(work_precision, a_time_is_rounded_before_its_unit_is_chosen) {
+  EXPECT_EQ(format_time_ns(999.7), "1 us");
+  EXPECT_EQ(format_time_ns(999.4), "999 ns");
+  EXPECT_EQ(format_time_ns(12345.0), "12.3 us");
+  EXPECT_EQ(format_time_ns(999'999.0), "1 ms");
+  EXPECT_EQ(format_time_ns(std::nan("")), "n/a");
+}

@@ -387,9 +387,9 @@ def section(doc, study, figs):
                       "passes) and the measured time a frame:")
 
 
-# --- --markdown and --readme: the verdict lines, and Small Steps as one compact table ------------
+# --- --markdown: the verdict lines, and Small Steps as one compact table ---------------------------
 
-BRIEF_COUNTS = (1, 4, 16, 64)  # the n the README's Small Steps table shows, of those the study ran
+BRIEF_COUNTS = (1, 4, 16, 64)  # the n the compact Small Steps table shows, of those the study ran
 
 
 def brief_counts(c):
@@ -417,7 +417,7 @@ def brief_cell(r):
 
 
 def small_steps_brief(c):
-    """The Small Steps table of --markdown and --readme: (caption, head, rows), a row per
+    """The Small Steps table of --markdown: (caption, head, rows), a row per
     problem and n, a column per design, each cell a run's error and time a frame."""
     shown, left_out = brief_counts(c)
     present = set(c.small_steps["design"].tolist())
@@ -453,13 +453,3 @@ def answer(doc, c, level=2):
     doc.items(c.lines(SMALL_STEPS))
     caption, head, rows = small_steps_brief(c)
     doc.table(head, rows, caption=caption)
-
-
-def readme_lines(c):
-    """--readme: the same, as Markdown lines."""
-    caption, head, rows = small_steps_brief(c)
-    return (["", f"**Pendulum challenge** (XPBD, {int(c.attrs['xpbd_substeps'])} substeps a "
-                 f"{float(c.attrs['hz']):g} Hz frame, against our methods in generalized coordinates):", ""]
-            + [f"- {line}" for line in c.answer] + ["", "Small Steps:", ""]
-            + [f"- {line}" for line in c.lines(SMALL_STEPS)]
-            + ["", caption, "", _md_row(head), "|" + "---|" * len(head)] + [_md_row(r) for r in rows])

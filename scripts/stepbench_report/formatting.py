@@ -17,6 +17,7 @@ def fmt_time_ns(ns):
     """As C++'s format_time_ns: "12.3 us"."""
     if ns is None or not np.isfinite(ns):
         return "n/a"
+    ns = float(f"{ns:.3g}")  # rounded before the unit is chosen: 999.7 ns is "1 us"
     for scale, unit in ((1e9, "s"), (1e6, "ms"), (1e3, "us")):
         if ns >= scale:
             return f"{ns / scale:.3g} {unit}"
@@ -53,6 +54,7 @@ def fmt_count(n):
     """A count such as force evaluations, short: 950, 12k, 1.2M."""
     if n is None or not np.isfinite(n):
         return "n/a"
+    n = float(f"{n:.3g}")  # rounded before the unit is chosen: 999,700 is "1M", not "1000k"
     for scale, unit in ((1e9, "G"), (1e6, "M"), (1e3, "k")):
         if n >= scale:
             return f"{_two_digits(n / scale)}{unit}"

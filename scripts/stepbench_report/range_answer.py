@@ -1,6 +1,6 @@
 """The range answers a study file stores with its scans (/scan/<name> `range_answer`:
 stepbench computed each when it wrote the scan, as `advise --scan` prints it), read for
---markdown and --readme. Nothing here computes an answer: the README's cut drops lines."""
+--markdown (docs/results.md). Nothing here computes an answer."""
 
 
 def _text(v):
@@ -24,18 +24,4 @@ def _read_file(path):
         return [(name, _text(g.attrs["range_answer"])) for name, g in f["scan"].items()
                 if "range_answer" in g.attrs]
 
-
-def brief_answer(text, hz=60.0):
-    """The README's cut of a range answer: its first line, the choice at every rate and,
-    of the lines at one step a frame, those at `hz` only (the other rates are in the report)."""
-    out = []
-    for line in text.rstrip("\n").split("\n"):
-        words = line.split()
-        one_step = len(words) > 2 and line.startswith("  ") and words[1] == "Hz" and not words[0].endswith(":")
-        if one_step and float(words[0]) != hz:
-            continue
-        if line == "At one step a frame:":
-            line = f"At one step a {hz:g} Hz frame (the other rates in the report):"
-        out.append(line)
-    return "\n".join(out)
 

@@ -350,6 +350,10 @@ def results_doc(study, command):
     if getattr(study, "challenge", None) is not None:
         from . import challenge
         challenge.answer(doc, study.challenge)
+    orders = xpbd_orders(study)
+    if orders:
+        doc.p("xpbd's observed order over the substep ladder (the study's fit, its levels in brackets): "
+              + "; ".join(orders) + ".")
     answers = _range_answers(study)
     if answers:
         doc.h(2, "A scene's range")
@@ -362,9 +366,29 @@ def results_doc(study, command):
     return doc
 
 
+# The README is a front page: no line of its block over this many characters (the whole
+# tables, the challenge, Small Steps, xpbd's findings and the scans' answers are in
+# docs/results.md, which --markdown writes from the same study).
+README_WIDTH = 160
+
+
+def readme_cell(r, kind):
+    """One (problem, target) of the README's table: our fastest method and its cost, and
+    that cost as a multiple of the fastest peer's ("rk4, 4.43 us (0.84x)"); the method's
+    dt or tolerance and the peer's name are in docs/results.md."""
+    if r is None:
+        return ""
+    if not r["ours_method"]:
+        return "peer only" if r["peer_method"] else "not reached"
+    cost = cost_text(kind, r["ours_cost"])
+    return f"{r['ours_method']}, {cost} ({ratio_text(r['ratio']) if r['peer_method'] else 'no peer'})"
+
+
 def readme_block(study, command):
     """--readme: the headline table (per problem: the fastest of ours at two typical
-    targets and the cheapest at 60 Hz) and the line naming the study."""
+    targets and the cheapest at 60 Hz), what it means, where the rest is, and the line
+    naming the study; every line within README_WIDTH characters."""
+    import textwrap
     v = study.verdict
     kind = v.cost_kind
     targets = [t for t in README_TARGETS if any(np.isclose(v.targets, t, rtol=1e-9, atol=0))]
@@ -373,44 +397,23 @@ def readme_block(study, command):
              + f" | {hz:g} Hz, error {target_text(frame_target)} |",
              "|---|" + "---|" * (len(targets) + 1)]
     for p in v.problems:
-        cells = [f"{p} ({v.unit(p)})"]
-        for t in targets:
-            r = v.equal(p, t)
-            cells.append(equal_error_cell(r, kind).md if r is not None else "")
-        a = v.answer(p, hz, frame_target)
-        rates = v.rates(p, hz)
-        if a is not None and a["method"]:
-            cells.append(f"{a['method']} x{int(a['substeps'])}, {frame_cost_text(kind, a)}; "
-                         f"{stable_text(rates, shorten=False)}")
-        else:
-            cells.append(f"none within 64 substeps; {stable_text(rates, shorten=False)}")
+        cells = [f"{p} ({v.unit(p)})"] + [readme_cell(v.equal(p, t), kind) for t in targets]
+        a, rates = v.answer(p, hz, frame_target), v.rates(p, hz)
+        stable = f"{int(np.count_nonzero(rates['stable']))} of {len(rates)} stable"
+        cells.append(f"{a['method']} x{int(a['substeps'])}, {cost_text(kind, float(a['cost_per_frame']))}; {stable}"
+                     if a is not None and a["method"] else f"none within 64 substeps; {stable}")
         lines.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
     a = study.attrs
-    lines += ["", f"Error: `{v.attrs['metric']}`, the max position error over the run, in the problem's unit. "
-              "At an error: the fastest of our methods, its dt or tolerance and its cost, and in brackets that "
-              "cost as a multiple of the fastest library peer's at the same error. At a frame rate: the cheapest of "
-              "our fixed-step methods with n substeps a frame (x n) and its cost per frame (in brackets: its share of "
-              "the frame), then which of them are stable at one step a frame.",
-              "", f"Study `{study.path}`, commit {a['git_commit']}, {a['cpu']}, {a['created_utc']}; written by "
-              f"`{command}`."]
-    if getattr(study, "challenge", None) is not None:  # before the line naming the study
-        from . import challenge
-        lines[-2:-2] = challenge.readme_lines(study.challenge)
-    orders = xpbd_orders(study)
-    if orders:
-        lines[-2:-2] = ["", "**xpbd's observed order** over the substep ladder (the study's fit, its levels in "
-                        "brackets): " + "; ".join(orders) + "."]
-    ladder = xpbd_ladder_finding(v)
-    if ladder:
-        lines[-2:-2] = ["", "**xpbd's stability and energy** (a finding of the study, verbatim): " + ladder]
-    answers = _range_answers(study)
-    if answers:
-        from . import range_answer
-        block = ["", "**A scene's range** (the full study's scans; `stepbench advise --scan FILE --tol X` at another "
-                 "tolerance, every rate and map in the report):"]
-        for _, text in answers:
-            block += ["", "```", range_answer.brief_answer(text), "```"]
-        lines[-2:-2] = block
+    prose = [f"Error: `{v.attrs['metric']}`, the largest position error over the run, in the problem's unit. At an "
+             "error: the fastest of our methods and its cost, in brackets that cost as a multiple of the fastest "
+             f"library peer's at the same error. At {hz:g} Hz: the cheapest of our fixed-step methods with n substeps "
+             "a frame (x n), its cost a frame, and how many of them stay stable at one step a frame.",
+             "Each method's dt or tolerance, the peers, the findings, the pendulum challenge, Small Steps and the "
+             "scenes' range answers: [docs/results.md](docs/results.md), written from the same study."]
+    for para in prose:
+        lines += [""] + textwrap.wrap(para, README_WIDTH - 30, break_long_words=False, break_on_hyphens=False)
+    lines += ["", f"Study `{study.path}`, commit {a['git_commit']}, {a['cpu']}, {a['created_utc']};",
+              f"written by `{command}`."]
     return "\n".join(lines)
 
 
@@ -420,14 +423,6 @@ def _range_answers(study):
         return range_answer.range_answers(study.path)
     except (OSError, KeyError):
         return []
-
-
-XPBD_LADDER_FINDING = "xpbd over its dt ladder"  # how judge/verdict.cpp's finding on xpbd's runs opens
-
-
-def xpbd_ladder_finding(v):
-    """The finding on xpbd's stability and energy over its ladder, as stored; None without one."""
-    return next((f for f in v.findings if f.startswith(XPBD_LADDER_FINDING)), None)
 
 
 def xpbd_orders(study):

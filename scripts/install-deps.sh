@@ -3,7 +3,7 @@
 # silent when everything is present. Needs root (or sudo) only when something is missing.
 set -euo pipefail
 packages=(
-  g++ cmake make git pkg-config clang-format ccache
+  g++ cmake make ninja-build git pkg-config clang-format ccache
   libeigen3-dev libgsl-dev libsundials-dev libhdf5-dev hdf5-tools
   libbenchmark-dev libbenchmark-tools libcli11-dev libfmt-dev nlohmann-json3-dev libboost-dev
   googletest libgtest-dev

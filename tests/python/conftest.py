@@ -57,6 +57,17 @@ def plain_study(stepbench, tmp_path_factory):
 
 
 @pytest.fixture(scope="session")
+def small_study(stepbench, tmp_path_factory):
+    """`stepbench sweep --quick` of three problems: every part of the study (the substeps
+    and the scan on stiff_spring), for the tests that cut a part out of a complete study
+    and read what the report makes of it; its report draws in a fifth of the time."""
+    path = tmp_path_factory.mktemp("small") / "study.h5"
+    run_study([stepbench, "sweep", "--quick", "--quiet", "--problem", "damped_spring", "--problem", "pendulum",
+               "--problem", "stiff_spring", "--out", str(path)], stdout=subprocess.DEVNULL)
+    return path
+
+
+@pytest.fixture(scope="session")
 def timed_study(bench, tmp_path_factory, request):
     """`stepbench_bench --quick --study_out`: the same sweep with every row timed (a few
     seconds). Returns the path and the finished process, whose output some tests read.

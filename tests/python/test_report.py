@@ -301,9 +301,9 @@ def test_stability_table_is_the_files(reports, shape):
     assert not os.path.exists(os.path.join(ROOT, "scripts", "stepbench_report", "theory.py"))
 
 
-def test_a_study_without_stability_is_incomplete(plain_study, tmp_path):
+def test_a_study_without_stability_is_incomplete(small_study, tmp_path):
     cut = tmp_path / "cut.h5"
-    edit(plain_study, cut, lambda f: f.__delitem__("stability"))
+    edit(small_study, cut, lambda f: f.__delitem__("stability"))
     out = tmp_path / "report"
     p = run_report(cut, out)
     assert p.returncode == 0, p.stderr
@@ -365,9 +365,9 @@ def test_substeps_verdicts_are_the_files(reports, shape):
                     assert float(r["artificial damping"]) == pytest.approx(match[0]["extra_damping"], rel=5e-3)
 
 
-def test_a_study_without_substeps_reports_it_absent(plain_study, tmp_path):
+def test_a_study_without_substeps_reports_it_absent(small_study, tmp_path):
     cut = tmp_path / "cut.h5"
-    edit(plain_study, cut, lambda f: f.__delitem__("substeps"))
+    edit(small_study, cut, lambda f: f.__delitem__("substeps"))
     out = tmp_path / "report"
     p = run_report(cut, out)
     assert p.returncode == 0, p.stderr
@@ -706,7 +706,7 @@ def test_a_study_without_verdict_says_so_first(plain_study, tmp_path):
     assert p.returncode == 1 and "no /verdict" in p.stderr and not (tmp_path / "r.md").exists()
 
 
-def test_a_format_3_study_is_read(plain_study, tmp_path):
+def test_a_format_3_study_is_read(small_study, tmp_path):
     """A study written before the verdict (format 3: no /verdict, equal_error without its
     interpolation fields) is still read."""
     old = tmp_path / "v3.h5"
@@ -724,7 +724,7 @@ def test_a_format_3_study_is_read(plain_study, tmp_path):
             del g["equal_error"]
             g.create_dataset("equal_error", data=new)
         f.attrs["format_version"] = 3
-    edit(plain_study, old, change)
+    edit(small_study, old, change)
     p = run_report(old, tmp_path / "report")
     assert p.returncode == 0, p.stderr
     assert "has no /verdict group" in report_text(tmp_path / "report")
@@ -827,7 +827,7 @@ def test_a_bad_file_is_refused_and_the_old_report_kept(reports, plain_study, tmp
     assert sorted(os.listdir(tmp_path)) == sorted(["report"] + ([] if kind == "missing" else ["bad.h5"]))
 
 
-def test_an_incomplete_study_is_reported_as_such(plain_study, tmp_path):
+def test_an_incomplete_study_is_reported_as_such(small_study, tmp_path):
     cut = tmp_path / "cut.h5"
 
     def change(f):
@@ -839,7 +839,7 @@ def test_an_incomplete_study_is_reported_as_such(plain_study, tmp_path):
             rows = f[f"problems/pendulum/{table}"][()]
             del f[f"problems/pendulum/{table}"]
             f.create_dataset(f"problems/pendulum/{table}", data=rows[rows["method"].astype(str) != "odeint_rk4"])
-    edit(plain_study, cut, change)
+    edit(small_study, cut, change)
     out = tmp_path / "report"
     p = run_report(cut, out)
     assert p.returncode == 0, p.stderr
@@ -851,20 +851,20 @@ def test_an_incomplete_study_is_reported_as_such(plain_study, tmp_path):
     assert "Incomplete study file: pendulum: no runs for odeint_rk4" in md
 
 
-def test_never_replaces_a_folder_it_did_not_write(reports, plain_study, tmp_path):
+def test_never_replaces_a_folder_it_did_not_write(reports, small_study, tmp_path):
     """--out naming a folder with other files in it (results/, the working directory)
     is refused, and nothing in it is touched; a report folder it wrote is replaced."""
     precious = tmp_path / "results"
     precious.mkdir()
     (precious / "notes.txt").write_text("keep me\n")
     for out, cwd in [(str(precious), None), ("", str(precious)), (".", str(precious))]:
-        p = run_report(plain_study, out, cwd=cwd)
+        p = run_report(small_study, out, cwd=cwd)
         assert p.returncode == 1, p.stdout
         assert len(p.stderr.strip().splitlines()) == 1 and p.stderr.startswith("report: error:"), p.stderr
         assert sorted(os.listdir(precious)) == ["notes.txt"]
     report = tmp_path / "report"
     shutil.copytree(reports["timed"][1], report)  # a report this script wrote
-    p = run_report(plain_study, report)
+    p = run_report(small_study, report)
     assert p.returncode == 0, p.stderr
     assert (report / ".stepbench-report").exists() and "Timings: absent" in report_text(report)
     assert sorted(os.listdir(tmp_path)) == ["report", "results"]  # no temporary folder left

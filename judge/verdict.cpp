@@ -146,7 +146,8 @@ std::vector<std::string> findings_of(const verdict_tables& v, const finding_inpu
       int ran = 0, completed = 0, diverged = 0, failed = 0;
       double dt_max = 0.0, dt_min = std::numeric_limits<double>::infinity();
       const ladder_run *coarsest = nullptr, *finest = nullptr;  // of the completed runs
-      double largest_drift = -std::numeric_limits<double>::infinity(), worst_constraint = nan;
+      // The highest signed drift, not the largest in size: whether any run gained energy.
+      double highest_drift = -std::numeric_limits<double>::infinity(), worst_constraint = nan;
       for (const auto& r : runs) {
         if (r.skipped) continue;
         ++ran;
@@ -158,7 +159,7 @@ std::vector<std::string> findings_of(const verdict_tables& v, const finding_inpu
         ++completed;
         if (!coarsest || r.dt > coarsest->dt) coarsest = &r;
         if (!finest || r.dt < finest->dt) finest = &r;
-        largest_drift = std::fmax(largest_drift, r.energy_drift);  // fmax drops a NaN
+        highest_drift = std::fmax(highest_drift, r.energy_drift);  // fmax drops a NaN
         worst_constraint = std::fmax(worst_constraint, r.constraint_violation);
       }
       if (ran == 0) continue;  // every rung over the work budget: nothing to say of it
@@ -168,16 +169,17 @@ std::vector<std::string> findings_of(const verdict_tables& v, const finding_inpu
       if (failed > 0) part += fmt::format(", failed at {}", failed);
       // A merged file may lack a drift (NaN): say only the numbers the runs have.
       if (coarsest && std::isfinite(coarsest->energy_drift) && std::isfinite(finest->energy_drift))
-        part += fmt::format(", final energy drift {:.2g} at {} and {:.2g} at {} (largest {:.2g})",
+        part += fmt::format(", final energy drift {:.2g} at {} and {:.2g} at {} (highest {:.2g})",
                             coarsest->energy_drift, format_time_ns(coarsest->dt * 1e9), finest->energy_drift,
-                            format_time_ns(finest->dt * 1e9), largest_drift);
+                            format_time_ns(finest->dt * 1e9), highest_drift);
       if (std::isfinite(worst_constraint)) part += fmt::format(", |C|/L within {:.2g}", worst_constraint);
       parts += (parts.empty() ? "" : "; ") + part;
     }
     if (!parts.empty())
       out.push_back(fmt::format(
           "{} over its dt ladder (final energy drift: the energy at the run's end against the truth's, of the "
-          "problem's energy scale, at the coarsest and the finest completed dt and the largest over the completed; "
+          "problem's energy scale, at the coarsest and the finest completed dt and the highest over the completed, "
+          "the most energy gained or the least lost; "
           "|C|/L: the largest relative length error of a rigid link, the stretch of a spring, over the run): {}.",
           method, parts));
   }

@@ -281,7 +281,7 @@ static std::string expected_xpbd_part(const std::string& problem, const std::vec
   if (diverged > 0) part += fmt::format(", diverged at {}", diverged);
   if (failed > 0) part += fmt::format(", failed at {}", failed);
   if (coarsest)
-    part += fmt::format(", final energy drift {:.2g} at {} and {:.2g} at {} (largest {:.2g})",
+    part += fmt::format(", final energy drift {:.2g} at {} and {:.2g} at {} (highest {:.2g})",
                         coarsest->metrics.energy_drift, format_time_ns(coarsest->param * 1e9),
                         finest->metrics.energy_drift, format_time_ns(finest->param * 1e9), largest);
   if (std::isfinite(worst)) part += fmt::format(", |C|/L within {:.2g}", worst);
@@ -358,7 +358,7 @@ TEST(sweep, xpbd_finding_counts_diverged_failed_and_skipped_runs) {
   in.small_steps_ladders.push_back({"xpbd", "merged", {{0.1, false, false, false, nan, nan}}});
   EXPECT_EQ(xpbd_finding().substr(xpbd_finding().find("): ") + 3),
             "rope completed 3 of the 5 dt it ran (100 ms to 6.25 ms), diverged at 1, failed at 1, final energy drift "
-            "-0.5 at 25 ms and -0.25 at 6.25 ms (largest 0.1), |C|/L within 0.25; merged completed 1 of the 1 dt it "
+            "-0.5 at 25 ms and -0.25 at 6.25 ms (highest 0.1), |C|/L within 0.25; merged completed 1 of the 1 dt it "
             "ran (100 ms to 100 ms).");
 }
 

@@ -95,8 +95,8 @@ int run_advise(const advise_args& args) {
       fmt::print("{}", format_frame_advice(f));
     return f.met() ? 0 : advise_exit_no_method;
   }
-  const study_data study = read_study(args.study);
-  const advice a = advise(study, args.problem, args.metric, tol);
+  const study s = read_study(args.study);
+  const advice a = advise(s, args.problem, args.metric, tol);
   const int code = a.met() ? 0 : advise_exit_no_method;
   if (!args.json) {
     fmt::print("{}", format_advice(a));

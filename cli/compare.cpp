@@ -141,8 +141,8 @@ int run_compare(const compare_args& a) {
     opts.gate_timing = a.gate_timing;
     if (a.json && a.format == "md") throw std::invalid_argument("--json and --format md: choose one");
     const std::string format = a.json ? "json" : a.format;
-    const std::vector<study_data> files = read_studies({a.base, a.next});  // read at once
-    const study_data &base = files[0], &next = files[1];
+    const std::vector<study> files = read_studies({a.base, a.next});  // read at once
+    const study &base = files[0], &next = files[1];
     const comparison c = compare_studies(base, next, opts);
     // The equal-error verdicts of two timed studies side by side (informs, never gates).
     std::optional<verdict_agreement> verdicts;

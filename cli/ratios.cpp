@@ -39,28 +39,26 @@ struct ratios_args {
 };
 
 // ns per step of each named method at the finest dt where all of them were timed.
-json step_costs(const study_problem& p, const std::vector<std::string>& names) {
-  std::vector<const study_method*> ms;
+json step_costs(const problem_study& p, const std::vector<std::string>& names) {
+  std::vector<const method_study*> ms;
   for (const auto& n : names)
     if (const auto* m = p.find(n)) ms.push_back(m);
-  if (ms.empty() || !ms.front()->columns.count("time_ns")) return nullptr;
-  const auto& ladder = ms.front()->col("param");
+  if (ms.empty()) return nullptr;
+  const auto& ladder = ms.front()->rows;
   for (std::size_t k = ladder.size(); k-- > 0;) {
-    json row = {{"problem", p.name},
-                {"dt", ladder[k]},
-                {"ns_per_step", json::object()},
-                {"force_evals_per_step", json::object()}};
+    const double dt = ladder[k].param;
+    json row = {
+        {"problem", p.name}, {"dt", dt}, {"ns_per_step", json::object()}, {"force_evals_per_step", json::object()}};
     bool all = true;
     for (const auto* m : ms) {
-      const auto& param = m->col("param");
-      const auto it = std::find(param.begin(), param.end(), ladder[k]);
-      const std::size_t i = static_cast<std::size_t>(it - param.begin());
-      if (it == param.end() || !std::isfinite(m->col("time_ns")[i])) {
+      const auto it = std::find_if(m->rows.begin(), m->rows.end(), [&](const method_row& r) { return r.param == dt; });
+      if (it == m->rows.end() || !std::isfinite(it->time.time_ns)) {
         all = false;
         break;
       }
-      row["ns_per_step"][m->name] = m->col("time_ns")[i] / m->col("steps")[i];
-      row["force_evals_per_step"][m->name] = m->col("force_evals")[i] / m->col("steps")[i];
+      const double steps = static_cast<double>(it->steps);
+      row["ns_per_step"][m->info.name] = it->time.time_ns / steps;
+      row["force_evals_per_step"][m->info.name] = static_cast<double>(it->work.force_evals) / steps;
     }
     if (all) return row;
   }
@@ -70,20 +68,19 @@ json step_costs(const study_problem& p, const std::vector<std::string>& names) {
 // ns per right-hand-side call of the library solvers (every adaptive peer and the
 // eighth-order fixed steps): the median over its timed rows of time / force evaluations
 // (one figure per method, robust to the rows' spread).
-json ns_per_call(const study_problem& p) {
+json ns_per_call(const problem_study& p) {
   json out = json::object();
-  for (const auto& method : p.methods) {
-    const auto* m = &method;
-    const std::string& n = m->name;
-    const bool solver = m->kind == method_kind::adaptive || m->declared_order >= 8.0;
-    if (m->origin != method_origin::peer || !solver || !m->columns.count("time_ns")) continue;
+  for (const auto& m : p.methods) {
+    const method_info& info = m.info;
+    const bool solver = info.kind == method_kind::adaptive || info.declared_order >= 8.0;
+    if (info.origin != method_origin::peer || !solver) continue;
     std::vector<double> v;
-    const auto &t = m->col("time_ns"), &f = m->col("force_evals");
-    for (std::size_t i = 0; i < t.size(); ++i)
-      if (std::isfinite(t[i]) && f[i] > 0) v.push_back(t[i] / f[i]);
+    for (const auto& r : m.rows)
+      if (std::isfinite(r.time.time_ns) && r.work.force_evals > 0)
+        v.push_back(r.time.time_ns / static_cast<double>(r.work.force_evals));
     if (v.empty()) continue;
     std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-    out[n] = {{"ns_per_call", v[v.size() / 2]}, {"rows", v.size()}, {"library", m->library}};
+    out[info.name] = {{"ns_per_call", v[v.size() / 2]}, {"rows", v.size()}, {"library", info.library}};
   }
   return out;
 }
@@ -98,8 +95,8 @@ std::string verdict(double ours_over_peer) {
 
 // Cheapest of ours and cheapest peer at a target, among the methods that were timed
 // (wp_candidates::timed_methods: core/work_precision.hpp says why).
-json equal_error(const study_problem& p, double target, const std::string& metric) {
-  const std::vector<wp_method> methods = work_precision_input(p, metric, true);
+json equal_error(const problem_study& p, double target, const std::string& metric) {
+  const std::vector<wp_method> methods = work_precision_input(p, metric);
   const auto r = cheapest(methods, target, true, metric, p.unit, wp_candidates::timed_methods);
   json out = {{"problem", p.name}, {"metric", metric}, {"target", target}, {"cost", r.cost}, {"ranked", json::array()}};
   const wp_pick *ours = nullptr, *peer = nullptr;
@@ -136,8 +133,9 @@ json equal_error(const study_problem& p, double target, const std::string& metri
 }
 
 // Every figure, as `--json` prints it and the text below is drawn from.
-json ratios_json(const study_data& s, const ratios_args& a) {
-  json out = {{"study", a.study}, {"cpu", s.meta.count("cpu") ? s.meta.at("cpu") : ""}};
+json ratios_json(const study& s, const ratios_args& a) {
+  const auto& meta = s.record->meta;
+  json out = {{"study", a.study}, {"cpu", meta.count("cpu") ? meta.at("cpu") : ""}};
   if (const auto* spring = s.find("damped_spring"))
     out["step_cost"] = step_costs(*spring, {"rk4", "baseline_rk4", "gsl_rk4", "odeint_rk4"});
   out["step_cost_rk8"] = json::array();
@@ -160,8 +158,10 @@ json ratios_json(const study_data& s, const ratios_args& a) {
   for (const auto& p : s.problems)
     for (const auto& m : p.methods)
       if (m.declared_order_holds == 0)
-        out["order_notes"].push_back(
-            {{"problem", p.name}, {"method", m.name}, {"declared", m.declared_order}, {"observed", m.fit_slope}});
+        out["order_notes"].push_back({{"problem", p.name},
+                                      {"method", m.info.name},
+                                      {"declared", m.info.declared_order},
+                                      {"observed", m.fit.order}});
   return out;
 }
 
@@ -299,7 +299,7 @@ constexpr const char* step_cost_subjects[] = {"rk4",          "baseline_rk4", "g
 int run_ratios(const ratios_args& a) {
   for (const auto& name : a.problems) make_problem(name);             // an unknown name: exit 2, naming the known ones
   for (const char* method : step_cost_subjects) find_method(method);  // unknown: exit 2, naming the known ones
-  const study_data s = read_study(a.study);
+  const study s = read_study(a.study);
   if (!s.timed) throw std::runtime_error(fmt::format("{} has no timings: run stepbench_bench --study_out", a.study));
   const json out = ratios_json(s, a);
   if (a.json)

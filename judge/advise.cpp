@@ -12,18 +12,16 @@
 #include "judge/rows.hpp"
 
 namespace stepbench {
-namespace {}  // namespace
-
-advice advise(const study_data& study, const std::string& problem, const std::string& metric, double tol) {
+advice advise(const study& study, const std::string& problem, const std::string& metric, double tol) {
   if (!is_error_metric(metric))
     throw std::invalid_argument(fmt::format("unknown metric '{}' (known: {})", metric, fmt::join(error_metrics, ", ")));
   if (!(tol > 0.0) || !std::isfinite(tol)) throw std::invalid_argument(fmt::format("--tol must be > 0, got {}", tol));
-  const study_problem* p = study.find(problem);
+  const problem_study* p = study.find(problem);
   if (!p) {
     std::vector<std::string> names;
     for (const auto& q : study.problems) names.push_back(q.name);
     throw std::invalid_argument(fmt::format("problem '{}' is not in the study file '{}' (it has: {})", problem,
-                                            study.path,
+                                            study.record ? study.record->path : "",
                                             names.empty() ? "none" : fmt::format("{}", fmt::join(names, ", "))));
   }
   advice a;
@@ -31,9 +29,9 @@ advice advise(const study_data& study, const std::string& problem, const std::st
   a.metric = metric;
   a.unit = metric == "err_vel_final" ? p->unit + "/s" : p->unit;
   a.tol = tol;
-  a.timed = study.timed;
-  a.methods = work_precision_input(*p, metric, study.timed);
-  a.result = cheapest(a.methods, tol, study.timed, metric, a.unit);
+  a.timed = study.timed.has_value();
+  a.methods = work_precision_input(*p, metric);
+  a.result = cheapest(a.methods, tol, a.timed, metric, a.unit);
   return a;
 }
 

@@ -15,7 +15,6 @@
 
 #include "core/work_precision.hpp"
 #include "study/study.hpp"
-#include "study/study_data.hpp"
 
 namespace stepbench {
 
@@ -32,7 +31,7 @@ struct advice {
 
 // Throws std::invalid_argument for an unknown metric or a problem the file lacks
 // (naming the problems it has), or a tol that is not a positive finite number.
-advice advise(const study_data& study, const std::string& problem, const std::string& metric, double tol);
+advice advise(const study& study, const std::string& problem, const std::string& metric, double tol);
 
 // The human-readable answer (several lines, ends with a newline).
 

@@ -13,6 +13,8 @@
 #include "core/number.hpp"
 #include "core/text.hpp"
 #include "core/work_precision.hpp"
+#include "judge/rows.hpp"
+#include "study/stability.hpp"
 
 namespace stepbench {
 namespace {
@@ -23,21 +25,21 @@ namespace {
 // function in one of the two lists below.
 
 struct problem_pair {
-  const study_problem& base;
-  const study_problem& next;
+  const problem_study& base;
+  const problem_study& next;
   const compare_options& opts;
 };
 
 struct method_pair {
-  const study_problem& base_problem;
-  const study_problem& next_problem;
-  const study_method& base;
-  const study_method& next;
+  const problem_study& base_problem;
+  const problem_study& next_problem;
+  const method_study& base;
+  const method_study& next;
   const compare_options& opts;
   std::vector<std::pair<std::size_t, std::size_t>> rows;  // (base row, new row) with equal param
 };
 
-change problem_change(change_kind k, const study_problem& p, std::string what, compare_value old_value,
+change problem_change(change_kind k, const problem_study& p, std::string what, compare_value old_value,
                       compare_value new_value) {
   change c;
   c.kind = k;
@@ -53,38 +55,38 @@ change row_change(change_kind k, const method_pair& mp, std::size_t new_row, std
   change c;
   c.kind = k;
   c.problem = mp.next_problem.name;
-  c.method = mp.next.name;
-  c.param_name = std::string(param_name(mp.next.kind));
-  c.param = mp.next.col("param")[new_row];
+  c.method = mp.next.info.name;
+  c.param_name = std::string(param_name(mp.next.info.kind));
+  c.param = mp.next.rows[new_row].param;
   c.what = std::move(what);
   c.old_value = old_value;
   c.new_value = new_value;
   c.ratio = new_value / old_value;
-  if (new_row < mp.next.notes.size()) c.note = mp.next.notes[new_row];
+  c.note = mp.next.rows[new_row].metrics.note;
   return c;
 }
 
 // The truth a problem's errors are measured against: its source and whether it is trusted.
 void check_truth(const problem_pair& pp, comparison& out) {
-  if (pp.base.truth_source != pp.next.truth_source)
-    out.changes.push_back(
-        problem_change(change_kind::regression, pp.next, "truth_source", pp.base.truth_source, pp.next.truth_source));
-  if (pp.base.truth_trusted != pp.next.truth_trusted)
-    out.changes.push_back(problem_change(pp.next.truth_trusted ? change_kind::improvement : change_kind::regression,
-                                         pp.next, "truth_trusted", pp.base.truth_trusted ? 1.0 : 0.0,
-                                         pp.next.truth_trusted ? 1.0 : 0.0));
+  const truth_table &base = pp.base.truth, &next = pp.next.truth;
+  if (base.source != next.source)
+    out.changes.push_back(problem_change(change_kind::regression, pp.next, "truth_source", base.source, next.source));
+  if (base.trusted != next.trusted)
+    out.changes.push_back(problem_change(next.trusted ? change_kind::improvement : change_kind::regression, pp.next,
+                                         "truth_trusted", base.trusted ? 1.0 : 0.0, next.trusted ? 1.0 : 0.0));
 }
 
 // The references: status (ok, failed, disagrees) and agreement with what they are compared with.
 void check_references(const problem_pair& pp, comparison& out) {
-  for (const auto& r : pp.base.references) {
-    const auto it = std::find_if(pp.next.references.begin(), pp.next.references.end(),
-                                 [&](const study_reference& n) { return n.source == r.source; });
-    if (it == pp.next.references.end()) {
+  const auto &base = pp.base.truth.references, &next = pp.next.truth.references;
+  for (const auto& r : base) {
+    const auto it =
+        std::find_if(next.begin(), next.end(), [&](const reference_check& n) { return n.source == r.source; });
+    if (it == next.end()) {
       out.removed.push_back({pp.base.name, "", "reference " + r.source, "status " + r.status + " in BASE"});
       continue;
     }
-    const study_reference& n = *it;
+    const reference_check& n = *it;
     const bool was_ok = r.status == "ok", is_ok = n.status == "ok";
     if (was_ok != is_ok) {
       auto c = problem_change(is_ok ? change_kind::improvement : change_kind::regression, pp.next,
@@ -93,8 +95,8 @@ void check_references(const problem_pair& pp, comparison& out) {
       out.changes.push_back(std::move(c));
     }
     if (r.compared_with != n.compared_with) continue;  // agreements with different things do not compare
-    for (const auto& [field, old_rel, new_rel] : {std::tuple{"err_pos_rel", r.err_pos_rel, n.err_pos_rel},
-                                                  std::tuple{"err_vel_rel", r.err_vel_rel, n.err_vel_rel}})
+    for (const auto& [field, old_rel, new_rel] :
+         {std::tuple{"err_pos_rel", r.vs.pos_rel, n.vs.pos_rel}, std::tuple{"err_vel_rel", r.vs.vel_rel, n.vs.vel_rel}})
       if (const auto k = judge_agreement(old_rel, new_rel, pp.opts.error_factor)) {
         auto c = problem_change(*k, pp.next, fmt::format("reference {} {}", r.source, field), old_rel, new_rel);
         c.ratio = new_rel / old_rel;
@@ -102,27 +104,33 @@ void check_references(const problem_pair& pp, comparison& out) {
         out.changes.push_back(std::move(c));
       }
   }
-  for (const auto& n : pp.next.references)
-    if (std::none_of(pp.base.references.begin(), pp.base.references.end(),
-                     [&](const study_reference& r) { return r.source == n.source; }))
+  for (const auto& n : next)
+    if (std::none_of(base.begin(), base.end(), [&](const reference_check& r) { return r.source == n.source; }))
       out.added.push_back({pp.next.name, "", "reference " + n.source, "status " + n.status + " in NEW"});
 }
 
-std::string param_list(const study_method& m, const std::vector<double>& params) {
+std::string param_list(const method_study& m, const std::vector<double>& params) {
   std::string s;
-  for (double p : params) s += (s.empty() ? "" : ", ") + format_param(m.kind, p);
+  for (double p : params) s += (s.empty() ? "" : ", ") + format_param(m.info.kind, p);
   return s;
+}
+
+std::vector<double> params_of(const method_study& m) {
+  std::vector<double> out;
+  for (const auto& r : m.rows) out.push_back(r.param);
+  return out;
 }
 
 // The ladder: rows are matched by their param, exactly. Rows only in BASE are removed,
 // rows only in NEW added; a method whose kind changed has no rows in common.
 void match_ladder(method_pair& mp, comparison& out) {
-  const auto& bp = mp.base.col("param");
-  const auto& np = mp.next.col("param");
-  if (mp.base.kind != mp.next.kind) {
-    out.removed.push_back({mp.next_problem.name, mp.next.name, "ladder",
-                           fmt::format("was {} ({} rows), now {} ({} rows): no row compared", to_string(mp.base.kind),
-                                       bp.size(), to_string(mp.next.kind), np.size())});
+  const auto bp = params_of(mp.base), np = params_of(mp.next);
+  const std::string& method = mp.next.info.name;
+  if (mp.base.info.kind != mp.next.info.kind) {
+    out.removed.push_back(
+        {mp.next_problem.name, method, "ladder",
+         fmt::format("was {} ({} rows), now {} ({} rows): no row compared", to_string(mp.base.info.kind), bp.size(),
+                     to_string(mp.next.info.kind), np.size())});
     return;
   }
   std::vector<double> only_base, only_new;
@@ -136,21 +144,20 @@ void match_ladder(method_pair& mp, comparison& out) {
   for (double p : np)
     if (std::find(bp.begin(), bp.end(), p) == bp.end()) only_new.push_back(p);
   if (!only_base.empty())
-    out.removed.push_back({mp.next_problem.name, mp.next.name, "ladder",
+    out.removed.push_back({mp.next_problem.name, method, "ladder",
                            fmt::format("ladder changed: {} of {} rows only in BASE ({}); {} compared", only_base.size(),
                                        bp.size(), param_list(mp.base, only_base), mp.rows.size())});
   if (!only_new.empty())
-    out.added.push_back({mp.next_problem.name, mp.next.name, "ladder",
+    out.added.push_back({mp.next_problem.name, method, "ladder",
                          fmt::format("ladder changed: {} of {} rows only in NEW ({}); {} compared", only_new.size(),
                                      np.size(), param_list(mp.next, only_new), mp.rows.size())});
 }
 
 // The timesteps of a method's fitted levels.
-std::vector<double> fitted_params(const study_method& m) {
+std::vector<double> fitted_params(const method_study& m) {
   std::vector<double> out;
-  const auto& params = m.col("param");
-  for (long level : m.fit_levels)
-    if (level >= 0 && static_cast<std::size_t>(level) < params.size()) out.push_back(params[level]);
+  for (int level : m.fit.levels)
+    if (level >= 0 && static_cast<std::size_t>(level) < m.rows.size()) out.push_back(m.rows[level].param);
   return out;
 }
 
@@ -160,52 +167,48 @@ std::vector<double> fitted_params(const study_method& m) {
 // one) only where both fitted the same timesteps: otherwise its order is another
 // measurement, not a change; and a change of fit status only on the same ladder.
 void check_order(const method_pair& mp, comparison& out) {
-  if (mp.base.kind != method_kind::fixed_step || mp.next.kind != method_kind::fixed_step) return;
-  const bool same_ladder =
-      mp.rows.size() == mp.base.col("param").size() && mp.rows.size() == mp.next.col("param").size();
-  const bool was = mp.base.fit_status == "fitted", is = mp.next.fit_status == "fitted";
+  if (mp.base.info.kind != method_kind::fixed_step || mp.next.info.kind != method_kind::fixed_step) return;
+  const bool same_ladder = mp.rows.size() == mp.base.rows.size() && mp.rows.size() == mp.next.rows.size();
+  const fit_result &base = mp.base.fit, &next = mp.next.fit;
+  const bool was = base.state == fit_result::status::fitted, is = next.state == fit_result::status::fitted;
   change c;
   c.problem = mp.next_problem.name;
-  c.method = mp.next.name;
+  c.method = mp.next.info.name;
   if (was && is) {
     if (!same_ladder && fitted_params(mp.base) != fitted_params(mp.next)) return;
-    const auto k = judge_order(mp.base.fit_slope, mp.next.fit_slope, mp.opts.order_drop);
+    const auto k = judge_order(base.order, next.order, mp.opts.order_drop);
     if (!k) return;
     c.kind = *k;
     c.what = "observed order";
-    c.old_value = mp.base.fit_slope;
-    c.new_value = mp.next.fit_slope;
-    c.ratio = mp.next.fit_slope / mp.base.fit_slope;
-  } else if (same_ladder && (was || (is && mp.base.fit_status == "insufficient"))) {
+    c.old_value = base.order;
+    c.new_value = next.order;
+    c.ratio = next.order / base.order;
+  } else if (same_ladder && (was || (is && base.state == fit_result::status::insufficient))) {
     // Fitted and no longer is; or could not be fitted and now is. (From `exact` to fitted
     // is no improvement: the errors left round-off, which the row checks judge.)
     c.kind = was ? change_kind::regression : change_kind::improvement;
     c.what = "order fit";
-    c.old_value = mp.base.fit_status;
-    c.new_value = mp.next.fit_status;
+    c.old_value = to_string(base.state);
+    c.new_value = to_string(next.state);
   } else {
     return;
   }
   out.changes.push_back(std::move(c));
 }
 
-// The flags that say a row has no result: diverged, failed, and (where both files have
-// the field) skipped over the work budget.
-std::vector<std::string> row_flags(const method_pair& mp) {
-  std::vector<std::string> out{"diverged", "failed"};
-  if (mp.base.columns.count("skipped") && mp.next.columns.count("skipped")) out.emplace_back("skipped");
-  return out;
-}
+// The flags that say a row has no result: diverged, failed, skipped over the work budget.
+constexpr std::pair<const char*, bool run_metrics::*> row_flags[] = {
+    {"diverged", &run_metrics::diverged}, {"failed", &run_metrics::failed}, {"skipped", &run_metrics::skipped}};
 
 // Every row in both files: newly diverged, failed or skipped (or no longer), and each error.
 void check_rows(const method_pair& mp, comparison& out) {
-  const auto flags = row_flags(mp);
-  const double pos_floor = error_floor_rel * std::max(mp.base_problem.pos_scale, mp.next_problem.pos_scale);
-  const double vel_floor = error_floor_rel * std::max(mp.base_problem.vel_scale, mp.next_problem.vel_scale);
+  const double pos_floor = error_floor_rel * std::max(mp.base_problem.truth.pos_scale, mp.next_problem.truth.pos_scale);
+  const double vel_floor = error_floor_rel * std::max(mp.base_problem.truth.vel_scale, mp.next_problem.truth.vel_scale);
   for (const auto& [i, j] : mp.rows) {
     bool completed = true;
-    for (const auto& flag : flags) {
-      const double old_flag = mp.base.col(flag)[i], new_flag = mp.next.col(flag)[j];
+    const run_metrics &old_row = mp.base.rows[i].metrics, &new_row = mp.next.rows[j].metrics;
+    for (const auto& [flag, member] : row_flags) {
+      const double old_flag = old_row.*member, new_flag = new_row.*member;
       completed = completed && old_flag == 0 && new_flag == 0;
       if ((old_flag != 0) != (new_flag != 0)) {
         auto c = row_change(new_flag != 0 ? change_kind::regression : change_kind::improvement, mp, j, flag, old_flag,
@@ -216,7 +219,7 @@ void check_rows(const method_pair& mp, comparison& out) {
     }
     if (!completed) continue;  // errors of completed runs only
     for (const char* metric : error_metrics) {
-      const double old_err = mp.base.col(metric)[i], new_err = mp.next.col(metric)[j];
+      const double old_err = metric_value(old_row, metric), new_err = metric_value(new_row, metric);
       const double floor = std::string_view(metric) == "err_vel_final" ? vel_floor : pos_floor;
       if (const auto k = judge_error(old_err, new_err, floor, mp.opts.error_factor)) {
         auto c = row_change(*k, mp, j, metric, old_err, new_err);
@@ -227,14 +230,14 @@ void check_rows(const method_pair& mp, comparison& out) {
   }
 }
 
-timing_side side(const study_method& m, std::size_t row) {
-  return {m.col("time_ns")[row], m.col("time_ns_min")[row], m.col("time_ns_max")[row],
-          static_cast<long>(m.col("repetitions")[row])};
+timing_side side(const method_study& m, std::size_t row) {
+  const timing& t = m.rows[row].time;
+  return {t.time_ns, t.time_ns_min, t.time_ns_max, t.repetitions};
 }
 
-bool timed_row(const study_method& m, std::size_t row) {
-  return std::isfinite(m.col("time_ns")[row]) && m.col("time_ns")[row] > 0 && m.col("repetitions")[row] >= 1 &&
-         m.col("cut")[row] == 0;
+bool timed_row(const method_study& m, std::size_t row) {
+  const timing& t = m.rows[row].time;
+  return std::isfinite(t.time_ns) && t.time_ns > 0 && t.repetitions >= 1 && !t.cut;
 }
 
 // Rows timed in both files: ratio, noise threshold, flag.
@@ -243,9 +246,9 @@ void collect_timing(const method_pair& mp, comparison& out) {
   for (const auto& [i, j] : mp.rows) {
     if (!timed_row(mp.base, i) || !timed_row(mp.next, j)) continue;
     timing_row t{mp.next_problem.name,
-                 mp.next.name,
-                 std::string(param_name(mp.next.kind)),
-                 mp.next.col("param")[j],
+                 mp.next.info.name,
+                 std::string(param_name(mp.next.info.kind)),
+                 mp.next.rows[j].param,
                  side(mp.base, i),
                  side(mp.next, j),
                  0.0,
@@ -287,9 +290,10 @@ constexpr method_check method_checks[] = {check_order, check_rows, collect_timin
 // The methods of a problem: present in one file only, or compared by every method check.
 void check_methods(const problem_pair& pp, comparison& out) {
   for (const auto& m : pp.base.methods) {
-    const study_method* n = pp.next.find(m.name);
+    const method_study* n = pp.next.find(m.info.name);
     if (!n) {
-      out.removed.push_back({pp.base.name, m.name, "method", fmt::format("{}, {} rows", to_string(m.kind), m.rows())});
+      out.removed.push_back(
+          {pp.base.name, m.info.name, "method", fmt::format("{}, {} rows", to_string(m.info.kind), m.rows.size())});
       continue;
     }
     method_pair mp{pp.base, pp.next, m, *n, pp.opts, {}};
@@ -297,8 +301,9 @@ void check_methods(const problem_pair& pp, comparison& out) {
     for (const auto check : method_checks) check(mp, out);
   }
   for (const auto& n : pp.next.methods)
-    if (!pp.base.find(n.name))
-      out.added.push_back({pp.next.name, n.name, "method", fmt::format("{}, {} rows", to_string(n.kind), n.rows())});
+    if (!pp.base.find(n.info.name))
+      out.added.push_back(
+          {pp.next.name, n.info.name, "method", fmt::format("{}, {} rows", to_string(n.info.kind), n.rows.size())});
 }
 
 using problem_check = void (*)(const problem_pair&, comparison&);
@@ -309,7 +314,7 @@ constexpr problem_check problem_checks[] = {check_truth, check_references, check
 
 std::string number(double v) { return fmt::format("{:.12g}", v); }
 
-void root_differences(const study_data& base, const study_data& next, comparison& out) {
+void root_differences(const study_record& base, const study_record& next, comparison& out) {
   // Run-specific figures that always differ are left out, and `sweep_options`, the
   // options as a block of lines for `stepbench merge`: the settings that shape results
   // have attributes of their own (levels, tolerances, ...), and --set shows as parameters.
@@ -320,7 +325,7 @@ void root_differences(const study_data& base, const study_data& next, comparison
       "compiler",   "build_type", "dependencies",  "build_flags", "version",
       "git_commit", "timing",     "benchmark_mode"};
   std::map<std::string, std::pair<std::string, std::string>> all;
-  const auto gather = [&](const study_data& s, bool is_new) {
+  const auto gather = [&](const study_record& s, bool is_new) {
     for (const auto& [k, v] : s.meta) (is_new ? all[k].second : all[k].first) = v;
     for (const auto& [k, v] : s.settings) (is_new ? all[k].second : all[k].first) = number(v);
   };
@@ -338,7 +343,7 @@ void root_differences(const study_data& base, const study_data& next, comparison
 }
 
 // A problem's parameters (and the scales derived from its truth), equal to 1e-9 relative.
-void problem_differences(const study_problem& base, const study_problem& next, comparison& out) {
+void problem_differences(const problem_study& base, const problem_study& next, comparison& out) {
   std::set<std::string> keys;
   for (const auto& [k, v] : base.params) keys.insert(k);
   for (const auto& [k, v] : next.params) keys.insert(k);
@@ -452,33 +457,34 @@ std::size_t comparison::gating() const {
 // The stability limits of our methods (/stability): a limit that moves by more than
 // stability_tolerance (relative), or a method that becomes (or stops being) stable for
 // every dt or unstable for every dt, is a regression.
-void check_stability(const study_data& base, const study_data& next, comparison& out) {
-  for (const auto& b : base.stability) {
-    const auto it = std::find_if(next.stability.begin(), next.stability.end(),
+void check_stability(const study& base_study, const study& next_study, comparison& out) {
+  const auto& next = next_study.results.get<stability_data>().limits;
+  for (const auto& b : base_study.results.get<stability_data>().limits) {
+    const auto it = std::find_if(next.begin(), next.end(),
                                  [&](const auto& n) { return n.integrator == b.integrator && n.test == b.test; });
-    if (it == next.stability.end()) {
-      if (!next.stability.empty())
-        out.removed.push_back({"stability", b.integrator, "limit " + b.test, "in BASE only"});
+    const std::string test(to_string(b.test));
+    if (it == next.end()) {
+      if (!next.empty()) out.removed.push_back({"stability", b.integrator, "limit " + test, "in BASE only"});
       continue;
     }
     change c;
     c.problem = "stability";
     c.method = b.integrator;
-    auto flags = [](const study_stability_limit& l) {
+    auto flags = [](const stability_limit& l) {
       return l.unconditionally_stable ? std::string("unconditionally stable")
              : l.unstable_for_all_dt  ? std::string("unstable for every dt")
                                       : std::string("finite limit");
     };
     if (flags(b) != flags(*it)) {
       c.kind = change_kind::regression;
-      c.what = b.test + " stability";
+      c.what = test + " stability";
       c.old_value = flags(b);
       c.new_value = flags(*it);
       out.changes.push_back(c);
     } else if (std::isfinite(b.theory) && std::isfinite(it->theory) &&
                std::abs(it->theory / b.theory - 1.0) > stability_tolerance) {
       c.kind = change_kind::regression;
-      c.what = b.test + " stability limit (y = w dt or lambda dt)";
+      c.what = test + " stability limit (y = w dt or lambda dt)";
       c.old_value = b.theory;
       c.new_value = it->theory;
       c.ratio = it->theory / b.theory;
@@ -487,31 +493,33 @@ void check_stability(const study_data& base, const study_data& next, comparison&
   }
 }
 
-comparison compare_studies(const study_data& base, const study_data& next, const compare_options& opts) {
+comparison compare_studies(const study& base, const study& next, const compare_options& opts) {
   if (!(opts.error_factor >= 1.0) || !std::isfinite(opts.error_factor))
     throw std::invalid_argument(
         fmt::format("--error-factor must be a finite number >= 1, got {:g}", opts.error_factor));
   if (!(opts.order_drop >= 0.0) || !std::isfinite(opts.order_drop))
     throw std::invalid_argument(fmt::format("--order-drop must be a finite number >= 0, got {:g}", opts.order_drop));
-  if (base.format_version != next.format_version)
+  if (!base.record || !next.record) throw std::logic_error("compare_studies takes studies read from files");
+  const study_record &base_file = *base.record, &next_file = *next.record;
+  if (base_file.format_version != next_file.format_version)
     throw std::runtime_error(
         fmt::format("cannot compare '{}' (format_version {}) with '{}' (format_version {}): "
                     "different study formats",
-                    base.path, base.format_version, next.path, next.format_version));
+                    base_file.path, base_file.format_version, next_file.path, next_file.format_version));
   comparison out;
   out.options = opts;
-  out.base_path = base.path;
-  out.new_path = next.path;
-  out.base_meta = base.meta;
-  out.new_meta = next.meta;
-  out.base_timed = base.timed;
-  out.new_timed = next.timed;
-  out.timing_compared = base.timed && next.timed;
+  out.base_path = base_file.path;
+  out.new_path = next_file.path;
+  out.base_meta = base_file.meta;
+  out.new_meta = next_file.meta;
+  out.base_timed = base.timed.has_value();
+  out.new_timed = next.timed.has_value();
+  out.timing_compared = out.base_timed && out.new_timed;
   if (!out.timing_compared)
-    out.timing_note = !base.timed && !next.timed ? "neither file is timed"
-                      : base.timed               ? "NEW is not timed"
-                                                 : "BASE is not timed";
-  root_differences(base, next, out);
+    out.timing_note = !out.base_timed && !out.new_timed ? "neither file is timed"
+                      : out.base_timed                  ? "NEW is not timed"
+                                                        : "BASE is not timed";
+  root_differences(base_file, next_file, out);
   if (out.timing_compared) {
     std::string differ;
     for (const auto& d : out.differences)
@@ -520,7 +528,7 @@ comparison compare_studies(const study_data& base, const study_data& next, const
     if (!differ.empty()) out.timing_note = fmt::format("the files differ in {}: the ratios measure that too", differ);
   }
   for (const auto& bp : base.problems) {
-    const study_problem* np = next.find(bp.name);
+    const problem_study* np = next.find(bp.name);
     if (!np) {
       out.removed.push_back({bp.name, "", "problem", plural(bp.methods.size(), "method", "methods")});
       continue;

@@ -25,7 +25,6 @@
 #include <vector>
 
 #include "study/study.hpp"
-#include "study/study_data.hpp"
 
 namespace stepbench {
 
@@ -141,7 +140,7 @@ struct comparison {
 
 // Compares two studies read by read_study. Throws std::runtime_error when they cannot be
 // compared (different format versions), std::invalid_argument for bad options.
-comparison compare_studies(const study_data& base, const study_data& next, const compare_options& opts = {});
+comparison compare_studies(const study& base, const study& next, const compare_options& opts = {});
 
 // The decision functions, one per kind of figure (exposed for the tests).
 // An error of a row that completed in both files; floor: the round-off floor in its unit.

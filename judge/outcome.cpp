@@ -17,8 +17,8 @@ std::vector<std::string> failed_cases(const study& s) {
     for (const auto& ms : ps.methods)
       for (const auto& r : ms.rows)
         if (r.metrics.failed)
-          out.push_back(fmt::format("{}/{} at {} {:g}: {}", ps.problem->name(), ms.info.name, param_name(ms.info.kind),
-                                    r.param, r.metrics.note));
+          out.push_back(fmt::format("{}/{} at {} {:g}: {}", ps.name, ms.info.name, param_name(ms.info.kind), r.param,
+                                    r.metrics.note));
   }
   for (const auto& st : s.results.get<std::vector<substep_study>>())
     for (const auto& m : st.methods)
@@ -88,8 +88,7 @@ std::vector<std::string> failure_summary(const study& s) {
           params.push_back(r.param);
         }
       if (!failed.empty())
-        out.push_back(
-            failure_line(ms.info.name, ps.problem->name(), param_name(ms.info.kind), failed, params, ms.rows.size()));
+        out.push_back(failure_line(ms.info.name, ps.name, param_name(ms.info.kind), failed, params, ms.rows.size()));
     }
   }
   for (const auto& st : s.results.get<std::vector<substep_study>>())
@@ -131,7 +130,7 @@ int report_study_outcome(const study& s, const char* program, bool strict) {
 std::vector<std::string> untrusted_problems(const study& s) {
   std::vector<std::string> out;
   for (const auto& ps : s.problems)
-    if (!ps.truth.trusted) out.emplace_back(ps.problem->name());
+    if (!ps.truth.trusted) out.emplace_back(ps.name);
   return out;
 }
 

@@ -5,7 +5,6 @@
 
 #include "core/work_precision.hpp"
 #include "study/study.hpp"
-#include "study/study_data.hpp"
 
 namespace stepbench {
 
@@ -16,8 +15,5 @@ double metric_value(const run_metrics& m, const std::string& metric);
 // The rows of a problem's methods in the shape the work-precision rule takes, for one
 // error metric (core/work_precision.hpp).
 std::vector<wp_method> work_precision_input(const problem_study& ps, const std::string& metric);
-
-// The rows of a problem's methods in the shape the work-precision rule takes, from a study file.
-std::vector<wp_method> work_precision_input(const study_problem& p, const std::string& metric, bool timed);
 
 }  // namespace stepbench

@@ -26,12 +26,6 @@ double cost_per_frame(const problem_study* ps, const frame_rate_study& fs, const
   return std::isfinite(ns) && ns > 0.0 ? ns * r.substeps : nan;
 }
 
-const problem_study* find_problem(const study& s, std::string_view name) {
-  for (const auto& ps : s.problems)
-    if (ps.problem->name() == name) return &ps;
-  return nullptr;
-}
-
 namespace {
 
 // A ratio in two digits, never in exponent form: 1.5, 12, 120 (not 1.2e+02).
@@ -231,11 +225,11 @@ finding_inputs finding_inputs_of(const study& s) {
   for (const auto& ps : s.problems)
     for (const auto& ms : ps.methods)
       if (ms.info.origin == method_origin::peer && ms.declared_order_holds == 0)
-        in.broken_orders[ms.info.name].insert(std::string(ps.problem->name()));
+        in.broken_orders[ms.info.name].insert(ps.name);
   for (const auto& ps : s.problems)
     for (const auto& ms : ps.methods) {
       if (!ms.info.traits.small_steps) continue;
-      ladder_finding f{ms.info.name, std::string(ps.problem->name()), {}};
+      ladder_finding f{ms.info.name, ps.name, {}};
       for (const auto& r : ms.rows) {
         const auto& m = r.metrics;
         f.runs.push_back({r.param, m.diverged, m.failed, m.skipped, m.energy_drift, m.constraint_violation_max});
@@ -251,7 +245,7 @@ verdict_tables compute_verdict(const study& s) {
   v.cost_kind = timed ? "time_ns" : "force_evals";
   for (const auto& ps : s.problems) {
     const auto methods = work_precision_input(ps, verdict_metric);
-    const std::string unit(ps.problem->position_unit());
+    const std::string unit(ps.unit);
     double best_error = std::numeric_limits<double>::infinity();
     for (const auto& m : methods)
       if (m.origin != method_origin::baseline)
@@ -266,7 +260,7 @@ verdict_tables compute_verdict(const study& s) {
         if (methods[p.method].origin == method_origin::peer && !peer) peer = &p;
       }
       equal_error_verdict e;
-      e.problem = std::string(ps.problem->name());
+      e.problem = ps.name;
       e.unit = unit;
       e.target = target;
       e.ours = cost_of(methods, ours);
@@ -279,7 +273,7 @@ verdict_tables compute_verdict(const study& s) {
     }
   }
   for (const auto& fs : s.results.get<std::vector<frame_rate_study>>()) {
-    const problem_study* ps = find_problem(s, fs.problem);
+    const problem_study* ps = s.find(fs.problem);
     std::vector<double> rates;
     for (const auto& r : fs.runs)
       if (std::find(rates.begin(), rates.end(), r.hz) == rates.end()) rates.push_back(r.hz);

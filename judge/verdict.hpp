@@ -23,9 +23,6 @@ bool is_first_order_pair(const substep_verdict& sv);
 bool judges_ladder_as_substeps(std::string_view method);
 std::vector<std::string> findings_of(const verdict_tables& v, const finding_inputs& in);
 
-// The problem named `name` in the study's sweep, or nullptr.
-const problem_study* find_problem(const study& s, std::string_view name);
-
 // The cost of a frame of a frame-rate run: the benchmark's median ns per step of its
 // method on the problem (`ps`, nullptr: none) times the steps of a frame when `timed`,
 // else the force evaluations of a frame.

@@ -34,6 +34,9 @@ problem_study sweep_problem(const std::string& name, const sweep_options& opts, 
   const auto t0 = std::chrono::steady_clock::now();
   problem_study ps;
   ps.problem = configured_problem(name, opts);
+  ps.name = ps.problem->name();
+  ps.unit = ps.problem->position_unit();
+  for (const auto& p : ps.problem->params()) ps.params[p.name] = p.value;
   ps.horizon = ps.problem->horizon();
   ps.truth = build_truth(*ps.problem, sample_times(ps.horizon, opts.sample_count), {.tol = opts.tol});
   for (const auto& r : ps.truth.references)

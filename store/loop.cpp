@@ -129,7 +129,7 @@ void write_loop(H5::Group& root, const study& s) {
     h5::attr(pg, "truth_source", lp.truth_source);
     const problem_study* ps = nullptr;
     for (const auto& p : s.problems)
-      if (p.problem->name() == lp.name) ps = &p;
+      if (p.name == lp.name) ps = &p;
     for (const auto& m : lp.methods) {
       H5::Group mg = pg.createGroup(m.info.name);
       const double measured = ps && s.timed ? measured_step_cost_ns(*ps, m.info.name) : nan;

@@ -128,7 +128,7 @@ void write_equal_error(H5::Group& g, const problem_study& ps, bool timed) {
   for (const char* m : {"err_pos_max", "err_pos_final"}) {
     const auto methods = work_precision_input(ps, m);
     for (double tgt : equal_error_targets()) {
-      const auto r = cheapest(methods, tgt, timed, m, metric_unit(m, ps.problem->position_unit()));
+      const auto r = cheapest(methods, tgt, timed, m, metric_unit(m, ps.unit));
       const auto answer = r.answer(methods);
       for (std::size_t k = 0; k < r.ranked.size(); ++k) {
         const auto& p = r.ranked[k];

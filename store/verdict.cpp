@@ -173,7 +173,7 @@ void write_frame_rates(H5::Group& root, const study& s) {
     H5::Group pg = fr.createGroup(fs.problem);
     attr(pg, "horizon", fs.horizon);
     attr(pg, "position_unit", fs.unit);
-    const problem_study* ps = find_problem(s, fs.problem);
+    const problem_study* ps = s.find(fs.problem);
     std::vector<frame_option> rows;
     for (const auto& r : fs.runs) {
       const auto& m = r.row.metrics;

@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <typeindex>
 #include <vector>
 
@@ -102,18 +103,30 @@ struct sweep_options {
 };
 
 struct method_study {
-  method_info info;
+  method_info info;  // as read from a file: name, description, origin, kind, declared order, traits, library
   std::vector<method_row> rows;
   fit_result fit;                 // against dt (fixed-step) or against the tolerance (adaptive)
   int declared_order_holds = -1;  // see core/convergence_fit.hpp
   std::string ladder_end;         // why the ladder stopped after its last row
 };
 
+// A problem's sweep. The judges read its facts (name, unit, parameters, truth, rows),
+// which the run and the reader (store/study_reader.hpp) both fill; the live problem is
+// the run's alone (null in a study read from a file).
 struct problem_study {
+  std::string name, unit;                // the problem's name and position unit
+  std::map<std::string, double> params;  // its declared parameters' values, by name
   std::unique_ptr<problem_instance> problem;
   double horizon = 0.0;
+  // As read from a file: source, trusted, note, the references' outcomes (not their
+  // solutions) and the scales; not the truth's states.
   truth_table truth;
   std::vector<method_study> methods;
+  const method_study* find(std::string_view method) const {
+    for (const auto& m : methods)
+      if (m.info.name == method) return &m;
+    return nullptr;
+  }
 };
 
 // How the timings were taken (present only when the study was timed).
@@ -174,13 +187,28 @@ class part_results {
   std::map<std::type_index, std::shared_ptr<void>> items_;
 };
 
+// What a study file records besides its parts, as the reader reads it back: its path,
+// format, and root attributes (build, machine, settings), strings and numbers apart.
+struct study_record {
+  std::string path;
+  long format_version = 0;
+  std::map<std::string, std::string> meta;
+  std::map<std::string, double> settings;
+};
+
 struct study {
-  sweep_options options;
-  bool swept = false;  // made by run_sweep (a scan-only file is not): the file records the selection and shard
+  sweep_options options;  // the run's; as read from a file, the defaults (the file's are in `record`)
+  bool swept = false;     // made by run_sweep (a scan-only file is not): the file records the selection and shard
   std::vector<problem_study> problems;  // the sweep's rows, which the other parts read
   part_results results;                 // every other part's
   double wall_seconds = 0.0;
-  std::optional<timing_settings> timed;
+  std::optional<timing_settings> timed;  // as read from a file: present (default settings) when timed
+  std::optional<study_record> record;    // a study read from a file
+  const problem_study* find(std::string_view problem) const {
+    for (const auto& ps : problems)
+      if (ps.name == problem) return &ps;
+    return nullptr;
+  }
 };
 
 }  // namespace stepbench

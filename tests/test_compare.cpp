@@ -19,6 +19,7 @@
 #include "run/sweep.hpp"
 #include "store/study_file.hpp"
 #include "store/study_reader.hpp"
+#include "study/stability.hpp"
 
 using namespace stepbench;
 namespace fs = std::filesystem;
@@ -235,23 +236,73 @@ TEST_F(compare_test, newly_diverged_and_failed_rows) {
   EXPECT_EQ(found(back, change_kind::improvement, "failed").size(), 1u);
 }
 
+// The reader fills the model the run fills: a study read back from its file holds the
+// run's problem facts, truth outcome, fits and every row, field for field.
+TEST_F(compare_test, a_study_read_back_is_the_study_written) {
+  study s = small_study({"damped_spring", "bouncing_ball"});
+  set_timings(s, 250.0, 0.05, 3);
+  const study r = read_study(write(s, "round.h5"));
+  ASSERT_TRUE(r.record.has_value());
+  EXPECT_EQ(r.record->format_version, study_format_version);
+  EXPECT_TRUE(r.timed.has_value());
+  EXPECT_FALSE(r.results.get<stability_data>().limits.empty());
+  ASSERT_EQ(r.problems.size(), s.problems.size());
+  const auto same = [](double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); };
+  for (const problem_study& w : s.problems) {  // the file's groups are in name order: found by name
+    ASSERT_NE(r.find(w.name), nullptr) << w.name;
+    const problem_study& q = *r.find(w.name);
+    EXPECT_EQ(q.name, w.problem->name());
+    EXPECT_EQ(q.unit, w.problem->position_unit());
+    EXPECT_EQ(q.horizon, w.horizon);
+    for (const auto& param : w.problem->params()) EXPECT_EQ(q.params.at(param.name), param.value) << param.name;
+    EXPECT_EQ(q.truth.source, w.truth.source);
+    EXPECT_EQ(q.truth.trusted, w.truth.trusted);
+    EXPECT_EQ(q.truth.pos_scale, w.truth.pos_scale);
+    ASSERT_EQ(q.truth.references.size(), w.truth.references.size());
+    ASSERT_EQ(q.methods.size(), w.methods.size());
+    for (const method_study& a : w.methods) {
+      ASSERT_NE(q.find(a.info.name), nullptr) << a.info.name;
+      const method_study& b = *q.find(a.info.name);
+      EXPECT_EQ(b.info.kind, a.info.kind);
+      EXPECT_EQ(b.info.origin, a.info.origin);
+      EXPECT_EQ(b.fit.state, a.fit.state) << a.info.name;
+      EXPECT_TRUE(same(b.fit.order, a.fit.order)) << a.info.name;
+      EXPECT_EQ(b.fit.levels, a.fit.levels) << a.info.name;
+      ASSERT_EQ(b.rows.size(), a.rows.size());
+      for (std::size_t k = 0; k < a.rows.size(); ++k) {
+        const method_row &x = a.rows[k], &y = b.rows[k];
+        EXPECT_EQ(y.param, x.param);
+        EXPECT_EQ(y.steps, x.steps);
+        EXPECT_EQ(y.work.force_evals, x.work.force_evals);
+        EXPECT_TRUE(same(y.metrics.err_pos_max, x.metrics.err_pos_max)) << a.info.name << " " << k;
+        EXPECT_TRUE(same(y.metrics.err_vel_final, x.metrics.err_vel_final));
+        EXPECT_EQ(y.metrics.diverged, x.metrics.diverged);
+        EXPECT_EQ(y.metrics.note, x.metrics.note);
+        EXPECT_TRUE(same(y.time.time_ns, x.time.time_ns));
+        EXPECT_EQ(y.time.repetitions, x.time.repetitions);
+      }
+    }
+  }
+}
+
 // A row skipped over the work budget has no result: newly skipped regresses, and its
-// errors are not judged. (Compared only where both files have the field.)
+// errors are not judged.
 TEST_F(compare_test, newly_skipped_row) {
   const std::string file = write(small_study({"damped_spring"}, {"rk4"}), "base.h5");
-  study_data a = read_study(file), b = read_study(file);
-  auto& ma = a.problems[0].methods[0];
-  auto& mb = b.problems[0].methods[0];
-  ma.columns["skipped"].assign(ma.rows(), 0.0);
-  mb.columns["skipped"].assign(mb.rows(), 0.0);
-  mb.columns["skipped"].back() = 1;
-  mb.columns["err_pos_max"].back() = std::nan("");
+  study a = read_study(file), b = read_study(file);
+  const auto& ma = a.problems[0].methods[0];
+  auto& last = b.problems[0].methods[0].rows.back().metrics;
+  ASSERT_FALSE(ma.rows.back().metrics.skipped);
+  last.skipped = true;
+  last.err_pos_max = std::nan("");
   const comparison c = compare_studies(a, b);
   ASSERT_EQ(c.count(change_kind::regression), 1u) << format_text(c);
   EXPECT_EQ(c.changes[0].what, "skipped");
-  EXPECT_EQ(c.changes[0].param, ma.col("param").back());
-  mb.columns.erase("skipped");                                          // one file without the field: not compared
-  EXPECT_EQ(compare_studies(a, b).count(change_kind::regression), 1u);  // the NaN error of a row that completed
+  EXPECT_EQ(c.changes[0].param, ma.rows.back().param);
+  last.skipped = false;  // completed: its NaN error regresses
+  const comparison completed = compare_studies(a, b);
+  ASSERT_EQ(completed.count(change_kind::regression), 1u) << format_text(completed);
+  EXPECT_EQ(completed.changes[0].what, "err_pos_max");
 }
 
 TEST_F(compare_test, order_drop_and_lost_fit) {
@@ -412,8 +463,8 @@ TEST_F(compare_test, files_that_cannot_be_compared) {
   set_root_long(v3, "format_version", study_format_version + 1);
   EXPECT_THROW(read_study(v3), std::runtime_error);
   // Two files of different format versions (both readable by some build).
-  study_data a = read_study(base), b = read_study(base);
-  b.format_version = a.format_version + 1;
+  study a = read_study(base), b = read_study(base);
+  b.record->format_version = a.record->format_version + 1;
   try {
     compare_studies(a, b);
     ADD_FAILURE() << "different format versions compared";
@@ -427,10 +478,10 @@ TEST_F(compare_test, files_that_cannot_be_compared) {
 
 TEST_F(compare_test, machine_and_build_differences_are_reported) {
   const std::string base = write(small_study({"damped_spring"}, {"rk4"}), "base.h5");
-  study_data a = read_study(base), b = read_study(base);
-  b.meta["cpu"] = "Another CPU";
-  b.meta["git_commit"] = "0123456789ab";
-  b.settings["cores"] = a.settings.at("cores") + 2;
+  study a = read_study(base), b = read_study(base);
+  b.record->meta["cpu"] = "Another CPU";
+  b.record->meta["git_commit"] = "0123456789ab";
+  b.record->settings["cores"] = a.record->settings.at("cores") + 2;
   b.problems[0].params["k_s"] = 20;
   const comparison c = compare_studies(a, b);
   std::vector<std::string> what;

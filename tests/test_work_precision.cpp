@@ -258,7 +258,7 @@ TEST(advise, reads_a_study_file) {
   const study s = run_sweep(opts);
   const auto path = (std::filesystem::temp_directory_path() / fmt::format("test_advise_{}.h5", ::getpid())).string();
   write_study(s, path);
-  const study_data file = read_study(path);
+  const study file = read_study(path);
   EXPECT_FALSE(file.timed);
   const auto a = advise(file, "damped_spring", "err_pos_final", 1e-4);
   EXPECT_EQ(a.unit, "m");

@@ -11,10 +11,10 @@
 #include "cli/commands.hpp"
 #include "judge/scan.hpp"
 #include "judge/verdict.hpp"
+#include "parts/study.hpp"
 #include "render/advise.hpp"
 #include "render/scan.hpp"
 #include "store/scan.hpp"
-#include "store/study_reader.hpp"
 #include "store/verdict.hpp"
 #include "study/scan.hpp"
 

@@ -14,9 +14,9 @@
 #include "cli/commands.hpp"
 #include "core/work_precision.hpp"
 #include "judge/verdict.hpp"
+#include "parts/study.hpp"
 #include "render/compare_render.hpp"
 #include "render/verdict.hpp"
-#include "store/verdict.hpp"
 #include "study/verdict.hpp"
 
 namespace stepbench::cli {
@@ -146,10 +146,10 @@ int run_compare(const compare_args& a) {
     const comparison c = compare_studies(base, next, opts);
     // The equal-error verdicts of two timed studies side by side (informs, never gates).
     std::optional<verdict_agreement> verdicts;
-    if (c.base_timed && c.new_timed) try {
-        verdicts = compare_verdicts(read_verdict(a.base), read_verdict(a.next));
-      } catch (const std::runtime_error&) {  // a file without /verdict: nothing to set side by side
-      }
+    const auto* base_verdict = base.results.find<verdict_tables>();
+    const auto* next_verdict = next.results.find<verdict_tables>();
+    if (c.base_timed && c.new_timed && base_verdict && next_verdict)
+      verdicts = compare_verdicts(*base_verdict, *next_verdict);
     if (format == "json") {
       json out = comparison_json(c);
       if (verdicts)

@@ -22,9 +22,9 @@
 #include "cli/commands.hpp"
 #include "core/work_precision.hpp"
 #include "judge/rows.hpp"
+#include "parts/study.hpp"
 #include "registry/registry.hpp"
 #include "render/table_render.hpp"
-#include "store/study_reader.hpp"
 
 namespace stepbench::cli {
 namespace {

@@ -11,9 +11,11 @@
 //   judge     derives its answers from the study as measured (and timed): run again by
 //             stepbench_bench after it times the rows, and by merge on the joined study
 //   write     its groups of the study file
+//   read      its groups read back into the study, for the commands that answer from a
+//             file (advise, compare, ratios): the model the run fills, filled again
 //   merge     how the shards of a study hold it (merge_rule)
 //
-// Run, judge and write follow the table's order; describe and merge read the same table;
+// Run, judge, write and read follow the table's order; describe and merge read the same table;
 // the report orders its sections by the `parts` the file names. Adding an analysis is
 // one file of parts/ that defines its study_part (its result type is its own: the study
 // keeps it in `results`, keyed by that type) and one line of parts/registry.cpp;
@@ -59,6 +61,8 @@ struct study_part {
   void (*run)(study&, const part_context&) = nullptr;
   void (*judge)(study&) = nullptr;  // nullptr: nothing to judge
   void (*write)(H5::Group& root, const study&) = nullptr;
+  // Called only when the file has its group; nullptr: no command reads it back.
+  void (*read)(const H5::Group& root, study&) = nullptr;
 };
 
 // A list of names as a describe line shows it: "a,b,c", or "all" when empty.

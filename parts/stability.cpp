@@ -19,6 +19,11 @@ extern const study_part stability_part{
         [](H5::Group& root, const study& s) {
           if (const auto* d = s.results.find<stability_data>()) write_stability(root, *d);
         },
+    .read =
+        [](const H5::Group& root, study& s) {
+          s.results.put(stability_data{}).limits =
+              stability_limit_columns().read(root.openGroup("stability"), "limits");
+        },
 };
 
 }  // namespace stepbench

@@ -11,6 +11,7 @@
 #include "run/sweep.hpp"
 #include "store/h5.hpp"
 #include "store/study_file.hpp"
+#include "store/study_reader.hpp"
 
 namespace stepbench {
 
@@ -71,6 +72,15 @@ void judge_study(study& s) {
                     std::find(s.options.parts.begin(), s.options.parts.end(), p.name) != s.options.parts.end()))
       p.judge(s);
 }
+
+std::vector<study> read_studies(const std::vector<std::string>& paths) {
+  return read_studies(paths, [](const H5::Group& root, study& s) {
+    for (const auto& p : study_parts())
+      if (p.read && h5::is_group(root, std::string(p.group))) p.read(root, s);
+  });
+}
+
+study read_study(const std::string& path) { return std::move(read_studies({path}).front()); }
 
 void write_study(const study& s, const std::string& path) {
   write_study_file(path, [&](H5::H5File& file) {

@@ -2,6 +2,7 @@
 // The study as one run of its parts (parts/part.hpp): run, judge and write walk the one
 // table of parts in its order.
 #include <string>
+#include <vector>
 
 #include "study/study.hpp"
 
@@ -30,5 +31,11 @@ std::size_t sweep_parts(const sweep_options& opts);
 // Writes the study: the root attributes, then every part that holds results, in the
 // study's order, atomically (store/study_file.hpp write_study_file).
 void write_study(const study& s, const std::string& path);
+
+// Reads study files back into the model the run fills: the root attributes (`record`),
+// then every part that reads, in the study's order, from the groups the file has
+// (store/study_reader.hpp says how a damaged file is refused, in one line).
+std::vector<study> read_studies(const std::vector<std::string>& paths);
+study read_study(const std::string& path);
 
 }  // namespace stepbench

@@ -75,6 +75,7 @@ extern const study_part sweep_part{
     .describe = describe,
     .run = run,
     .write = write,
+    .read = read_problems,
 };
 
 }  // namespace stepbench

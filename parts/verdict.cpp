@@ -18,6 +18,7 @@ extern const study_part verdict_part{
     .describe = [](const sweep_options&) { return std::string("verdict: targets 1e-2 .. 1e-12"); },
     .judge = [](study& s) { s.results.put(compute_verdict(s)); },
     .write = write_verdict,
+    .read = [](const H5::Group& root, study& s) { s.results.put(read_verdict(root)); },
 };
 
 }  // namespace stepbench

@@ -204,11 +204,84 @@ void write_problem(H5::Group& parent, const problem_study& ps, const std::option
   if (timed) write_front(g, ps, true, timed);
 }
 
+method_origin parse_origin(const std::string& s) {
+  for (const auto o : {method_origin::ours, method_origin::peer, method_origin::baseline})
+    if (s == to_string(o)) return o;
+  throw std::runtime_error(fmt::format("unknown method origin '{}'", s));
+}
+
+method_kind parse_kind(const std::string& s) {
+  for (const auto k : {method_kind::fixed_step, method_kind::adaptive})
+    if (s == to_string(k)) return k;
+  throw std::runtime_error(fmt::format("unknown method kind '{}'", s));
+}
+
+fit_result::status parse_fit_status(const std::string& s) {
+  for (const auto f : {fit_result::status::fitted, fit_result::status::exact, fit_result::status::insufficient})
+    if (s == to_string(f)) return f;
+  throw std::runtime_error(fmt::format("unknown fit_status '{}'", s));
+}
+
+// A method's group as write_method (store/study_file.cpp) writes it.
+method_study read_method(const H5::Group& g, const std::string& name) {
+  method_study m;
+  m.info.name = name;
+  m.info.origin = parse_origin(h5::string_attr(g, "origin"));
+  m.info.kind = parse_kind(h5::string_attr(g, "kind"));
+  m.info.description = h5::string_attr(g, "description");
+  m.info.library = h5::string_attr(g, "library");
+  m.info.declared_order = h5::double_attr(g, "declared_order");
+  m.fit.state = parse_fit_status(h5::string_attr(g, "fit_status"));
+  m.fit.order = h5::double_attr(g, "fit_slope");
+  for (long level : h5::int_array_attr(g, "fit_levels")) m.fit.levels.push_back(static_cast<int>(level));
+  m.declared_order_holds = static_cast<int>(h5::long_attr(g, "declared_order_holds"));
+  m.rows = runs_columns().read(g, "runs");
+  return m;
+}
+
+// A problem's group as write_problem writes it: its facts, the truth's outcome and
+// scales (not its states), the references' outcomes and every method.
+problem_study read_problem(const H5::Group& g, const std::string& name) {
+  problem_study p;
+  p.name = name;
+  p.unit = h5::string_attr(g, "position_unit");
+  p.horizon = h5::double_attr(g, "horizon");
+  p.truth.source = h5::string_attr(g, "truth_source");
+  p.truth.trusted = h5::long_attr(g, "truth_trusted") != 0;
+  p.truth.pos_scale = h5::double_attr(g, "pos_scale");
+  p.truth.vel_scale = h5::double_attr(g, "vel_scale");
+  for (const auto& q : parameters_columns().read(g, "parameters")) p.params[q.name] = q.value;
+  if (h5::is_group(g, "reference")) {
+    const H5::Group refs = g.openGroup("reference");
+    for (const auto& src : h5::children(refs)) {
+      const H5::Group r = refs.openGroup(src);
+      reference_check ref;
+      ref.source = src;
+      ref.status = h5::string_attr(r, "status");
+      ref.reason = h5::string_attr(r, "reason");
+      ref.compared_with = h5::string_attr(r, "compared_with");
+      ref.vs.pos_rel = h5::double_attr(r, "err_pos_rel");
+      ref.vs.vel_rel = h5::double_attr(r, "err_vel_rel");
+      p.truth.references.push_back(std::move(ref));
+    }
+  }
+  if (!h5::is_group(g, "methods"))
+    throw std::runtime_error(fmt::format("missing group 'methods' in {}", g.getObjName()));
+  const H5::Group methods = g.openGroup("methods");
+  for (const auto& m : h5::children(methods)) p.methods.push_back(read_method(methods.openGroup(m), m));
+  return p;
+}
+
 }  // namespace
 
 void write_problems(H5::Group& root, const study& s) {
   H5::Group problems = root.createGroup("problems");
   for (const auto& ps : s.problems) write_problem(problems, ps, s.timed);
+}
+
+void read_problems(const H5::Group& root, study& s) {
+  const H5::Group problems = root.openGroup("problems");
+  for (const auto& name : h5::children(problems)) s.problems.push_back(read_problem(problems.openGroup(name), name));
 }
 
 void write_machine(H5::H5Object& obj, const std::optional<timing_settings>& timing) {

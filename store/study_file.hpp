@@ -32,6 +32,11 @@ void write_root_attributes(H5::H5File& file, const study& s, const std::string& 
 // fronts.
 void write_problems(H5::Group& root, const study& s);
 
+// /problems read back (the sweep's read): each problem's facts, truth outcome and scales
+// (not its states), the references' outcomes and every method (info, fit, rows), in the
+// file's order of names.
+void read_problems(const H5::Group& root, study& s);
+
 // The machine a study ran on (run/machine.hpp), as attributes of `obj`: cpu, cores,
 // and with timings num_cpus, mhz_per_cpu, cpu_scaling_enabled (Google Benchmark's context).
 void write_machine(H5::H5Object& obj, const std::optional<timing_settings>& timing);

@@ -18,79 +18,10 @@
 #include <vector>
 
 #include "store/h5.hpp"
-#include "store/stability.hpp"
 #include "store/study_file.hpp"
 
 namespace stepbench {
 namespace {
-
-method_origin parse_origin(const std::string& s) {
-  for (const auto o : {method_origin::ours, method_origin::peer, method_origin::baseline})
-    if (s == to_string(o)) return o;
-  throw std::runtime_error(fmt::format("unknown method origin '{}'", s));
-}
-
-method_kind parse_kind(const std::string& s) {
-  for (const auto k : {method_kind::fixed_step, method_kind::adaptive})
-    if (s == to_string(k)) return k;
-  throw std::runtime_error(fmt::format("unknown method kind '{}'", s));
-}
-
-fit_result::status parse_fit_status(const std::string& s) {
-  for (const auto f : {fit_result::status::fitted, fit_result::status::exact, fit_result::status::insufficient})
-    if (s == to_string(f)) return f;
-  throw std::runtime_error(fmt::format("unknown fit_status '{}'", s));
-}
-
-// A method's group as write_method (store/study_file.cpp) writes it.
-method_study read_method(const H5::Group& g, const std::string& name) {
-  method_study m;
-  m.info.name = name;
-  m.info.origin = parse_origin(h5::string_attr(g, "origin"));
-  m.info.kind = parse_kind(h5::string_attr(g, "kind"));
-  m.info.description = h5::string_attr(g, "description");
-  m.info.library = h5::string_attr(g, "library");
-  m.info.declared_order = h5::double_attr(g, "declared_order");
-  m.fit.state = parse_fit_status(h5::string_attr(g, "fit_status"));
-  m.fit.order = h5::double_attr(g, "fit_slope");
-  for (long level : h5::int_array_attr(g, "fit_levels")) m.fit.levels.push_back(static_cast<int>(level));
-  m.declared_order_holds = static_cast<int>(h5::long_attr(g, "declared_order_holds"));
-  m.rows = runs_columns().read(g, "runs");
-  return m;
-}
-
-// A problem's group as write_problem writes it: its facts, the truth's outcome and
-// scales (not its states), the references' outcomes and every method.
-problem_study read_problem(const H5::Group& g, const std::string& name) {
-  problem_study p;
-  p.name = name;
-  p.unit = h5::string_attr(g, "position_unit");
-  p.horizon = h5::double_attr(g, "horizon");
-  p.truth.source = h5::string_attr(g, "truth_source");
-  p.truth.trusted = h5::long_attr(g, "truth_trusted") != 0;
-  p.truth.pos_scale = h5::double_attr(g, "pos_scale");
-  p.truth.vel_scale = h5::double_attr(g, "vel_scale");
-  for (const auto& q : parameters_columns().read(g, "parameters")) p.params[q.name] = q.value;
-  if (h5::is_group(g, "reference")) {
-    const H5::Group refs = g.openGroup("reference");
-    for (const auto& src : h5::children(refs)) {
-      const H5::Group r = refs.openGroup(src);
-      reference_check ref;
-      ref.source = src;
-      ref.status = h5::string_attr(r, "status");
-      ref.reason = h5::string_attr(r, "reason");
-      ref.compared_with = h5::string_attr(r, "compared_with");
-      ref.vs.pos_rel = h5::double_attr(r, "err_pos_rel");
-      ref.vs.vel_rel = h5::double_attr(r, "err_vel_rel");
-      p.truth.references.push_back(std::move(ref));
-    }
-  }
-  if (!h5::is_group(g, "methods"))
-    throw std::runtime_error(fmt::format("missing group 'methods' in {}", g.getObjName()));
-  const H5::Group methods = g.openGroup("methods");
-  for (const auto& m : h5::children(methods)) p.methods.push_back(read_method(methods.openGroup(m), m));
-  return p;
-}
 
 // The HDF5 signature, at 0, 512, 1024, 2048, ... (a user block may come first).
 bool has_hdf5_signature(const std::vector<char>& bytes) {
@@ -100,9 +31,9 @@ bool has_hdf5_signature(const std::vector<char>& bytes) {
   return false;
 }
 
-// The whole file from its bytes. Errors are std::runtime_error or H5::Exception, without
-// the file's name.
-study read_image(const std::string& path, std::vector<char>& bytes) {
+// The whole file from its bytes: the record, then `read_parts`. Errors are
+// std::runtime_error or H5::Exception, without the file's name.
+study read_image(const std::string& path, std::vector<char>& bytes, const study_parts_reader& read_parts) {
   if (!has_hdf5_signature(bytes)) throw std::runtime_error("not an HDF5 file");
   H5::FileAccPropList access;
   access.setCore(std::size_t{1} << 20, false);
@@ -124,11 +55,8 @@ study read_image(const std::string& path, std::vector<char>& bytes) {
   rec.meta = h5::string_attrs(file);
   rec.settings = h5::number_attrs(file, false);
   if (h5::long_attr(file, "timing") != 0) out.timed.emplace();
-  if (h5::is_group(file, "stability"))
-    out.results.put(stability_data{}).limits = stability_limit_columns().read(file.openGroup("stability"), "limits");
   if (!h5::is_group(file, "problems")) throw std::runtime_error("missing group 'problems'");
-  const H5::Group problems = file.openGroup("problems");
-  for (const auto& name : h5::children(problems)) out.problems.push_back(read_problem(problems.openGroup(name), name));
+  read_parts(file, out);
   return out;
 }
 
@@ -142,6 +70,7 @@ study read_image(const std::string& path, std::vector<char>& bytes) {
 // another error's text. The children of several files run at once.
 struct reading_child {
   std::string path;
+  const study_parts_reader* read_parts;
   std::vector<char> bytes;
   pid_t pid = -1;
   int fd = -1;
@@ -160,8 +89,8 @@ std::runtime_error cannot_read(const std::string& path, const std::string& what)
   return std::runtime_error(fmt::format("cannot read study file '{}': {}", path, what));
 }
 
-reading_child start_reading(const std::string& path) {
-  reading_child c{path, {}, -1, -1};
+reading_child start_reading(const std::string& path, const study_parts_reader& read_parts) {
+  reading_child c{path, &read_parts, {}, -1, -1};
   std::ifstream in(path, std::ios::binary);
   c.bytes.assign(std::istreambuf_iterator<char>(in), {});
   if (!in.good() && !in.eof()) throw cannot_read(path, std::strerror(errno));
@@ -192,7 +121,7 @@ reading_child start_reading(const std::string& path) {
     ::dup2(null, STDERR_FILENO);
     std::string answer;
     try {
-      read_image(path, c.bytes);
+      read_image(path, c.bytes, read_parts);
     } catch (const H5::Exception& e) {
       answer = "H" + e.getDetailMsg();
     } catch (const std::exception& e) {
@@ -235,7 +164,7 @@ study finish_reading(reading_child& c) {
   if (!answer.empty() && answer[0] == 'H')
     throw fail(fmt::format("HDF5: {} (truncated or corrupt?)", answer.substr(1)));
   if (!answer.empty()) throw fail(answer.substr(1));
-  return read_image(c.path, c.bytes);
+  return read_image(c.path, c.bytes, *c.read_parts);
 }
 
 // Children still running when reading stops early (an error in an earlier file) are
@@ -256,7 +185,7 @@ struct reading_children {
 
 }  // namespace
 
-std::vector<study> read_studies(const std::vector<std::string>& paths) {
+std::vector<study> read_studies(const std::vector<std::string>& paths, const study_parts_reader& read_parts) {
   for (const auto& path : paths) {
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) throw cannot_read(path, "no such file");
@@ -264,12 +193,10 @@ std::vector<study> read_studies(const std::vector<std::string>& paths) {
   }
   H5::Exception::dontPrint();
   reading_children children;
-  for (const auto& path : paths) children.all.push_back(start_reading(path));
+  for (const auto& path : paths) children.all.push_back(start_reading(path, read_parts));
   std::vector<study> out;
   for (auto& c : children.all) out.push_back(finish_reading(c));
   return out;
 }
-
-study read_study(const std::string& path) { return std::move(read_studies({path}).front()); }
 
 }  // namespace stepbench

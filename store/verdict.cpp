@@ -185,18 +185,6 @@ void write_frame_rates(H5::Group& root, const study& s) {
   }
 }
 
-verdict_tables read_verdict(const std::string& path) {
-  try {
-    if (!H5::H5File::isHdf5(path)) throw std::runtime_error("not an HDF5 file");
-    const H5::H5File file(path, H5F_ACC_RDONLY);
-    return read_verdict(file);
-  } catch (const H5::Exception& e) {
-    throw std::runtime_error(fmt::format("cannot read the verdict of study file '{}': {}", path, e.getDetailMsg()));
-  } catch (const std::runtime_error& e) {
-    throw std::runtime_error(fmt::format("cannot read the verdict of study file '{}': {}", path, e.what()));
-  }
-}
-
 verdict_tables read_verdict(const H5::Group& root) {
   if (!h5::is_group(root, "verdict"))
     throw std::runtime_error("it has no /verdict (written before format_version 4: run the study again)");

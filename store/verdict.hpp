@@ -14,10 +14,9 @@ namespace stepbench {
 void write_verdict(H5::Group& root, const study& s);
 void write_frame_rates(H5::Group& root, const study& s);
 
-// Reads /verdict back from a study file (`stepbench advise --hz`); throws
-// std::runtime_error naming what is missing.
-verdict_tables read_verdict(const std::string& path);
-verdict_tables read_verdict(const H5::Group& root);  // the file's root; errors without the path
+// /verdict read back from a study file's root (the verdict part's read, merge's judging
+// again); throws std::runtime_error naming what is missing, without the path.
+verdict_tables read_verdict(const H5::Group& root);
 
 // A problem's frame-rate runs (/frame_rates/<problem>) and the verdict's cost kind.
 // Throws std::invalid_argument for a problem the file lacks (naming what it has) and

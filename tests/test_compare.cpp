@@ -18,7 +18,6 @@
 #include "render/table_render.hpp"
 #include "run/sweep.hpp"
 #include "store/study_file.hpp"
-#include "store/study_reader.hpp"
 #include "study/stability.hpp"
 
 using namespace stepbench;

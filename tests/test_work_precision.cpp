@@ -16,7 +16,6 @@
 #include "parts/study.hpp"
 #include "run/sweep.hpp"
 #include "store/study_file.hpp"
-#include "store/study_reader.hpp"
 #include "store/verdict.hpp"
 
 using namespace stepbench;

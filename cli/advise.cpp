@@ -15,7 +15,6 @@
 #include "render/advise.hpp"
 #include "render/scan.hpp"
 #include "store/scan.hpp"
-#include "store/verdict.hpp"
 #include "study/scan.hpp"
 
 namespace stepbench::cli {
@@ -88,7 +87,7 @@ int run_advise(const advise_args& args) {
     const double hz = parse_number(args.hz_text, "--hz");
     if (args.metric != "err_pos_max")
       throw std::invalid_argument("--hz answers for err_pos_max only (the frame-rate study measures that)");
-    const frame_advice f = advise_frame(read_frame_rate_runs(args.study, args.problem), hz, tol);
+    const frame_advice f = advise_frame(read_study(args.study), args.problem, hz, tol);
     if (args.json)
       std::cout << frame_advice_json(f).dump(2) << "\n";
     else

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "judge/rows.hpp"
+#include "judge/verdict.hpp"
 
 namespace stepbench {
 advice advise(const study& study, const std::string& problem, const std::string& metric, double tol) {
@@ -35,19 +36,34 @@ advice advise(const study& study, const std::string& problem, const std::string&
   return a;
 }
 
-frame_advice advise_frame(const frame_rate_runs& runs, double hz, double tol) {
+frame_advice advise_frame(const study& s, const std::string& problem, double hz, double tol) {
   if (!(tol > 0.0) || !std::isfinite(tol)) throw std::invalid_argument(fmt::format("--tol must be > 0, got {}", tol));
   if (!(hz > 0.0) || !std::isfinite(hz)) throw std::invalid_argument(fmt::format("--hz must be > 0, got {}", hz));
+  const std::string path = s.record ? s.record->path : "";
+  const auto& studies = s.results.get<std::vector<frame_rate_study>>();
+  const auto* verdict = s.results.find<verdict_tables>();
+  if (studies.empty() || !verdict)
+    throw std::runtime_error(fmt::format(
+        "cannot read study file '{}': it has no frame-rate study (written before format_version 4: run the study "
+        "again)",
+        path));
+  const auto fs = std::find_if(studies.begin(), studies.end(), [&](const auto& f) { return f.problem == problem; });
+  if (fs == studies.end()) {
+    std::vector<std::string> names;
+    for (const auto& f : studies) names.push_back(f.problem);
+    throw std::invalid_argument(
+        fmt::format("problem '{}' has no frame-rate runs in '{}' (it has: {})", problem, path, fmt::join(names, ", ")));
+  }
   frame_advice f;
-  f.problem = runs.problem;
+  f.problem = problem;
   f.hz = hz;
   f.tol = tol;
-  f.cost_kind = runs.cost_kind;
-  f.unit = runs.unit;
-  f.horizon = runs.horizon;
-  const std::string& problem = runs.problem;
+  f.cost_kind = verdict->cost_kind;
+  f.unit = fs->unit;
+  f.horizon = fs->horizon;
+  const std::vector<frame_option> runs = frame_options(s, *fs);
   std::vector<double> rates;
-  for (const auto& o : runs.runs)
+  for (const auto& o : runs)
     if (std::find(rates.begin(), rates.end(), o.hz) == rates.end()) rates.push_back(o.hz);
   if (std::find(rates.begin(), rates.end(), hz) == rates.end())
     throw std::invalid_argument(
@@ -55,7 +71,7 @@ frame_advice advise_frame(const frame_rate_runs& runs, double hz, double tol) {
   std::map<std::string, frame_option> best, closest;  // per method: cheapest meeting tol; lowest error
   std::vector<std::string> order;
   std::set<std::string> untimed;  // meets the tolerance in a run the benchmark did not time
-  for (const frame_option& o : runs.runs) {
+  for (const frame_option& o : runs) {
     if (o.hz != hz) continue;
     if (std::find(order.begin(), order.end(), o.method) == order.end()) order.push_back(o.method);
     if (o.substeps == 1) f.one_step.push_back(o);

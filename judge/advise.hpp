@@ -49,6 +49,6 @@ struct frame_advice {
 // methods are stable at one step a frame and their error, and the cheapest method and
 // substep count a frame whose err_pos_max is at or under `tol`. Throws
 // std::invalid_argument for a rate the runs lack (naming what they have) or a bad tol.
-frame_advice advise_frame(const frame_rate_runs& runs, double hz, double tol);
+frame_advice advise_frame(const study& s, const std::string& problem, double hz, double tol);
 
 }  // namespace stepbench

@@ -26,6 +26,18 @@ double cost_per_frame(const problem_study* ps, const frame_rate_study& fs, const
   return std::isfinite(ns) && ns > 0.0 ? ns * r.substeps : nan;
 }
 
+std::vector<frame_option> frame_options(const study& s, const frame_rate_study& fs) {
+  const problem_study* ps = s.find(fs.problem);
+  std::vector<frame_option> out;
+  for (const auto& r : fs.runs) {
+    const auto& m = r.row.metrics;
+    out.push_back({r.method, m.note, r.hz, r.substeps, r.row.param, m.completed(), m.diverged,
+                   m.completed() ? m.err_pos_max : nan, r.row.steps, static_cast<double>(r.row.work.force_evals),
+                   cost_per_frame(ps, fs, r, s.timed.has_value())});
+  }
+  return out;
+}
+
 namespace {
 
 // A ratio in two digits, never in exponent form: 1.5, 12, 120 (not 1.2e+02).

@@ -27,6 +27,9 @@ std::vector<std::string> findings_of(const verdict_tables& v, const finding_inpu
 // method on the problem (`ps`, nullptr: none) times the steps of a frame when `timed`,
 // else the force evaluations of a frame.
 double cost_per_frame(const problem_study* ps, const frame_rate_study& fs, const frame_rate_run& r, bool timed);
+// A problem's frame-rate runs as the file stores them and `advise --hz` ranks them: each
+// with its cost a frame (cost_per_frame, from the study's sweep of the problem).
+std::vector<frame_option> frame_options(const study& s, const frame_rate_study& fs);
 
 verdict_agreement compare_verdicts(const verdict_tables& base, const verdict_tables& next);
 }  // namespace stepbench

@@ -23,6 +23,7 @@ extern const study_part frame_rates_part{
         },
     .run = [](study& s, const part_context&) { s.results.put(run_frame_rates(s, s.options.frame_rates)); },
     .write = write_frame_rates,
+    .read = read_frame_rates,
 };
 
 }  // namespace stepbench

@@ -168,20 +168,39 @@ void write_frame_rates(H5::Group& root, const study& s) {
   const auto& studies = s.results.get<std::vector<frame_rate_study>>();
   if (studies.empty()) return;
   H5::Group fr = root.createGroup("frame_rates");
-  const bool timed = s.timed.has_value();
   for (const auto& fs : studies) {
     H5::Group pg = fr.createGroup(fs.problem);
     attr(pg, "horizon", fs.horizon);
     attr(pg, "position_unit", fs.unit);
-    const problem_study* ps = s.find(fs.problem);
-    std::vector<frame_option> rows;
-    for (const auto& r : fs.runs) {
-      const auto& m = r.row.metrics;
-      rows.push_back({r.method, m.note, r.hz, r.substeps, r.row.param, m.completed(), m.diverged,
-                      m.completed() ? m.err_pos_max : nan, r.row.steps, static_cast<double>(r.row.work.force_evals),
-                      cost_per_frame(ps, fs, r, timed)});
+    frame_rate_run_columns().write(pg, "runs", frame_options(s, fs));
+  }
+}
+
+void read_frame_rates(const H5::Group& root, study& s) {
+  auto& studies = s.results.put(std::vector<frame_rate_study>{});
+  const H5::Group all = root.openGroup("frame_rates");
+  for (const auto& problem : h5::children(all)) {
+    const H5::Group g = all.openGroup(problem);
+    frame_rate_study& fs = studies.emplace_back();
+    fs.problem = problem;
+    fs.unit = h5::string_attr(g, "position_unit");
+    fs.horizon = h5::double_attr(g, "horizon");
+    // The run as the file keeps it: a run that did not complete and did not diverge
+    // failed (or was skipped: the file does not tell them apart); its cost a frame is
+    // derived again from the sweep's rows (frame_options).
+    for (const frame_option& o : frame_rate_run_columns().read(g, "runs")) {
+      frame_rate_run& r = fs.runs.emplace_back();
+      r.hz = o.hz;
+      r.method = o.method;
+      r.substeps = o.substeps;
+      r.row.param = o.dt;
+      r.row.steps = o.steps;
+      r.row.work.force_evals = static_cast<long>(o.force_evals);
+      r.row.metrics.err_pos_max = o.err_pos_max;
+      r.row.metrics.diverged = o.diverged;
+      r.row.metrics.failed = !o.completed && !o.diverged;
+      r.row.metrics.note = o.note;
     }
-    frame_rate_run_columns().write(pg, "runs", rows);
   }
 }
 
@@ -201,34 +220,6 @@ verdict_tables read_verdict(const H5::Group& root) {
   v.frame_rate = frame_rate_columns().read(g, "frame_rate");
   v.frame_answers = frame_answer_columns().read(g, "frame_answer");
   return v;
-}
-
-frame_rate_runs read_frame_rate_runs(const std::string& path, const std::string& problem) {
-  frame_rate_runs f;
-  f.problem = problem;
-  try {
-    if (!std::filesystem::exists(path)) throw std::runtime_error("no such file");
-    if (!H5::H5File::isHdf5(path)) throw std::runtime_error("not an HDF5 file");
-    const H5::H5File file(path, H5F_ACC_RDONLY);
-    if (!h5::is_group(file, "frame_rates") || !h5::is_group(file, "verdict"))
-      throw std::runtime_error("it has no frame-rate study (written before format_version 4: run the study again)");
-    f.cost_kind = h5::string_attr(file.openGroup("verdict"), "cost_kind");
-    const H5::Group all = file.openGroup("frame_rates");
-    if (!h5::is_group(all, problem))
-      throw std::invalid_argument(fmt::format("problem '{}' has no frame-rate runs in '{}' (it has: {})", problem, path,
-                                              fmt::join(h5::children(all), ", ")));
-    const H5::Group g = all.openGroup(problem);
-    f.unit = h5::string_attr(g, "position_unit");
-    f.horizon = h5::double_attr(g, "horizon");
-    f.runs = frame_rate_run_columns().read(g, "runs");
-  } catch (const H5::Exception& e) {
-    throw std::runtime_error(fmt::format("cannot read study file '{}': {}", path, e.getDetailMsg()));
-  } catch (const std::invalid_argument&) {
-    throw;
-  } catch (const std::runtime_error& e) {
-    throw std::runtime_error(fmt::format("cannot read study file '{}': {}", path, e.what()));
-  }
-  return f;
 }
 
 }  // namespace stepbench

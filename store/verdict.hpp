@@ -18,10 +18,8 @@ void write_frame_rates(H5::Group& root, const study& s);
 // again); throws std::runtime_error naming what is missing, without the path.
 verdict_tables read_verdict(const H5::Group& root);
 
-// A problem's frame-rate runs (/frame_rates/<problem>) and the verdict's cost kind.
-// Throws std::invalid_argument for a problem the file lacks (naming what it has) and
-// std::runtime_error when the file cannot be read.
-frame_rate_runs read_frame_rate_runs(const std::string& path, const std::string& problem);
+// /frame_rates read back (the frame_rates part's read): each problem's runs.
+void read_frame_rates(const H5::Group& root, study& s);
 // From a study file's /substeps/<p>/verdict and /problems/<p>/methods, for `problems` in
 // that order.
 finding_inputs read_finding_inputs(const H5::Group& root, const std::vector<std::string>& problems);

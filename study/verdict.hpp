@@ -113,11 +113,4 @@ struct frame_option {
   double force_evals = 0.0, cost_per_frame = 0.0;
 };
 
-// A problem's frame-rate runs as a study file holds them (store/verdict.hpp reads them).
-struct frame_rate_runs {
-  std::string problem, unit, cost_kind;  // cost_kind: time_ns or force_evals (per frame)
-  double horizon = 0.0;
-  std::vector<frame_option> runs;
-};
-
 }  // namespace stepbench

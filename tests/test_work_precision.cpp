@@ -329,7 +329,8 @@ TEST(advise, frame_rates_follow_the_stability_limits_and_agree_with_the_substeps
   ASSERT_NEAR(substeps.front().frame_dt, 1.0 / 60.0, 1e-15);
   const auto path = (std::filesystem::temp_directory_path() / fmt::format("test_frames_{}.h5", ::getpid())).string();
   write_study(s, path);
-  const frame_advice f = advise_frame(read_frame_rate_runs(path, "stiff_spring"), 60.0, 1e-3);
+  const study file = read_study(path);
+  const frame_advice f = advise_frame(file, "stiff_spring", 60.0, 1e-3);
   auto completed_at = [&](const std::string& m, int n) {
     for (const auto& r : frame_rates.front().runs)
       if (r.hz == 60.0 && r.method == m && r.substeps == n) return r.row.metrics.completed();
@@ -360,8 +361,13 @@ TEST(advise, frame_rates_follow_the_stability_limits_and_agree_with_the_substeps
       cheapest = std::min(cheapest, static_cast<double>(r.row.work.force_evals) / 32.0);
   EXPECT_DOUBLE_EQ(f.ranked.front().cost_per_frame, cheapest);
   EXPECT_LE(f.ranked.front().err_pos_max, 1e-3);
-  EXPECT_THROW(advise_frame(read_frame_rate_runs(path, "stiff_spring"), 50.0, 1e-3), std::invalid_argument);
-  EXPECT_THROW(read_frame_rate_runs(path, "nosuch"), std::invalid_argument);
+  EXPECT_THROW(advise_frame(file, "stiff_spring", 50.0, 1e-3), std::invalid_argument);
+  EXPECT_THROW(advise_frame(file, "nosuch", 60.0, 1e-3), std::invalid_argument);
+  // Read back, the runs rank as the run's: the same answer at the same cost.
+  const frame_advice from_run = advise_frame(s, "stiff_spring", 60.0, 1e-3);
+  ASSERT_TRUE(from_run.met());
+  EXPECT_EQ(from_run.ranked.front().method, f.ranked.front().method);
+  EXPECT_EQ(from_run.ranked.front().cost_per_frame, f.ranked.front().cost_per_frame);
   std::filesystem::remove(path);
 }
 

@@ -25,11 +25,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A few methods on one or two problems, 5 levels: milliseconds.
+// A few methods on one or two problems, 5 levels: milliseconds. The sweep alone (what
+// compare reads but /stability, which takes a second and is asked for where it is read).
 study small_study(std::vector<std::string> problems = {"damped_spring"},
                   std::vector<std::string> methods = {"rk4", "euler", "velocity_verlet", "gsl_rk4", "rk45"},
-                  int levels = 5) {
+                  int levels = 5, std::vector<std::string> parts = {"sweep"}) {
   sweep_options o;
+  o.parts = std::move(parts);
   o.problems = std::move(problems);
   o.methods = std::move(methods);
   o.levels = o.max_levels = levels;  // a ladder of exactly `levels` rows
@@ -238,7 +240,8 @@ TEST_F(compare_test, newly_diverged_and_failed_rows) {
 // The reader fills the model the run fills: a study read back from its file holds the
 // run's problem facts, truth outcome, fits and every row, field for field.
 TEST_F(compare_test, a_study_read_back_is_the_study_written) {
-  study s = small_study({"damped_spring", "bouncing_ball"});
+  study s = small_study({"damped_spring", "bouncing_ball"}, {"rk4", "euler", "velocity_verlet", "gsl_rk4", "rk45"}, 5,
+                        {"sweep", "stability"});
   set_timings(s, 250.0, 0.05, 3);
   const study r = read_study(write(s, "round.h5"));
   ASSERT_TRUE(r.record.has_value());
@@ -282,6 +285,32 @@ TEST_F(compare_test, a_study_read_back_is_the_study_written) {
       }
     }
   }
+}
+
+// A stability limit that moves by more than stability_tolerance regresses; one that
+// moves less is noise; a method that becomes unconditionally stable is a change of kind.
+TEST_F(compare_test, a_moved_stability_limit_regresses) {
+  const std::string file = write(small_study({"damped_spring"}, {"rk4"}, 5, {"sweep", "stability"}), "base.h5");
+  const study a = read_study(file);
+  study b = read_study(file);
+  auto& limits = b.results.find<stability_data>()->limits;
+  const auto finite = std::find_if(limits.begin(), limits.end(), [](const stability_limit& l) {
+    return std::isfinite(l.theory) && l.integrator == "rk4" && l.test == stability_test::oscillator;
+  });
+  ASSERT_NE(finite, limits.end());
+  EXPECT_NEAR(finite->theory, 2.0 * std::sqrt(2.0), 1e-6);  // RK4 on the oscillator: |y| < 2 sqrt 2
+  finite->theory *= 1.0 + stability_tolerance / 2;
+  EXPECT_EQ(compare_studies(a, b).count(change_kind::regression), 0u);
+  finite->theory *= 1.0 + 2 * stability_tolerance;
+  const comparison c = compare_studies(a, b);
+  ASSERT_EQ(c.count(change_kind::regression), 1u) << format_text(c);
+  EXPECT_EQ(c.changes[0].method, "rk4");
+  EXPECT_EQ(c.changes[0].what, "oscillator stability limit (y = w dt or lambda dt)");
+  finite->theory = std::nan("");
+  finite->unconditionally_stable = true;
+  const comparison kind = compare_studies(a, b);
+  ASSERT_EQ(kind.count(change_kind::regression), 1u) << format_text(kind);
+  EXPECT_EQ(kind.changes[0].what, "oscillator stability");
 }
 
 // A row skipped over the work budget has no result: newly skipped regresses, and its

@@ -199,6 +199,7 @@ TEST(sweep, overrides_reach_the_problem) {
   opts.methods = {"rk4"};
   opts.levels = 3;
   opts.overrides["pendulum"]["theta0_deg"] = 10.0;
+  opts.parts = {"sweep"};
   const auto s = run_sweep(opts);
   const auto params = s.problems.front().problem->params();
   bool found = false;

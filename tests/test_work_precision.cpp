@@ -254,6 +254,7 @@ TEST(advise, reads_a_study_file) {
   sweep_options opts;
   opts.problems = {"damped_spring"};
   opts.levels = 6;
+  opts.parts = {"sweep"};  // the part advise reads
   const study s = run_sweep(opts);
   const auto path = (std::filesystem::temp_directory_path() / fmt::format("test_advise_{}.h5", ::getpid())).string();
   write_study(s, path);

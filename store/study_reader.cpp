@@ -8,11 +8,10 @@
 #include <unistd.h>
 
 #include <csignal>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -89,11 +88,36 @@ std::runtime_error cannot_read(const std::string& path, const std::string& what)
   return std::runtime_error(fmt::format("cannot read study file '{}': {}", path, what));
 }
 
-reading_child start_reading(const std::string& path, const study_parts_reader& read_parts) {
-  reading_child c{path, &read_parts, {}, -1, -1};
-  std::ifstream in(path, std::ios::binary);
-  c.bytes.assign(std::istreambuf_iterator<char>(in), {});
-  if (!in.good() && !in.eof()) throw cannot_read(path, std::strerror(errno));
+// The largest file taken for a study: the default study's file is about 10 MB, a large
+// merged or scanned one some hundreds; past this it is not a study (or not one this
+// machine should hold in memory three times, as the reader does).
+constexpr std::uintmax_t largest_study_file = std::uintmax_t{1} << 30;
+
+// The file's bytes, read whole by the calling process (a regular file only: a device or a
+// pipe would not end).
+std::vector<char> file_bytes(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw cannot_read(path, "not a regular file");
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) throw cannot_read(path, ec.message());
+  if (size > largest_study_file)
+    throw cannot_read(path,
+                      fmt::format("{} bytes: larger than a study file can be ({} bytes)", size, largest_study_file));
+  std::vector<char> bytes(static_cast<std::size_t>(size));
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) throw cannot_read(path, std::strerror(errno));
+  const std::size_t got = std::fread(bytes.data(), 1, bytes.size(), f);
+  const bool failed = std::ferror(f) != 0;
+  std::fclose(f);
+  if (failed) throw cannot_read(path, "an I/O error while reading it");
+  bytes.resize(got);  // shorter when the file shrank meanwhile: the child judges what was read
+  return bytes;
+}
+
+// `held`: the bytes this process holds of the files read so far, this one's included.
+reading_child start_reading(const std::string& path, const study_parts_reader& read_parts, std::size_t& held) {
+  reading_child c{path, &read_parts, file_bytes(path), -1, -1};
+  held += c.bytes.size();
   int fds[2];
   if (::pipe(fds) != 0)
     throw cannot_read(path, fmt::format("cannot start the process that reads it: {}", std::strerror(errno)));
@@ -113,7 +137,11 @@ reading_child start_reading(const std::string& path, const study_parts_reader& r
     const rlimit cpu{20, 20};
     ::setrlimit(RLIMIT_CPU, &cpu);
 #if !defined(__SANITIZE_ADDRESS__)
-    const rlimit memory{std::size_t{2} << 30, std::size_t{2} << 30};
+    // The memory bound: 2 GiB for HDF5's work, plus the bytes of this file and of those
+    // read before it (inherited), each held up to three times (ours, HDF5's copy, its
+    // core file).
+    const std::size_t bound = (std::size_t{2} << 30) + 3 * held;
+    const rlimit memory{bound, bound};
     ::setrlimit(RLIMIT_AS, &memory);
 #endif
     const int null = ::open("/dev/null", O_WRONLY);
@@ -164,7 +192,13 @@ study finish_reading(reading_child& c) {
   if (!answer.empty() && answer[0] == 'H')
     throw fail(fmt::format("HDF5: {} (truncated or corrupt?)", answer.substr(1)));
   if (!answer.empty()) throw fail(answer.substr(1));
-  return read_image(c.path, c.bytes, *c.read_parts);
+  try {  // the same bytes, with the same code, that the child read whole
+    return read_image(c.path, c.bytes, *c.read_parts);
+  } catch (const H5::Exception& e) {
+    throw fail(fmt::format("HDF5: {}", e.getDetailMsg()));
+  } catch (const std::exception& e) {
+    throw fail(e.what());
+  }
 }
 
 // Children still running when reading stops early (an error in an earlier file) are
@@ -193,7 +227,8 @@ std::vector<study> read_studies(const std::vector<std::string>& paths, const stu
   }
   H5::Exception::dontPrint();
   reading_children children;
-  for (const auto& path : paths) children.all.push_back(start_reading(path, read_parts));
+  std::size_t held = 0;
+  for (const auto& path : paths) children.all.push_back(start_reading(path, read_parts, held));
   std::vector<study> out;
   for (auto& c : children.all) out.push_back(finish_reading(c));
   return out;

@@ -5,6 +5,7 @@
 #include <H5Cpp.h>
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -260,7 +261,19 @@ TEST_F(compare_test, a_study_read_back_is_the_study_written) {
     EXPECT_EQ(q.truth.source, w.truth.source);
     EXPECT_EQ(q.truth.trusted, w.truth.trusted);
     EXPECT_EQ(q.truth.pos_scale, w.truth.pos_scale);
+    EXPECT_EQ(q.truth.vel_scale, w.truth.vel_scale);
     ASSERT_EQ(q.truth.references.size(), w.truth.references.size());
+    for (const reference_check& x : w.truth.references) {  // in name order in the file
+      const auto found = std::find_if(q.truth.references.begin(), q.truth.references.end(),
+                                      [&](const reference_check& r) { return r.source == x.source; });
+      ASSERT_NE(found, q.truth.references.end()) << x.source;
+      const reference_check& y = *found;
+      EXPECT_EQ(y.status, x.status);
+      EXPECT_EQ(y.compared_with, x.compared_with);
+      if (!x.compared_with.empty()) {
+        EXPECT_TRUE(same(y.vs.pos_rel, x.vs.pos_rel)) << x.source;
+      }
+    }
     ASSERT_EQ(q.methods.size(), w.methods.size());
     for (const method_study& a : w.methods) {
       ASSERT_NE(q.find(a.info.name), nullptr) << a.info.name;
@@ -279,6 +292,11 @@ TEST_F(compare_test, a_study_read_back_is_the_study_written) {
         EXPECT_TRUE(same(y.metrics.err_pos_max, x.metrics.err_pos_max)) << a.info.name << " " << k;
         EXPECT_TRUE(same(y.metrics.err_vel_final, x.metrics.err_vel_final));
         EXPECT_EQ(y.metrics.diverged, x.metrics.diverged);
+        EXPECT_EQ(y.metrics.failed, x.metrics.failed);
+        EXPECT_EQ(y.metrics.skipped, x.metrics.skipped);
+        EXPECT_EQ(y.time.cut, x.time.cut);
+        EXPECT_TRUE(same(y.time.time_ns_min, x.time.time_ns_min));
+        EXPECT_TRUE(same(y.time.time_ns_max, x.time.time_ns_max));
         EXPECT_EQ(y.metrics.note, x.metrics.note);
         EXPECT_TRUE(same(y.time.time_ns, x.time.time_ns));
         EXPECT_EQ(y.time.repetitions, x.time.repetitions);
@@ -475,7 +493,10 @@ TEST_F(compare_test, files_that_cannot_be_compared) {
     std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     std::ofstream(cut, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size() / 2));
   }
-  for (const auto& bad : {cut, path("missing.h5")}) {
+  // A device that never ends, and a pipe that never does either, are refused unread.
+  const std::string pipe = path("pipe.h5");
+  ASSERT_EQ(::mkfifo(pipe.c_str(), 0600), 0);
+  for (const auto& bad : {cut, path("missing.h5"), std::string("/dev/zero"), pipe}) {
     try {
       read_study(bad);
       ADD_FAILURE() << bad << " was read";

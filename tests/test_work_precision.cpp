@@ -369,6 +369,29 @@ TEST(advise, frame_rates_follow_the_stability_limits_and_agree_with_the_substeps
   ASSERT_TRUE(from_run.met());
   EXPECT_EQ(from_run.ranked.front().method, f.ranked.front().method);
   EXPECT_EQ(from_run.ranked.front().cost_per_frame, f.ranked.front().cost_per_frame);
+  // Timed, a frame's cost is the sweep's measured ns a step times the substeps, derived
+  // again from the rows read back: the same figures as the run's.
+  study timed = run_sweep(opts);
+  timed.timed = timing_settings{"full", 0.01, 3, 0.5, 2, 1000.0, 0, 1.0};
+  double ns = 100.0;
+  for (auto& ps : timed.problems)
+    for (auto& ms : ps.methods) {
+      ns *= 1.5;  // a cost of its own for each method
+      for (auto& r : ms.rows)
+        if (r.metrics.completed()) r.time = {ns * static_cast<double>(r.steps), 0.0, 0.0, 3, false};
+    }
+  judge_study(timed);  // judged again once timed, as stepbench_bench does
+  write_study(timed, path);
+  const frame_advice run_timed = advise_frame(timed, "stiff_spring", 60.0, 1e-3),
+                     read_timed = advise_frame(read_study(path), "stiff_spring", 60.0, 1e-3);
+  EXPECT_EQ(read_timed.cost_kind, "time_ns");
+  ASSERT_FALSE(run_timed.ranked.empty());
+  ASSERT_EQ(read_timed.ranked.size(), run_timed.ranked.size());
+  for (std::size_t k = 0; k < run_timed.ranked.size(); ++k) {
+    EXPECT_EQ(read_timed.ranked[k].method, run_timed.ranked[k].method);
+    EXPECT_EQ(read_timed.ranked[k].substeps, run_timed.ranked[k].substeps);
+    EXPECT_DOUBLE_EQ(read_timed.ranked[k].cost_per_frame, run_timed.ranked[k].cost_per_frame);
+  }
   std::filesystem::remove(path);
 }
 

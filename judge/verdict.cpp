@@ -209,23 +209,15 @@ std::vector<std::string> findings_of(const verdict_tables& v, const finding_inpu
   return out;
 }
 
-namespace {
-const method_info* registered(std::string_view name) {
-  const auto& all = all_methods();
-  const auto it = std::find_if(all.begin(), all.end(), [&](const method_info& m) { return m.name == name; });
-  return it == all.end() ? nullptr : &*it;  // a file may hold a method this build lacks
-}
-}  // namespace
-
 bool is_first_order_pair(const substep_verdict& sv) {
-  const method_info* im = registered(sv.implicit_method);
-  const method_info* em = registered(sv.explicit_method);
+  const method_info* im = registered_method(sv.implicit_method);
+  const method_info* em = registered_method(sv.explicit_method);
   return im && em && im->declared_order == 1.0 && im->traits.needs_jacobian && !im->traits.symplectic &&
          em->declared_order == 1.0 && em->traits.symplectic && !em->traits.needs_jacobian;
 }
 
 bool judges_ladder_as_substeps(std::string_view method) {
-  const method_info* m = registered(method);
+  const method_info* m = registered_method(method);
   return m && m->traits.small_steps;
 }
 

@@ -28,6 +28,7 @@ extern const study_part substeps_part{
         [](H5::Group& root, const study& s) {
           write_substeps(root, s.results.get<std::vector<substep_study>>(), s.timed.has_value());
         },
+    .read = read_substeps,
 };
 
 }  // namespace stepbench

@@ -44,9 +44,14 @@ std::vector<method_info> integrators() {
   return out;
 }
 
-const method_info& find_method(std::string_view name) {
+const method_info* registered_method(std::string_view name) {
   for (const auto& m : all_methods())
-    if (m.name == name) return m;
+    if (m.name == name) return &m;
+  return nullptr;
+}
+
+const method_info& find_method(std::string_view name) {
+  if (const method_info* m = registered_method(name)) return *m;
   std::vector<std::string> known;
   for (const auto& m : all_methods()) known.push_back(m.name);
   throw std::invalid_argument(fmt::format("unknown method '{}' (known: {})", name, fmt::join(known, ", ")));

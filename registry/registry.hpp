@@ -22,5 +22,7 @@ const std::vector<method_info>& all_methods();
 std::vector<method_info> integrators();
 // Throws std::invalid_argument naming the unknown method and the known ones.
 const method_info& find_method(std::string_view name);
+// The method of that name, or nullptr (a study file may hold a method this build lacks).
+const method_info* registered_method(std::string_view name);
 
 }  // namespace stepbench

@@ -12,6 +12,7 @@
 
 #include "build_info.hpp"
 #include "judge/rows.hpp"
+#include "registry/registry.hpp"
 #include "run/machine.hpp"
 #include "run/sweep.hpp"
 #include "store/h5.hpp"
@@ -225,6 +226,9 @@ fit_result::status parse_fit_status(const std::string& s) {
 // A method's group as write_method (store/study_file.cpp) writes it.
 method_study read_method(const H5::Group& g, const std::string& name) {
   method_study m;
+  // The build's own declaration where it has the method (capabilities, evaluations a
+  // step), the file's figures over it.
+  if (const method_info* known = registered_method(name)) m.info = *known;
   m.info.name = name;
   m.info.origin = parse_origin(h5::string_attr(g, "origin"));
   m.info.kind = parse_kind(h5::string_attr(g, "kind"));

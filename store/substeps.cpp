@@ -1,6 +1,7 @@
 #include "store/substeps.hpp"
 
 #include "judge/substeps.hpp"
+#include "registry/registry.hpp"
 #include "store/h5.hpp"
 #include "store/study_file.hpp"
 
@@ -49,6 +50,26 @@ void write_substeps(H5::Group& root, const std::vector<substep_study>& studies, 
       substep_runs_columns().write(mg, "runs", m.rows, timed);
     }
     substep_verdict_columns().write(g, "verdict", substep_verdicts(s, timed));
+  }
+}
+
+void read_substeps(const H5::Group& root, study& s) {
+  auto& studies = s.results.put(std::vector<substep_study>{});
+  const H5::Group top = root.openGroup("substeps");
+  for (const auto& problem : h5::children(top)) {
+    const H5::Group g = top.openGroup(problem);
+    substep_study& st = studies.emplace_back();
+    st.problem = problem;
+    st.frame_dt = h5::double_attr(g, "frame_dt");
+    const H5::Group methods = g.openGroup("methods");
+    for (const auto& name : h5::children(methods)) {
+      const H5::Group mg = methods.openGroup(name);
+      substep_method& m = st.methods.emplace_back();
+      if (const method_info* known = registered_method(name)) m.info = *known;
+      m.info.name = name;
+      m.info.traits.needs_jacobian = h5::long_attr(mg, "needs_jacobian") != 0;
+      m.rows = substep_runs_columns().read(mg, "runs");
+    }
   }
 }
 

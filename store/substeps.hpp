@@ -11,5 +11,8 @@ namespace stepbench {
 const column_map<substep_row>& substep_runs_columns();
 const column_map<substep_verdict>& substep_verdict_columns();
 void write_substeps(H5::Group& root, const std::vector<substep_study>& studies, bool timed);
+// /substeps read back (the substeps part's read): each problem's frame and methods' runs,
+// each method's declaration the build's where it has the method.
+void read_substeps(const H5::Group& root, study& s);
 
 }  // namespace stepbench

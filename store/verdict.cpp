@@ -14,40 +14,26 @@
 
 namespace stepbench {
 
-finding_inputs read_finding_inputs(const H5::Group& root, const std::vector<std::string>& problems) {
-  finding_inputs in;
-  for (const auto& p : problems) {
-    if (h5::is_group(root, "substeps/" + p)) {
-      const H5::Group g = root.openGroup("substeps/" + p);
-      const double frame_dt = h5::double_attr(g, "frame_dt");
-      for (auto& sv : substep_verdict_columns().read(g, "verdict")) {
-        sv.problem = p;  // the table is the problem's own
-        if (is_first_order_pair(sv)) in.substeps.push_back({p, frame_dt, std::move(sv)});
-      }
-    }
-    if (h5::is_group(root, "problems/" + p + "/methods")) {
-      const H5::Group methods = root.openGroup("problems/" + p + "/methods");
-      for (const auto& m : h5::children(methods)) {
-        const H5::Group g = methods.openGroup(m);
-        if (h5::string_attr(g, "origin") == "peer" && h5::long_attr(g, "declared_order_holds") == 0)
-          in.broken_orders[m].insert(p);
-      }
-      for (const auto& m : h5::children(methods)) {
-        if (!judges_ladder_as_substeps(m)) continue;
-        ladder_finding f{m, p, {}};
-        for (const method_row& r : runs_columns().read(methods.openGroup(m), "runs")) {
-          const auto& mt = r.metrics;
-          f.runs.push_back({r.param, mt.diverged, mt.failed, mt.skipped, mt.energy_drift, mt.constraint_violation_max});
-        }
-        in.small_steps_ladders.push_back(std::move(f));
-      }
-    }
-  }
-  return in;
-}
-
 void judge_findings_again(H5::Group& root, const std::vector<std::string>& problems) {
-  const auto findings = findings_of(read_verdict(root), read_finding_inputs(root, problems));
+  // What the findings read, back from the merged file: the sweep's rows and the substeps
+  // studies, in the study's order of problems.
+  study s;
+  if (h5::long_attr(root, "timing") != 0) s.timed.emplace();
+  read_problems(root, s);
+  if (h5::is_group(root, "substeps")) read_substeps(root, s);
+  auto* read = s.results.find<std::vector<substep_study>>();
+  auto& substeps = read ? *read : s.results.put(std::vector<substep_study>{});
+  std::vector<problem_study> swept;
+  std::vector<substep_study> stepped;
+  for (const auto& p : problems) {
+    for (auto& ps : s.problems)
+      if (ps.name == p) swept.push_back(std::move(ps));
+    for (auto& st : substeps)
+      if (st.problem == p) stepped.push_back(std::move(st));
+  }
+  s.problems = std::move(swept);
+  substeps = std::move(stepped);
+  const auto findings = findings_of(read_verdict(root), finding_inputs_of(s));
   H5::Group g = root.openGroup("verdict");
   if (g.attrExists("findings")) g.removeAttr("findings");
   h5::attr(g, "findings", fmt::format("{}", fmt::join(findings, "\n")));

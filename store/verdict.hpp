@@ -20,9 +20,6 @@ verdict_tables read_verdict(const H5::Group& root);
 
 // /frame_rates read back (the frame_rates part's read): each problem's runs.
 void read_frame_rates(const H5::Group& root, study& s);
-// From a study file's /substeps/<p>/verdict and /problems/<p>/methods, for `problems` in
-// that order.
-finding_inputs read_finding_inputs(const H5::Group& root, const std::vector<std::string>& problems);
 
 // The findings, which span problems, judged again from a merged file's joined tables
 // (/verdict's attribute `findings`): merge's judged_again for the verdict part.

@@ -218,6 +218,12 @@ class Study:
         return int(self.attrs["timing"]) == 1
 
 
+def _path(obj):
+    """An object's path for a message: h5py gives None for one HDF5 cannot name (a damaged
+    link), and a message must not fail on it."""
+    return obj.name if obj.name is not None else "(an object of a damaged file)"
+
+
 def _method_sort_key(m):
     order = m.declared_order
     return (ORIGINS.index(m.origin), m.adaptive, order if np.isfinite(order) else 99, m.name)
@@ -250,7 +256,7 @@ class _Reader:
         location = _attribute_holder(obj)
         missing = [n for n in names if not h5a.exists(location, n.encode())]
         if missing:
-            where = "the root group" if obj.name == "/" else obj.name
+            where = "the root group" if obj.name == "/" else _path(obj)
             raise self.error(f"{where} lacks attribute{'s' if len(missing) > 1 else ''} {', '.join(missing)}")
         return self.attributes(obj)
 
@@ -308,7 +314,7 @@ class _Reader:
     def need_group(self, parent, name):
         g = parent.get(name)
         if not isinstance(g, h5py.Group):
-            raise self.error(f"{parent.name.rstrip('/')}/{name} is missing (a group)")
+            raise self.error(f"{_path(parent).rstrip('/')}/{name} is missing (a group)")
         return g
 
     def need_table(self, parent, name, fields):
@@ -320,7 +326,7 @@ class _Reader:
         except KeyError:
             ds = None
         if not isinstance(ds, h5d.DatasetID):
-            raise self.error(f"{parent.name.rstrip('/')}/{name} is missing (a dataset)")
+            raise self.error(f"{_path(parent).rstrip('/')}/{name} is missing (a dataset)")
         stored = ds.get_type()
         read_as = self.read_type(stored)
         missing = [n for n in fields if n not in (read_as.dtype.names or ())]
@@ -340,7 +346,7 @@ class _Reader:
 
     def need_value(self, obj, key, value, allowed):
         if value not in allowed:
-            raise self.error(f"{obj.name}: {key} is '{value}', not one of {', '.join(map(str, allowed))}")
+            raise self.error(f"{_path(obj)}: {key} is '{value}', not one of {', '.join(map(str, allowed))}")
 
     def need_column(self, parent, table, rows, field, allowed):
         """Every value of column `field` of the table `parent`/`table` (read as `rows`) is
@@ -355,7 +361,7 @@ class _Reader:
         them are not entries."""
         return [(name, sub) for name, sub in g.items() if isinstance(sub, h5py.Group)]
 
-    def method(self, g, timed):
+    def method(self, g, timed, name):
         attrs = self.need_attrs(g, METHOD_ATTRS)
         self.need_value(g, "origin", attrs["origin"], ORIGINS)
         self.need_value(g, "kind", attrs["kind"], tuple(schema.PARAM_KIND))
@@ -363,15 +369,14 @@ class _Reader:
         self.need_value(g, "fit_status", attrs["fit_status"], FIT_STATUSES)
         self.need_value(g, "declared_order_holds", int(attrs["declared_order_holds"]), (-1, 0, 1))
         runs = self.need_table(g, "runs", RUN_FIELDS + (TIMED_RUN_FIELDS if timed else ()))
-        name = g.name.rsplit("/", 1)[1]
         levels = np.atleast_1d(attrs["fit_levels"])
         if len(levels) and (levels.min() < 0 or levels.max() >= len(runs)):
-            raise self.error(f"{g.name}: fit_levels {levels.tolist()} name rows beyond its {len(runs)} runs")
+            raise self.error(f"{_path(g)}: fit_levels {levels.tolist()} name rows beyond its {len(runs)} runs")
         return Method(name, attrs, runs)
 
-    def problem(self, g, timed):
+    def problem(self, g, timed, name):
         attrs = self.need_attrs(g, PROBLEM_ATTRS)
-        methods = [self.method(mg, timed) for mg in self.need_group(g, "methods").values()
+        methods = [self.method(mg, timed, mname) for mname, mg in self.need_group(g, "methods").items()
                    if isinstance(mg, h5py.Group)]
         methods.sort(key=_method_sort_key)
         refs = g.get("reference")
@@ -383,7 +388,7 @@ class _Reader:
         if timed:
             fronts["time"] = self.need_table(g, "front_time", FRONT_FIELDS)
         equal_error_fields = tuple(n for n in EQUAL_ERROR_FIELDS if n not in self.lacks.get("equal_error", ()))
-        p = Problem(g.name.rsplit("/", 1)[1], attrs, methods, references,
+        p = Problem(name, attrs, methods, references,
                     self.need_table(g, "equal_error", equal_error_fields), fronts,
                     self.need_table(g, "parameters", PARAMETER_FIELDS))
         self.check_derived(g, p)
@@ -401,13 +406,13 @@ class _Reader:
         for table, rows in tables:
             for method, param in zip(rows["method"].tolist(), rows["param"].tolist()):
                 if param not in params.get(method, ()):
-                    raise self.error(f"{g.name}/{table} names a run that {g.name}/methods lacks "
+                    raise self.error(f"{_path(g)}/{table} names a run that {_path(g)}/methods lacks "
                                      f"({method} at {param:g})")
 
     def need_array(self, parent, name, ndim):
         ds = parent.get(name)
         if not isinstance(ds, h5py.Dataset) or ds.dtype.names is not None or ds.ndim != ndim:
-            raise self.error(f"{parent.name.rstrip('/')}/{name} is missing (a {ndim}-D dataset of numbers)")
+            raise self.error(f"{_path(parent).rstrip('/')}/{name} is missing (a {ndim}-D dataset of numbers)")
         return np.asarray(ds[()], dtype=float)
 
     def stability(self):
@@ -480,14 +485,14 @@ class _Reader:
         if timed:
             self.need_attrs(f, TIMED_ROOT_ATTRS)
         problems_group = f.get("problems")
-        groups = [g for g in problems_group.values() if isinstance(g, h5py.Group)] \
+        groups = [(name, g) for name, g in problems_group.items() if isinstance(g, h5py.Group)] \
             if isinstance(problems_group, h5py.Group) else []
         if not groups:
             if self.has_scan():
                 return self.scan_file(attrs, share)
             self.need_group(f, "problems")
             raise self.error("/problems holds no problem and the file has no /scan (neither a study nor a scan file)")
-        problems = [self.problem(g, timed) for g in groups[_problem_share(share, shares)]]
+        problems = [self.problem(g, timed, name) for name, g in groups[_problem_share(share, shares)]]
         if share > 0:
             return Study(path=str(self.path), attrs=attrs, problems=problems)
         return Study(path=str(self.path), attrs=attrs, problems=problems, stability=self.stability(),

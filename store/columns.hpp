@@ -11,6 +11,7 @@
 // setter.
 #include <cstdint>
 #include <functional>
+#include <initializer_list>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -25,6 +26,15 @@
 #include "store/schema.hpp"
 
 namespace stepbench {
+
+// The value of an enumeration a file stores as its name (to_string(value)); throws
+// std::runtime_error, "unknown <what> '<text>'", for a name none of `values` has.
+template <class E>
+E parse_enum(std::string_view text, std::initializer_list<E> values, std::string_view what) {
+  for (const E v : values)
+    if (text == to_string(v)) return v;
+  throw std::runtime_error(std::string("unknown ") + std::string(what) + " '" + std::string(text) + "'");
+}
 
 namespace columns_detail {
 

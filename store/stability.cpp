@@ -6,23 +6,22 @@ namespace stepbench {
 
 const column_map<stability_limit>& stability_limit_columns() {
   using R = stability_limit;
-  static const auto columns = column_map<R>("stability_limits")
-                                  .member("integrator", &R::integrator)
-                                  .field(
-                                      "test", [](const R& l) { return std::string(to_string(l.test)); },
-                                      [](R& l, const std::string& test) {
-                                        for (const auto t : {stability_test::oscillator, stability_test::decay})
-                                          if (test == to_string(t)) return void(l.test = t);
-                                        throw std::runtime_error("unknown stability test '" + test + "'");
-                                      })
-                                  .member("measured", &R::measured)
-                                  .member("theory", &R::theory)
-                                  .derived("rel_difference", [](const R& l) { return l.rel_difference(); })
-                                  .member("unstable_for_all_dt", &R::unstable_for_all_dt)
-                                  .member("unconditionally_stable", &R::unconditionally_stable)
-                                  .member("run_confirms", &R::run_confirms)
-                                  .member("step_failed_at", &R::step_failed_at)
-                                  .member("note", &R::note);
+  static const auto columns =
+      column_map<R>("stability_limits")
+          .member("integrator", &R::integrator)
+          .field(
+              "test", [](const R& l) { return std::string(to_string(l.test)); },
+              [](R& l, const std::string& test) {
+                l.test = parse_enum(test, {stability_test::oscillator, stability_test::decay}, "stability test");
+              })
+          .member("measured", &R::measured)
+          .member("theory", &R::theory)
+          .derived("rel_difference", [](const R& l) { return l.rel_difference(); })
+          .member("unstable_for_all_dt", &R::unstable_for_all_dt)
+          .member("unconditionally_stable", &R::unconditionally_stable)
+          .member("run_confirms", &R::run_confirms)
+          .member("step_failed_at", &R::step_failed_at)
+          .member("note", &R::note);
   return columns;
 }
 

@@ -205,24 +205,6 @@ void write_problem(H5::Group& parent, const problem_study& ps, const std::option
   if (timed) write_front(g, ps, true, timed);
 }
 
-method_origin parse_origin(const std::string& s) {
-  for (const auto o : {method_origin::ours, method_origin::peer, method_origin::baseline})
-    if (s == to_string(o)) return o;
-  throw std::runtime_error(fmt::format("unknown method origin '{}'", s));
-}
-
-method_kind parse_kind(const std::string& s) {
-  for (const auto k : {method_kind::fixed_step, method_kind::adaptive})
-    if (s == to_string(k)) return k;
-  throw std::runtime_error(fmt::format("unknown method kind '{}'", s));
-}
-
-fit_result::status parse_fit_status(const std::string& s) {
-  for (const auto f : {fit_result::status::fitted, fit_result::status::exact, fit_result::status::insufficient})
-    if (s == to_string(f)) return f;
-  throw std::runtime_error(fmt::format("unknown fit_status '{}'", s));
-}
-
 // A method's group as write_method (store/study_file.cpp) writes it.
 method_study read_method(const H5::Group& g, const std::string& name) {
   method_study m;
@@ -230,12 +212,15 @@ method_study read_method(const H5::Group& g, const std::string& name) {
   // step), the file's figures over it.
   if (const method_info* known = registered_method(name)) m.info = *known;
   m.info.name = name;
-  m.info.origin = parse_origin(h5::string_attr(g, "origin"));
-  m.info.kind = parse_kind(h5::string_attr(g, "kind"));
+  m.info.origin = parse_enum(h5::string_attr(g, "origin"),
+                             {method_origin::ours, method_origin::peer, method_origin::baseline}, "method origin");
+  m.info.kind = parse_enum(h5::string_attr(g, "kind"), {method_kind::fixed_step, method_kind::adaptive}, "method kind");
   m.info.description = h5::string_attr(g, "description");
   m.info.library = h5::string_attr(g, "library");
   m.info.declared_order = h5::double_attr(g, "declared_order");
-  m.fit.state = parse_fit_status(h5::string_attr(g, "fit_status"));
+  using fit = fit_result::status;
+  m.fit.state =
+      parse_enum(h5::string_attr(g, "fit_status"), {fit::fitted, fit::exact, fit::insufficient}, "fit_status");
   m.fit.order = h5::double_attr(g, "fit_slope");
   for (long level : h5::int_array_attr(g, "fit_levels")) m.fit.levels.push_back(static_cast<int>(level));
   m.declared_order_holds = static_cast<int>(h5::long_attr(g, "declared_order_holds"));

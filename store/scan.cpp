@@ -7,6 +7,7 @@
 
 #include "core/number.hpp"
 #include "store/columns.hpp"
+#include "store/study_reader.hpp"
 
 namespace stepbench {
 namespace {
@@ -82,137 +83,116 @@ const column_map<scan_best>& scan_best_columns() {
   return columns;
 }
 
-}  // namespace
-
-scan_result read_scan(const std::string& path, const std::string& name) {
-  H5::Exception::dontPrint();  // errors become one line, not HDF5's stack
+// /scan/<which>, from a file the reader has checked.
+scan_result read_scan_group(const H5::Group& all, const std::string& which) {
   scan_result s;
-  try {
-    if (!std::filesystem::exists(path)) throw std::runtime_error("no such file");
-    if (!H5::H5File::isHdf5(path)) throw std::runtime_error("not an HDF5 file");
-    const H5::H5File file(path, H5F_ACC_RDONLY);
-    if (!h5::is_group(file, "scan")) throw std::runtime_error("it holds no scan (/scan is absent)");
-    const H5::Group all = file.openGroup("scan");
-    const auto names = h5::children(all);
-    std::string which = name;
-    if (which.empty()) {
-      if (names.size() != 1)
-        throw std::invalid_argument(
-            fmt::format("'{}' holds {} scans; name one with --name ({})", path, names.size(), fmt::join(names, ", ")));
-      which = names.front();
+  const H5::Group g = all.openGroup(which);
+  auto& o = s.options;
+  o.name = which;
+  o.problem = h5::string_attr(g, "problem");
+  s.unit = h5::string_attr(g, "unit");
+  o.tol = h5::double_attr(g, "tol");
+  const auto lo = h5::double_array_attr(g, "axis_lo"), hi = h5::double_array_attr(g, "axis_hi");
+  const auto count = h5::int_array_attr(g, "axis_count"), log = h5::int_array_attr(g, "axis_log");
+  const std::vector<std::string> axis_names = names_of(h5::string_attr(g, "axes"));
+  if (axis_names.size() != lo.size() || lo.size() != hi.size() || hi.size() != count.size() ||
+      count.size() != log.size())
+    throw std::runtime_error(fmt::format("scan '{}': its axis attributes differ in length", which));
+  for (std::size_t k = 0; k < axis_names.size(); ++k)
+    o.axes.push_back({axis_names[k], lo[k], hi[k], static_cast<int>(count[k]), log[k] != 0, false});
+  o.hz = h5::double_array_attr(g, "hz");
+  o.substeps.clear();  // the file's counts replace the defaults, not extend them
+  for (long n : h5::int_array_attr(g, "substeps")) o.substeps.push_back(static_cast<int>(n));
+  o.methods = names_of(h5::string_attr(g, "methods"));
+  const auto fixed_names = names_of(h5::string_attr(g, "fixed_params"));
+  const auto fixed_values = h5::double_array_attr(g, "fixed_values");
+  if (fixed_names.size() != fixed_values.size())
+    throw std::runtime_error(
+        fmt::format("scan '{}': {} fixed_params but {} fixed_values", which, fixed_names.size(), fixed_values.size()));
+  for (std::size_t k = 0; k < fixed_names.size(); ++k) o.fixed[fixed_names[k]] = fixed_values[k];
+  o.ref_tol.rtol = h5::double_attr(g, "reference_rtol");
+  o.ref_tol.atol = h5::double_attr(g, "reference_atol");
+  o.limits.work_budget = h5::double_attr(g, "work_budget");
+  o.reference_budget = h5::double_attr(g, "reference_budget");
+  s.wall_seconds = h5::double_attr(g, "wall_seconds");
+  const H5::Group values = g.openGroup("values");
+  std::vector<std::vector<double>> columns;
+  for (const auto& a : o.axes) columns.push_back(h5::read_vector(values.openDataSet(a.param)));
+  s.grid_points = static_cast<std::size_t>(h5::long_attr(g, "grid_points"));
+  double product = 1.0;  // in doubles: a damaged count cannot overflow it
+  for (const auto& a : o.axes) product *= a.count;
+  if (static_cast<double>(s.grid_points) != product)
+    throw std::runtime_error(fmt::format("scan '{}': grid_points {} is not the product of its axes' counts, {:.0f}",
+                                         which, s.grid_points, product));
+  o.shard_index = static_cast<int>(h5::long_attr(g, "shard_index"));
+  o.shard_count = static_cast<int>(h5::long_attr(g, "shard_count"));
+  s.points = scan_point_columns().read(g, "points");
+  std::map<std::size_t, std::size_t> local_of;  // grid index -> row
+  for (std::size_t i = 0; i < s.points.size(); ++i) {
+    auto& p = s.points[i];
+    for (const auto& c : columns) {
+      if (c.size() != s.points.size())
+        throw std::runtime_error(fmt::format("scan '{}': values/ and points differ in length", which));
+      p.values.push_back(c[i]);
     }
-    if (!h5::is_group(all, which))
-      throw std::invalid_argument(
-          fmt::format("'{}' has no scan '{}' (it has: {})", path, which, fmt::join(names, ", ")));
-    const H5::Group g = all.openGroup(which);
-    auto& o = s.options;
-    o.name = which;
-    o.problem = h5::string_attr(g, "problem");
-    s.unit = h5::string_attr(g, "unit");
-    o.tol = h5::double_attr(g, "tol");
-    const auto lo = h5::double_array_attr(g, "axis_lo"), hi = h5::double_array_attr(g, "axis_hi");
-    const auto count = h5::int_array_attr(g, "axis_count"), log = h5::int_array_attr(g, "axis_log");
-    const std::vector<std::string> axis_names = names_of(h5::string_attr(g, "axes"));
-    if (axis_names.size() != lo.size() || lo.size() != hi.size() || hi.size() != count.size() ||
-        count.size() != log.size())
-      throw std::runtime_error(fmt::format("scan '{}': its axis attributes differ in length", which));
-    for (std::size_t k = 0; k < axis_names.size(); ++k)
-      o.axes.push_back({axis_names[k], lo[k], hi[k], static_cast<int>(count[k]), log[k] != 0, false});
-    o.hz = h5::double_array_attr(g, "hz");
-    o.substeps.clear();  // the file's counts replace the defaults, not extend them
-    for (long n : h5::int_array_attr(g, "substeps")) o.substeps.push_back(static_cast<int>(n));
-    o.methods = names_of(h5::string_attr(g, "methods"));
-    const auto fixed_names = names_of(h5::string_attr(g, "fixed_params"));
-    const auto fixed_values = h5::double_array_attr(g, "fixed_values");
-    if (fixed_names.size() != fixed_values.size())
-      throw std::runtime_error(fmt::format("scan '{}': {} fixed_params but {} fixed_values", which, fixed_names.size(),
-                                           fixed_values.size()));
-    for (std::size_t k = 0; k < fixed_names.size(); ++k) o.fixed[fixed_names[k]] = fixed_values[k];
-    o.ref_tol.rtol = h5::double_attr(g, "reference_rtol");
-    o.ref_tol.atol = h5::double_attr(g, "reference_atol");
-    o.limits.work_budget = h5::double_attr(g, "work_budget");
-    o.reference_budget = h5::double_attr(g, "reference_budget");
-    s.wall_seconds = h5::double_attr(g, "wall_seconds");
-    const H5::Group values = g.openGroup("values");
-    std::vector<std::vector<double>> columns;
-    for (const auto& a : o.axes) columns.push_back(h5::read_vector(values.openDataSet(a.param)));
-    s.grid_points = static_cast<std::size_t>(h5::long_attr(g, "grid_points"));
-    double product = 1.0;  // in doubles: a damaged count cannot overflow it
-    for (const auto& a : o.axes) product *= a.count;
-    if (static_cast<double>(s.grid_points) != product)
-      throw std::runtime_error(fmt::format("scan '{}': grid_points {} is not the product of its axes' counts, {:.0f}",
-                                           which, s.grid_points, product));
-    o.shard_index = static_cast<int>(h5::long_attr(g, "shard_index"));
-    o.shard_count = static_cast<int>(h5::long_attr(g, "shard_count"));
-    s.points = scan_point_columns().read(g, "points");
-    std::map<std::size_t, std::size_t> local_of;  // grid index -> row
-    for (std::size_t i = 0; i < s.points.size(); ++i) {
-      auto& p = s.points[i];
-      for (const auto& c : columns) {
-        if (c.size() != s.points.size())
-          throw std::runtime_error(fmt::format("scan '{}': values/ and points differ in length", which));
-        p.values.push_back(c[i]);
-      }
-      if (p.index >= s.grid_points || local_of.count(p.index))
-        throw std::runtime_error(fmt::format("scan '{}': point {} is outside its grid of {} or repeated", which,
-                                             static_cast<std::int64_t>(p.index), s.grid_points));
-      local_of[p.index] = i;
-    }
-    s.runs = scan_run_columns().read(g, "runs");
-    for (std::size_t i = 0; i < s.runs.size(); ++i) {
-      auto& r = s.runs[i];
-      const auto at = local_of.find(r.point);
-      if (at == local_of.end())
-        throw std::runtime_error(fmt::format("scan '{}': run {} names point {}, which its points table lacks", which, i,
-                                             static_cast<std::int64_t>(r.point)));
-      r.point = at->second;
-    }
-    compute_best(s);
-    s.source = path;
-  } catch (const std::invalid_argument&) {
-    throw;
-  } catch (const H5::Exception& e) {
-    throw std::runtime_error(fmt::format("cannot read the scan in '{}': {}", path, e.getDetailMsg()));
-  } catch (const std::exception& e) {
-    throw std::runtime_error(fmt::format("cannot read the scan in '{}': {}", path, e.what()));
+    if (p.index >= s.grid_points || local_of.count(p.index))
+      throw std::runtime_error(fmt::format("scan '{}': point {} is outside its grid of {} or repeated", which,
+                                           static_cast<std::int64_t>(p.index), s.grid_points));
+    local_of[p.index] = i;
   }
+  s.runs = scan_run_columns().read(g, "runs");
+  for (std::size_t i = 0; i < s.runs.size(); ++i) {
+    auto& r = s.runs[i];
+    const auto at = local_of.find(r.point);
+    if (at == local_of.end())
+      throw std::runtime_error(fmt::format("scan '{}': run {} names point {}, which its points table lacks", which, i,
+                                           static_cast<std::int64_t>(r.point)));
+    r.point = at->second;
+  }
+  compute_best(s);
   return s;
 }
 
+}  // namespace
+
+study read_scan_file(const std::string& path) {
+  study file = std::move(read_studies({path}, [](const H5::Group& root, study& s) {
+                           if (!h5::is_group(root, "scan"))
+                             throw std::runtime_error("it holds no scan (/scan is absent)");
+                           const H5::Group all = root.openGroup("scan");
+                           auto& scans = s.results.put(std::vector<scan_result>{});
+                           for (const auto& name : h5::children(all)) scans.push_back(read_scan_group(all, name));
+                         }).front());
+  for (auto& sc : *file.results.find<std::vector<scan_result>>()) sc.source = path;
+  return file;
+}
+
 std::vector<scan_result> read_scans(const std::string& path) {
+  return std::move(*read_scan_file(path).results.find<std::vector<scan_result>>());
+}
+
+scan_result read_scan(const std::string& path, const std::string& name) {
+  std::vector<scan_result> scans = read_scans(path);
   std::vector<std::string> names;
-  try {
-    if (!std::filesystem::exists(path)) throw std::runtime_error("no such file");
-    if (!H5::H5File::isHdf5(path)) throw std::runtime_error("not an HDF5 file");
-    const H5::H5File file(path, H5F_ACC_RDONLY);
-    if (!h5::is_group(file, "scan")) throw std::runtime_error("it holds no scan (/scan is absent)");
-    names = h5::children(file.openGroup("scan"));
-  } catch (const H5::Exception& e) {
-    throw std::runtime_error(fmt::format("cannot read the scans in '{}': {}", path, e.getDetailMsg()));
-  } catch (const std::exception& e) {
-    throw std::runtime_error(fmt::format("cannot read the scans in '{}': {}", path, e.what()));
-  }
-  std::vector<scan_result> out;
-  for (const auto& name : names) out.push_back(read_scan(path, name));
-  return out;
+  for (const auto& s : scans) names.push_back(s.options.name);
+  if (name.empty() && scans.size() != 1)
+    throw std::invalid_argument(
+        fmt::format("'{}' holds {} scans; name one with --name ({})", path, scans.size(), fmt::join(names, ", ")));
+  for (auto& s : scans)
+    if (name.empty() || s.options.name == name) return std::move(s);
+  throw std::invalid_argument(fmt::format("'{}' has no scan '{}' (it has: {})", path, name, fmt::join(names, ", ")));
 }
 
 std::string file_build(const std::string& path) {
-  H5::Exception::dontPrint();
-  try {
-    if (!std::filesystem::exists(path)) throw std::runtime_error("no such file");
-    if (!H5::H5File::isHdf5(path)) throw std::runtime_error("not an HDF5 file");
-    const H5::H5File file(path, H5F_ACC_RDONLY);
-    // The compiler and the libraries too: another GSL or SUNDIALS is another truth.
-    return fmt::format("format_version {}, commit {}, {} build, flags {}, {}, {}",
-                       h5::long_attr(file, "format_version"), h5::string_attr(file, "git_commit"),
-                       h5::string_attr(file, "build_type"), h5::string_attr(file, "build_flags"),
-                       h5::string_attr(file, "compiler"), h5::string_attr(file, "dependencies"));
-  } catch (const H5::Exception& e) {
-    throw std::runtime_error(fmt::format("cannot read the build of '{}': {}", path, e.getDetailMsg()));
-  } catch (const std::exception& e) {
-    throw std::runtime_error(fmt::format("cannot read the build of '{}': {}", path, e.what()));
-  }
+  // The compiler and the libraries too: another GSL or SUNDIALS is another truth.
+  const study file = std::move(read_studies({path}, [](const H5::Group&, study&) {}).front());
+  const study_record& r = *file.record;
+  const auto meta = [&](const char* key) {
+    const auto it = r.meta.find(key);
+    return it == r.meta.end() ? std::string("-") : it->second;
+  };
+  return fmt::format("format_version {}, commit {}, {} build, flags {}, {}, {}", r.format_version, meta("git_commit"),
+                     meta("build_type"), meta("build_flags"), meta("compiler"), meta("dependencies"));
 }
 
 void write_scans(H5::Group& root, const std::vector<scan_result>& scans) {

@@ -8,14 +8,19 @@
 
 namespace stepbench {
 
-// Reads /scan/<name> of a study file (name "" : the only scan in it); throws
-// std::runtime_error naming the file and what is wrong, std::invalid_argument for a
-// name it does not hold (listing those it does).
+// A file's scans (/scan), read as every study file is (store/study_reader.hpp: a damaged
+// file never reaches HDF5 in the calling process): the study holds its record and, as
+// its scans part's result, every scan; throws std::runtime_error, "cannot read study
+// file '<path>': <what is wrong>".
+study read_scan_file(const std::string& path);
+
+// Its scans alone; read_scan: /scan/<name> (name "" : the only scan in it), and
+// std::invalid_argument for a name the file does not hold (listing those it does).
+std::vector<scan_result> read_scans(const std::string& path);
 scan_result read_scan(const std::string& path, const std::string& name);
 
-// Every scan of a study file, and the build that wrote it (format_version, git_commit,
-// build_type, build_flags as one line), for `stepbench merge`; errors as read_scan's.
-std::vector<scan_result> read_scans(const std::string& path);
+// The build that wrote a study file (format_version, git_commit, build_type, build_flags,
+// compiler and dependencies as one line), for `stepbench merge`; errors as read_scan's.
 
 std::string file_build(const std::string& path);
 

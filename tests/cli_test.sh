@@ -200,7 +200,7 @@ rc=$?  # 3: with at most 8 substeps nothing holds 1 mm over the whole range
   bad "advise --scan at 1e-3 exited $rc: $(cat "$work/out")"
 grep -q '60 Hz  rk4  *diverges for k_s >= 5.62e+04 N/m' "$work/out" && ok || bad "advise --scan: $(cat "$work/out")"
 "$bin" advise --scan "$work/none.h5" --tol 1e-3 >/dev/null 2>"$work/err"
-[ $? -eq 1 ] && grep -q "cannot read the scan in '.*none.h5': no such file" "$work/err" && ok ||
+[ $? -eq 1 ] && grep -q "cannot read study file '.*none.h5': no such file" "$work/err" && ok ||
   bad "advise --scan of a missing file: $(cat "$work/err")"
 
 # scan --shard K/N and merge: three shards join to the unsharded scan's answer; a shard
@@ -278,7 +278,7 @@ cmp -s "$work/small.txt" "$work/smallwhole.txt" && ok ||
 # A file whose grid_points is not the product of its axes' counts is refused by name.
 cp "$work/whole.h5" "$work/badgrid.h5"
 /usr/bin/python3 -c 'import h5py,sys; f=h5py.File(sys.argv[1],"r+"); f["scan/stiff_spring"].attrs["grid_points"]=14' "$work/badgrid.h5"
-expect_error "cannot read the scan in '.*badgrid.h5': scan 'stiff_spring': grid_points 14 is not the product of its axes' counts, 13" \
+expect_error "cannot read study file '.*badgrid.h5': scan 'stiff_spring': grid_points 14 is not the product of its axes' counts, 13" \
   advise --scan "$work/badgrid.h5" --tol 1e-3
 
 # stepbench_bench, beside stepbench: --help lists our flags, one line each, above Google

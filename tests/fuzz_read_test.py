@@ -4,7 +4,7 @@ A small study (`stepbench sweep --quick`, one problem) is copied COPIES times wi
 fixed seed, each copy with 1 to 64 random bytes changed or (one in eight) cut short;
 every reading command (advise, compare both ways, ratios) reads each copy and must
 end by an exit status it documents, never by a signal, with at most one line on
-stderr. The report's readers (scripts/stepbench_report: study.load, and on a copy it
+stderr; so must `advise --scan` on as many damaged copies of a small scan file. The report's readers (scripts/stepbench_report: study.load, and on a copy it
 accepts scan.load and the range answers, as the report reads them) read every copy in
 one child process, which must end normally too, each refusal one line naming the copy.
 No run may hang: each has a timeout, past which it is a failure. The runs go two at a
@@ -25,7 +25,8 @@ SEED = 16
 PROBLEM = "damped_spring"
 # What each command may answer with: advise 3 is "no method meets the tolerance", which a
 # changed error column can make true.
-ALLOWED = {"advise": (0, 1, 2, 3), "compare": (0, 1, 2), "ratios": (0, 1, 2)}
+ALLOWED = {"advise": (0, 1, 2, 3), "compare": (0, 1, 2), "ratios": (0, 1, 2), "advise --scan": (0, 1, 2, 3)}
+SCAN = ["--problem", "stiff_spring", "--param", "stiff_spring.k_s=1e1:1e3:3:log", "--hz", "60", "--substeps", "1"]
 SCRIPTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scripts")
 
 # Runs at once: the commands of different copies and the report's reader. Each reads a
@@ -101,15 +102,20 @@ def main():
         base = os.path.join(work, "base.h5")
         subprocess.run([stepbench, "sweep", "--quick", "--quiet", "--problem", PROBLEM, "--out", base],
                        check=True, stdout=subprocess.DEVNULL)
+        scan_base = os.path.join(work, "scan.h5")
+        subprocess.run([stepbench, "scan", *SCAN, "--quiet", "--out", scan_base], check=True, stdout=subprocess.DEVNULL)
         with open(base, "rb") as f:
             data = f.read()
+        with open(scan_base, "rb") as f:
+            scan_data = f.read()
         rng = random.Random(SEED)
-        paths = []
+        paths, scan_paths = [], []
         for k in range(copies):
-            path = os.path.join(work, f"copy{k:03d}.h5")
-            with open(path, "wb") as f:
-                f.write(mutate(data, rng))
-            paths.append(path)
+            for name, original, into in (("copy", data, paths), ("scan", scan_data, scan_paths)):
+                path = os.path.join(work, f"{name}{k:03d}.h5")
+                with open(path, "wb") as f:
+                    f.write(mutate(original, rng))
+                into.append(path)
         # In the Sanitize build: HDF5 leaks what it decoded of a damaged object when it
         # refuses it; that is HDF5's to mend, and LeakSanitizer's report of it is not ours.
         suppressions = os.path.join(work, "lsan.supp")
@@ -119,7 +125,8 @@ def main():
         commands = [(name, args) for path in paths for name, args in (
             ("advise", ["advise", "--problem", PROBLEM, "--tol", "1e-6", "--study", path]),
             ("compare", ["compare", base, path]), ("compare", ["compare", path, base]),
-            ("ratios", ["ratios", "--study", path]))]
+            ("ratios", ["ratios", "--study", path]))] + \
+            [("advise --scan", ["advise", "--scan", path, "--tol", "1e-3"]) for path in scan_paths]
         report_timeout = REPORT_TIMEOUT_BASE + REPORT_TIMEOUT_PER_COPY * copies
         start = time.monotonic()
         with ThreadPoolExecutor(WORKERS) as pool:
@@ -139,10 +146,11 @@ def main():
             last = report.stdout.split()[-1:] or ["(before the first copy)"]
             failures.append(f"report reader: {outcome(report, report_timeout)} at {last[0]}: "
                             f"{report.stderr.strip().splitlines()[-1:]}")
-        print(f"{copies} damaged copies of a {len(data)}-byte study (seed {SEED}), read in "
+        print(f"{copies} damaged copies of a {len(data)}-byte study and of a {len(scan_data)}-byte scan file "
+              f"(seed {SEED}), read in "
               f"{time.monotonic() - start:.0f} s by {WORKERS} workers:")
         for (name, end), n in sorted(counts.items()):
-            print(f"  {name:8} {end}: {n}")
+            print(f"  {name:13} {end}: {n}")
         print(f"  report reader: {outcome(report, report_timeout)}")
     for f in failures:
         print("FAIL:", f)

@@ -3,7 +3,6 @@
 // help (own_flags_help, printed by --help above Google Benchmark's) is the list below.
 // Quick and full mode supply defaults for --benchmark_min_time and
 // --benchmark_repetitions unless those are given.
-#include <map>
 #include <string>
 #include <vector>
 

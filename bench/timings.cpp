@@ -1,7 +1,5 @@
 #include "bench/timings.hpp"
 
-#include <fmt/format.h>
-
 #include <sstream>
 
 namespace stepbench::bench {

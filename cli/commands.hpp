@@ -6,8 +6,6 @@
 #include <cmath>
 #include <functional>
 #include <nlohmann/json.hpp>
-#include <stdexcept>
-#include <string>
 
 namespace stepbench {
 struct scan_answer;  // study/scan.hpp

@@ -10,8 +10,6 @@
 // beyond that (a Jacobian, symplecticity, reuse of the last force) is declared in its
 // `capabilities`, which the registry and the study file report.
 #include <Eigen/Core>
-#include <array>
-#include <cmath>
 #include <concepts>
 #include <string>
 #include <string_view>

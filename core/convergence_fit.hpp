@@ -41,14 +41,8 @@ struct fit_result {
 };
 
 inline const char* to_string(fit_result::status s) {
-  switch (s) {
-    case fit_result::status::fitted:
-      return "fitted";
-    case fit_result::status::exact:
-      return "exact";
-    default:
-      return "insufficient";
-  }
+  constexpr const char* names[] = {"fitted", "exact", "insufficient"};
+  return names[static_cast<int>(s)];
 }
 
 // Worst-case round-off bound for n steps on a motion of size `scale`: 8 eps n scale.

@@ -55,16 +55,8 @@ inline constexpr std::array<loop_design, 4> all_loop_designs{loop_design::variab
                                                              loop_design::interpolated, loop_design::substeps};
 
 inline std::string_view to_string(loop_design d) {
-  switch (d) {
-    case loop_design::variable:
-      return "variable";
-    case loop_design::fixed:
-      return "fixed";
-    case loop_design::interpolated:
-      return "interpolated";
-    default:
-      return "substeps";
-  }
+  constexpr std::string_view names[] = {"variable", "fixed", "interpolated", "substeps"};
+  return names[static_cast<int>(d)];
 }
 
 // The designs that step a fixed dt from an accumulator.
@@ -392,14 +384,8 @@ loop_result simulate_loop(const P& problem, const I& method, const loop_config& 
 // game second > 1); `load` is that ratio over the run.
 enum class loop_outcome { keeps_up, slow_motion, spiral };
 inline std::string_view to_string(loop_outcome o) {
-  switch (o) {
-    case loop_outcome::keeps_up:
-      return "keeps_up";
-    case loop_outcome::slow_motion:
-      return "slow_motion";
-    default:
-      return "spiral";
-  }
+  constexpr std::string_view names[] = {"keeps_up", "slow_motion", "spiral"};
+  return names[static_cast<int>(o)];
 }
 
 struct loop_schedule {

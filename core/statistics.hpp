@@ -2,7 +2,6 @@
 // Small statistics used in more than one place (the order fit, the benchmark's
 // repetitions, the compare gate): one definition each.
 #include <algorithm>
-#include <cmath>
 #include <limits>
 #include <vector>
 

@@ -18,7 +18,6 @@
 //    three extra stages cost three evaluations, paid only in a step that holds a sample
 //    time (computed at the first interpolation inside the step, not at every step as
 //    dop853.f does when dense output is requested).
-#include <algorithm>
 #include <array>
 #include <cmath>
 

@@ -7,7 +7,6 @@
 //   F_i = F(t + c_i h, X_i, V_i).
 // Not a method itself: rk45 uses it, and tests check that the hand-scheduled steps of
 // midpoint and rk4 equal the generic step on their tableaux to rounding.
-#include <Eigen/Core>
 #include <array>
 
 #include "core/concepts.hpp"

@@ -7,7 +7,6 @@
 //  - the first step is Hairer's starting-step algorithm (HNW I, sec. II.4, "Starting
 //    step size"), two force evaluations;
 //  - the next step from step_controller below (dopri5.f's and dop853.f's).
-#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 

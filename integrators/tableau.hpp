@@ -18,12 +18,8 @@ struct explicit_tableau {
   std::array<double, S> b{};
   std::array<double, S> c{};
   int order = 0;
-  std::array<double, S> b_hat{};  // meaningful when has_embedded
+  std::array<double, S> b_hat{};  // an embedded pair's second weights (embedded_order > 0)
   int embedded_order = 0;
-  bool has_embedded = false;
-  // First same as last: the last stage is f(t + h, y_1) (a_{S,j} = b_j, c_S = 1), so it
-  // is the next step's first stage and a step costs S - 1 evaluations after the first.
-  bool fsal = false;
 };
 
 // The leading S stages of a T-stage tableau: a method stored together with the extra
@@ -41,8 +37,6 @@ constexpr explicit_tableau<S> leading_stages(const explicit_tableau<T>& t) {
   }
   r.order = t.order;
   r.embedded_order = t.embedded_order;
-  r.has_embedded = t.has_embedded;
-  r.fsal = false;
   return r;
 }
 

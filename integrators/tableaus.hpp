@@ -57,8 +57,6 @@ inline constexpr explicit_tableau<7> dopri5_tableau = {
     .order = 5,
     .b_hat = {5179.0 / 57600.0, 0.0, 7571.0 / 16695.0, 393.0 / 640.0, -92097.0 / 339200.0, 187.0 / 2100.0, 1.0 / 40.0},
     .embedded_order = 4,
-    .has_embedded = true,
-    .fsal = true,
 };
 
 // Dense output of DOPRI5: the quartic continuous extension of Shampine, Some practical
@@ -236,7 +234,6 @@ inline constexpr explicit_tableau<16> dop853_extended = [] {
   t.order = 8;
   for (int j = 0; j < 12; ++j) t.b_hat[j] = t.b[j] - dop853_e5[j];
   t.embedded_order = 5;
-  t.has_embedded = true;
   return t;
 }();
 
@@ -395,8 +392,5 @@ inline constexpr verlet_composition<15> kahan_li8 = [] {
 }();
 
 inline constexpr auto triple_jump4_kick_drift = kick_drift(triple_jump4);
-inline constexpr auto yoshida6a_kick_drift = kick_drift(yoshida6a);
-inline constexpr auto yoshida8d_kick_drift = kick_drift(yoshida8d);
-inline constexpr auto kahan_li8_kick_drift = kick_drift(kahan_li8);
 
 }  // namespace stepbench

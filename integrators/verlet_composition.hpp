@@ -19,7 +19,6 @@
 // up to 4) by O(h^5) a step, and keeps order 4 (not beyond: an order-8 set would need
 // more accurate kicks). 4 (N + 1) evaluations a step; no longer symplectic (nothing with
 // a damper is).
-#include <array>
 
 #include "core/concepts.hpp"
 #include "integrators/tableau.hpp"

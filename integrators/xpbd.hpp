@@ -22,7 +22,6 @@
 // paper argues against: one step of h with 10 iterations accumulating lambda, the same
 // counted work as `xpbd` at h / 10 (at h = one frame: one step a frame). A pass over the constraints visits each spring
 // once, as a force evaluation does: it is counted as one force evaluation (the external acceleration is a constant).
-#include <cmath>
 #include <string>
 
 #include "core/constraints.hpp"

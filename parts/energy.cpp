@@ -5,8 +5,6 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include <algorithm>
-
 #include "core/contains.hpp"
 #include "parts/part.hpp"
 #include "run/sweep.hpp"

@@ -6,7 +6,6 @@
 #include <fmt/ranges.h>
 
 #include "parts/part.hpp"
-#include "run/sweep.hpp"
 #include "store/loop.hpp"
 
 namespace stepbench {

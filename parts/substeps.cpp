@@ -6,7 +6,6 @@
 #include <fmt/ranges.h>
 
 #include "parts/part.hpp"
-#include "run/sweep.hpp"
 #include "store/substeps.hpp"
 
 namespace stepbench {

@@ -4,7 +4,6 @@
 #include "judge/verdict.hpp"
 
 #include "parts/part.hpp"
-#include "run/sweep.hpp"
 #include "store/verdict.hpp"
 
 namespace stepbench {

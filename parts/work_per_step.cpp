@@ -6,7 +6,6 @@
 // It is also the example of the shape docs/architecture.md walks through ("Adding an
 // analysis"): the result, its table, its run and write, in this one file, and its line
 // in parts/registry.cpp. It measures nothing new: it reads the sweep's rows.
-#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>

@@ -8,7 +8,6 @@
 // adds its newest term last, and for a position-only acceleration (the pendulum) the
 // stage positions come from the accelerations directly (the Nystrom form,
 // integrators/unrolled_rk.hpp), so that consecutive stages overlap.
-#include <cmath>
 
 #include "core/method.hpp"
 #include "integrators/tableaus.hpp"

@@ -9,10 +9,8 @@
 #include <gsl/gsl_odeiv2.h>
 
 #include <memory>
-#include <span>
 #include <stdexcept>
 #include <string>
-#include <vector>
 
 #include "core/first_order.hpp"
 #include "core/method.hpp"

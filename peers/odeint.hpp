@@ -6,10 +6,7 @@
 // needs the state size at compile time here, so these peers apply to problems with a
 // fixed-size state. The state helpers below serve the adaptive Odeint peers too
 // (peers/odeint_high_order.hpp).
-#include <algorithm>
 #include <array>
-#include <cmath>
-#include <span>
 #include <utility>
 
 #include "core/first_order.hpp"

@@ -8,13 +8,8 @@
 // (runge_kutta_fehlberg78 at our dt, `odeint_rkf78`, is in peers/odeint.hpp with the
 // other fixed-step Odeint peers.)
 // Their loop is integrate_times' (adaptive_peer, core/step_adapter.hpp).
-#include <algorithm>
 #include <array>
-#include <cmath>
 #include <limits>
-#include <span>
-#include <string>
-#include <vector>
 
 #include "core/first_order.hpp"
 #include "core/method.hpp"

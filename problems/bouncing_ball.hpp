@@ -18,7 +18,6 @@
 // motion is a parabola, which every method of order >= 2 integrates exactly: what the
 // study measures on this problem is the contact handling.
 #include <Eigen/Core>
-#include <cmath>
 
 #include "core/concepts.hpp"
 #include "problems/exact/bouncing_ball.hpp"

@@ -65,8 +65,6 @@ struct spring_damper {
 
   double gamma() const { return k_d / (2.0 * mass_kg); }
   double omega0_sq() const { return k_s / mass_kg; }
-  // Damping ratio zeta = k_d / (2 sqrt(k_s m)): < 1 under-, = 1 critically, > 1 over-damped.
-  double damping_ratio() const { return k_d / (2.0 * std::sqrt(k_s * mass_kg)); }
 
   phase<vec> exact(double t) const {
     const double g = gamma(), w0 = std::sqrt(omega0_sq());

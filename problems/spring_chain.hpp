@@ -20,7 +20,6 @@
 // so dF/dx and dF/dv have 5 sub- and 5 super-diagonals and the implicit methods solve in
 // O(n) (core/band_matrix.hpp), not through a dense O(n^3) solve.
 #include <Eigen/Core>
-#include <cmath>
 
 #include "core/band_matrix.hpp"
 #include "core/concepts.hpp"

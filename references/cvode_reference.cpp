@@ -157,7 +157,6 @@ class cvode_session {
     st_.sys = &sys;
   }
   const char* source() const { return source_; }
-  long rhs_calls() const { return st_.calls; }
 
   void create(reference_tolerances tol) {
     st_.interleaved = banded();

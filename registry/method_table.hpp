@@ -4,13 +4,11 @@
 // The slots are filled in the unit CMake generates for each problem from
 // registry/problem_unit.cpp.in, from the method groups that run on it (integrators/group_*.hpp,
 // peers/group_*.hpp); problem_model<P> (registry/problem_model.hpp) reads the table.
-#include <fmt/format.h>
 
 #include <exception>
 #include <functional>
 #include <span>
 #include <stdexcept>
-#include <string_view>
 #include <vector>
 
 #include "core/drive.hpp"

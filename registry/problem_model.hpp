@@ -6,8 +6,6 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
-#include <cmath>
-#include <cstddef>
 #include <limits>
 #include <memory>
 #include <stdexcept>

@@ -3,8 +3,6 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "judge/scan.hpp"
-
 namespace stepbench {
 
 std::string format_scan_answer(const scan_answer& a) {

@@ -6,7 +6,6 @@
 
 #include "core/contains.hpp"
 #include "core/measure.hpp"
-#include "run/sweep.hpp"
 
 namespace stepbench {
 

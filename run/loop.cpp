@@ -3,17 +3,13 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <stdexcept>
 
 #include "core/contains.hpp"
 #include "core/number.hpp"
-#include "core/statistics.hpp"
-#include "run/sweep.hpp"
 
 namespace stepbench {
 namespace {

@@ -5,8 +5,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdint>
-#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>

@@ -1,10 +1,8 @@
 #include "run/substeps.hpp"
 
-#include <cmath>
 #include <limits>
 
 #include "core/number.hpp"
-#include "registry/registry.hpp"
 
 namespace stepbench {
 namespace {

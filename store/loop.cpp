@@ -1,7 +1,5 @@
 #include "store/loop.hpp"
 
-#include <fmt/format.h>
-
 #include <cmath>
 
 #include "core/number.hpp"

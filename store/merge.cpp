@@ -9,13 +9,10 @@
 #include <set>
 #include <stdexcept>
 
-#include "judge/verdict.hpp"
 #include "run/machine.hpp"
 #include "store/h5.hpp"
 #include "store/schema.hpp"
 #include "store/study_file.hpp"
-#include "store/verdict.hpp"
-#include "study/verdict.hpp"
 
 namespace stepbench {
 namespace {

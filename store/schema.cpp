@@ -234,17 +234,8 @@ constexpr table all_tables[] = {
 }  // namespace
 
 std::string_view to_string(field_type t) {
-  switch (t) {
-    case f64:
-      return "f64";
-    case i64:
-      return "i64";
-    case i8:
-      return "i8";
-    case str:
-      return "str";
-  }
-  return "?";
+  constexpr std::string_view names[] = {"f64", "i64", "i8", "str"};
+  return names[static_cast<int>(t)];
 }
 
 std::span<const table> tables() { return all_tables; }

@@ -3,10 +3,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include <filesystem>
-
 #include "core/number.hpp"
-#include "judge/substeps.hpp"
 #include "judge/verdict.hpp"
 #include "store/columns.hpp"
 #include "store/study_file.hpp"

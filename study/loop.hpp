@@ -22,7 +22,6 @@
 //                    problem, in a timed study) or stated (`stated_step_cost_ns`)
 #include <cstdint>
 #include <string>
-#include <string_view>
 #include <vector>
 
 #include "core/game_loop.hpp"

@@ -5,7 +5,6 @@
 // judge/, store/ and render/.
 #include <cmath>
 #include <functional>
-#include <limits>
 #include <map>
 #include <memory>
 #include <optional>

@@ -72,7 +72,7 @@ interrupt_throughout() {
 echo "previous results" >"$work/study.h5"
 complete=("$stepbench" compare "$work/study.h5" "$work/study.h5")  # exit 0: a whole study file
 # (the snapshot says study.h5 changed; the names say nothing else did)
-interrupt_throughout "$work/scratch.h5" "$work/study.h5" "$stepbench" sweep --quick --parts sweep --quiet --problem pendulum --problem spring_chain --out __TARGET__
+interrupt_throughout "$work/scratch.h5" "$work/study.h5" "$stepbench" sweep --quick --parts sweep --quiet --problem pendulum --out __TARGET__
 interrupt_throughout "$work/scratch.h5" "$work/study.h5" "$bench" --quick --parts=sweep --problem=pendulum --benchmark_filter=pendulum --study_out=__TARGET__
 rm -f "$work/scratch.h5"
 # Unless a run finished before its signal, or was signalled after its rename (and rightly
@@ -80,7 +80,7 @@ rm -f "$work/scratch.h5"
 [ "$finished" -gt 0 ] || [ "$replaced" -gt 0 ] || { [ "$(cat "$work/study.h5")" = "previous results" ] && ok || bad "the previous study file was touched"; }
 
 # The report: a previous report folder survives an interrupted run whole.
-"$stepbench" sweep --quick --parts sweep,verdict --quiet --problem pendulum --problem damped_spring --out "$work/good.h5" 2>/dev/null || bad "quick sweep for the report failed"
+"$stepbench" sweep --quick --parts sweep,verdict --quiet --problem pendulum --out "$work/good.h5" 2>/dev/null || bad "quick sweep for the report failed"
 /usr/bin/python3 "$report" "$work/good.h5" --out "$work/report" >/dev/null 2>&1 || bad "report failed"
 # The report says so itself when the signal came after its swap (a whole new folder).
 complete=(grep -q "after the new report was in place" "$work/err")

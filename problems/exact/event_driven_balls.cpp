@@ -53,22 +53,6 @@ ball_scene default_ball_scene(int n, std::uint64_t seed) {
   return s;
 }
 
-const char* to_string(contact_kind k) {
-  switch (k) {
-    case contact_kind::left_wall:
-      return "left_wall";
-    case contact_kind::right_wall:
-      return "right_wall";
-    case contact_kind::floor:
-      return "floor";
-    case contact_kind::ceiling:
-      return "ceiling";
-    case contact_kind::ball:
-      return "ball";
-  }
-  return "?";
-}
-
 inelastic_collapse::inelastic_collapse(double t, int a, int b, const std::string& why)
     : std::runtime_error("event_driven_balls: inelastic collapse at t = " + std::to_string(t) + ": " + why +
                          "; no event-driven truth beyond"),

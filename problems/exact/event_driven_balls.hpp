@@ -169,8 +169,6 @@ ball_scene default_ball_scene(int n = 16, std::uint64_t seed = 1);
 
 enum class contact_kind { left_wall, right_wall, floor, ceiling, ball };
 
-const char* to_string(contact_kind k);
-
 struct contact_event {
   double time;
   contact_kind kind;

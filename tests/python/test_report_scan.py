@@ -207,9 +207,9 @@ def grafted(study, out, files):
 
 
 @pytest.fixture(scope="module")
-def gaps_report(plain_study, scan_files, tmp_path_factory):
+def gaps_report(small_study, scan_files, tmp_path_factory):
     d = tmp_path_factory.mktemp("gaps_report")
-    study = grafted(plain_study, d / "study.h5", {n: scan_files / f for n, f in GRAFTED.items()})
+    study = grafted(small_study, d / "study.h5", {n: scan_files / f for n, f in GRAFTED.items()})
     p = subprocess.run([PYTHON, REPORT, str(study), "--out", str(d / "report"), "--jobs", "2"], capture_output=True,
                        text=True, timeout=180)
     assert p.returncode == 0, p.stderr

@@ -89,10 +89,10 @@ int run_merge(const merge_args& a) {
         throw std::invalid_argument(fmt::format("merge: '{}' is named twice (overlapping shards)", a.bench[i]));
   // One build: shards of different builds, formats or flags are not one study.
   const std::string build = file_build(a.inputs.front());
-  for (const auto& path : a.inputs)
-    if (const std::string b = file_build(path); b != build)
-      throw std::invalid_argument(fmt::format("merge: '{}' was written by another build ({}) than '{}' ({})", path, b,
-                                              a.inputs.front(), build));
+  for (std::size_t i = 1; i < a.inputs.size(); ++i)
+    if (const std::string b = file_build(a.inputs[i]); b != build)
+      throw std::invalid_argument(fmt::format("merge: '{}' was written by another build ({}) than '{}' ({})",
+                                              a.inputs[i], b, a.inputs.front(), build));
   // Study shards (written by a sweep) or scan shards, not both.
   std::vector<bool> study_shard;
   for (const auto& path : a.inputs) study_shard.push_back(is_study_file(path));

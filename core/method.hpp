@@ -18,7 +18,7 @@ enum class method_origin { ours, peer, baseline };
 // What its parameter is: a timestep (a dt ladder) or a tolerance (a tolerance ladder).
 enum class method_kind { fixed_step, adaptive };
 
-// The names the study file stores, indexed by the enumerators (as every to_string here).
+// The names the study file stores, indexed by the enumerators.
 inline std::string_view to_string(method_origin o) {
   constexpr std::string_view names[] = {"ours", "peer", "baseline"};
   return names[static_cast<int>(o)];

@@ -4,7 +4,7 @@
 // integrators/tableaus.hpp): for i = 0..N-1
 //   v += kick[i] h F(x) / m,   x += drift[i] h v,   then   v += kick[N] h F(x) / m.
 // The method is the data: forest_ruth is this stepper over triple_jump4_kick_drift, and
-// an eighth-order one would be the same over kahan_li8_kick_drift.
+// a higher-order one would be the same over kick_drift of its composition (tableaus.hpp).
 //
 // Position-only force: N force evaluations a step. Adjacent kicks of two sub-steps act
 // at the same x and are merged in the sequence; the last kick's force, at the step's new

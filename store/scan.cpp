@@ -3,8 +3,6 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include <filesystem>
-
 #include "core/number.hpp"
 #include "store/columns.hpp"
 #include "store/study_reader.hpp"
@@ -189,7 +187,9 @@ std::string file_build(const std::string& path) {
   const study_record& r = *file.record;
   const auto meta = [&](const char* key) {
     const auto it = r.meta.find(key);
-    return it == r.meta.end() ? std::string("-") : it->second;
+    if (it == r.meta.end())
+      throw std::runtime_error(fmt::format("cannot read study file '{}': no root attribute '{}'", path, key));
+    return it->second;
   };
   return fmt::format("format_version {}, commit {}, {} build, flags {}, {}, {}", r.format_version, meta("git_commit"),
                      meta("build_type"), meta("build_flags"), meta("compiler"), meta("dependencies"));

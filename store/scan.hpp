@@ -5,6 +5,7 @@
 
 #include "store/h5.hpp"
 #include "study/scan.hpp"
+#include "study/study.hpp"
 
 namespace stepbench {
 
@@ -20,8 +21,8 @@ std::vector<scan_result> read_scans(const std::string& path);
 scan_result read_scan(const std::string& path, const std::string& name);
 
 // The build that wrote a study file (format_version, git_commit, build_type, build_flags,
-// compiler and dependencies as one line), for `stepbench merge`; errors as read_scan's.
-
+// compiler and dependencies as one line), for `stepbench merge`'s check that its shards
+// are of one build; errors as read_scan's, and a missing attribute is one.
 std::string file_build(const std::string& path);
 
 // /scan/<name> of each scan (docs/study-format.md).

@@ -268,7 +268,6 @@ void write_problems(H5::Group& root, const study& s) {
 }
 
 void read_problems(const H5::Group& root, study& s) {
-  if (!h5::is_group(root, "problems")) throw std::runtime_error("missing group 'problems'");
   const H5::Group problems = root.openGroup("problems");
   for (const auto& name : h5::children(problems)) s.problems.push_back(read_problem(problems.openGroup(name), name));
 }

@@ -54,6 +54,8 @@ study read_image(const std::string& path, std::vector<char>& bytes, const study_
   rec.meta = h5::string_attrs(file);
   rec.settings = h5::number_attrs(file, false);
   if (h5::long_attr(file, "timing") != 0) out.timed.emplace();
+  // Every study file has it, a scan file's empty (parts read their groups where present).
+  if (!h5::is_group(file, "problems")) throw std::runtime_error("missing group 'problems'");
   read_parts(file, out);
   return out;
 }

@@ -10,7 +10,7 @@ const study& default_study() {
     o.parts = {"sweep", "verdict"};
 #ifdef __SANITIZE_ADDRESS__
     // Under the sanitizers (CI's second stage) the fixed-step ladders stop at 16 levels,
-    // not 20: the same code runs, the extension past `levels` included, in a third of the
+    // not 20: the same code runs, the extension past `levels` included, in half the
     // time (levels 17 to 20 are the first-order methods' millions of steps; 550 s of the
     // stage's CPU time at 20). What needs the last levels is checked in the Release stage.
     o.max_levels = 16;

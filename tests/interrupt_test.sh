@@ -72,7 +72,7 @@ interrupt_throughout() {
 echo "previous results" >"$work/study.h5"
 complete=("$stepbench" compare "$work/study.h5" "$work/study.h5")  # exit 0: a whole study file
 # (the snapshot says study.h5 changed; the names say nothing else did)
-interrupt_throughout "$work/scratch.h5" "$work/study.h5" "$stepbench" sweep --quick --parts sweep --quiet --problem pendulum --out __TARGET__
+interrupt_throughout "$work/scratch.h5" "$work/study.h5" "$stepbench" sweep --quick --parts sweep --quiet --problem pendulum --problem damped_spring --out __TARGET__
 interrupt_throughout "$work/scratch.h5" "$work/study.h5" "$bench" --quick --parts=sweep --problem=pendulum --benchmark_filter=pendulum --study_out=__TARGET__
 rm -f "$work/scratch.h5"
 # Unless a run finished before its signal, or was signalled after its rename (and rightly

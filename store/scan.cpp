@@ -153,7 +153,7 @@ scan_result read_scan_group(const H5::Group& all, const std::string& which) {
 
 }  // namespace
 
-study read_scan_file(const std::string& path) {
+std::vector<scan_result> read_scans(const std::string& path) {
   study file = std::move(read_studies({path}, [](const H5::Group& root, study& s) {
                            if (!h5::is_group(root, "scan"))
                              throw std::runtime_error("it holds no scan (/scan is absent)");
@@ -161,12 +161,9 @@ study read_scan_file(const std::string& path) {
                            auto& scans = s.results.put(std::vector<scan_result>{});
                            for (const auto& name : h5::children(all)) scans.push_back(read_scan_group(all, name));
                          }).front());
-  for (auto& sc : *file.results.find<std::vector<scan_result>>()) sc.source = path;
-  return file;
-}
-
-std::vector<scan_result> read_scans(const std::string& path) {
-  return std::move(*read_scan_file(path).results.find<std::vector<scan_result>>());
+  std::vector<scan_result> scans = std::move(*file.results.find<std::vector<scan_result>>());
+  for (auto& sc : scans) sc.source = path;
+  return scans;
 }
 
 scan_result read_scan(const std::string& path, const std::string& name) {

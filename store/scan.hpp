@@ -5,18 +5,14 @@
 
 #include "store/h5.hpp"
 #include "study/scan.hpp"
-#include "study/study.hpp"
 
 namespace stepbench {
 
-// A file's scans (/scan), read as every study file is (store/study_reader.hpp: a damaged
-// file never reaches HDF5 in the calling process): the study holds its record and, as
-// its scans part's result, every scan; throws std::runtime_error, "cannot read study
-// file '<path>': <what is wrong>".
-study read_scan_file(const std::string& path);
-
-// Its scans alone; read_scan: /scan/<name> (name "" : the only scan in it), and
-// std::invalid_argument for a name the file does not hold (listing those it does).
+// Every scan of a file (/scan), read as every study file is (store/study_reader.hpp: a
+// damaged file never reaches HDF5 in the calling process); throws std::runtime_error,
+// "cannot read study file '<path>': <what is wrong>". read_scan: /scan/<name> (name "" :
+// the only scan in it), and std::invalid_argument for a name the file does not hold
+// (listing those it does).
 std::vector<scan_result> read_scans(const std::string& path);
 scan_result read_scan(const std::string& path, const std::string& name);
 

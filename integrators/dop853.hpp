@@ -6,11 +6,8 @@
 // tests/test_tableaus.cpp; the stages are integrators/unrolled_rk.hpp's.
 //  - Step: 12 stages; on acceptance f(t + h, y_1) is evaluated, the next step's first
 //    stage (12 evaluations a step, as dop853.f).
-//  - Error (dop853.f after label 35): with the components of [x; v] scaled by
-//    sc = tol + tol max(|y0|, |y1|), E5 = ||sum e5_i k_i / sc||^2, E3 the same with
-//    e3 = b - b_hat3, over n = 2 dim components,
-//      err = |h| E5 / sqrt(n (E5 + 0.01 E3)),
-//    which is O(h^8). The step-size control is dop853.f's with its defaults
+//  - Error: dop853.f's, O(h^8) (tableaus.hpp above dop853_err3_weight; error() below).
+//    The step-size control is dop853.f's with its defaults
 //    (integrators/step_control.hpp: no PI term, beta = 0): h_new = h / clamp(err^(1/8) /
 //    0.9, 1/6, 1/0.333), after a rejection h / min(1/0.333, err^(1/8) / 0.9), and no
 //    growth right after a rejection.
@@ -28,20 +25,12 @@
 
 namespace stepbench {
 
-namespace dop853_detail {
-// The error weights over the 16 stages of dop853_extended (zero beyond stage 12).
-inline constexpr std::array<double, 16> e5 = [] {
-  std::array<double, 16> e{};
-  for (int i = 0; i < 12; ++i) e[i] = dop853_e5[i];
-  return e;
-}();
-inline constexpr std::array<double, 16> e3 = [] {
+// e3 = b - b_hat3 over the 16 stages of dop853_extended (zero beyond stage 12).
+inline constexpr std::array<double, 16> dop853_e3 = [] {
   std::array<double, 16> e{};
   for (int i = 0; i < 12; ++i) e[i] = dop853_extended.b[i] - dop853_b_hat3[i];
   return e;
 }();
-inline constexpr std::array<double, 16> b = dop853_extended.b;
-}  // namespace dop853_detail
 
 struct dop853 {
   static constexpr std::string_view name = "dop853";
@@ -74,17 +63,16 @@ struct dop853 {
     }
 
     double initial_dt(const Sys& sys, double t, step_state<Vec>& s, double horizon) {
-      const Vec& f0 = current_force(sys, t, s);
-      return starting_step(sys, t, s.x, s.v, f0, order, tol, horizon, x1, v1, ex5);
+      return starting_step(sys, t, s, order, tol, horizon, x1, v1, ex5);
     }
 
     step_attempt try_step(const Sys& sys, double t, step_state<Vec>& s, double h) {
       const double h_im = h * inverse_mass(sys);
       k.F[0] = current_force(sys, t, s);
       k.template compute<1, 12>(sys, t, s.x, s.v, h, h_im);
-      k.template combine<dop853_detail::b>(x1, v1, s.x, s.v, h, h_im);
-      k.template difference<dop853_detail::e5>(ex5, ev5, s.v, h, h_im);
-      k.template difference<dop853_detail::e3>(ex3, ev3, s.v, h, h_im);
+      k.template combine<dop853_extended.b>(x1, v1, s.x, s.v, h, h_im);
+      k.template difference<dop853_e5>(ex5, ev5, s.v, h, h_im);
+      k.template difference<dop853_e3>(ex3, ev3, s.v, h, h_im);
       return control.attempt(h, error(s), [&] {
         x0 = s.x;
         v0 = s.v;
@@ -101,7 +89,10 @@ struct dop853 {
       });
     }
 
-    // dop853.f's err: |h| E5 / sqrt(n (E5 + 0.01 E3)); ex, ev include the factor h.
+    // dop853.f's err (after label 35): with the components of [x; v] scaled by
+    // sc = tol + tol max(|y0|, |y1|), E5 = ||sum e5_i k_i / sc||^2, E3 the same with
+    // e3 = b - b_hat3, over n = 2 dim components, err = |h| E5 / sqrt(n (E5 + 0.01 E3));
+    // ex, ev include the factor h.
     double error(const step_state<Vec>& s) {
       // One division per component: the reciprocal scales, then products.
       rx = (tol + tol * s.x.cwiseAbs().cwiseMax(x1.cwiseAbs()).array()).inverse().matrix();

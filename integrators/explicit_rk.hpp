@@ -60,11 +60,7 @@ struct rk_stages {
   void weighted(const std::array<double, S>& w, double h, double h_im, Vec& x, Vec& v) const {
     x.setZero();
     v.setZero();
-    for (int i = 0; i < S; ++i) {
-      if (w[i] == 0.0) continue;
-      x += (h * w[i]) * V[i];
-      v += (h_im * w[i]) * F[i];
-    }
+    combine(w, h, h_im, x, v, x, v);
   }
 };
 

@@ -76,17 +76,29 @@ constexpr double sum(const std::array<double, S>& w) {
   return s;
 }
 
-// dst = base + sum_k (scale w_k) terms[j_k], in increasing j (the newest term last).
+// dst = base + sum_k (scale w_k) terms[j_k], in increasing j (the newest term last); with
+// no_base, the sum alone (at least one term).
 // (Function templates rather than lambdas: GCC's flatten does not always inline a
 // generic lambda's call operator.)
 // A state of fixed size is summed coefficient by coefficient on plain doubles: the same
 // operations in the same order as Eigen's expression (so the same roundings), but a
 // sum of a dozen terms as one Eigen expression is a tree of a dozen nodes, which GCC
 // keeps on the stack instead of in registers (rk8 on one coordinate: a quarter slower).
+struct no_base {};
 template <const auto& R, class Dst, class Base, class Terms, std::size_t... K>
-[[gnu::always_inline]] inline void assign_sum(Dst& dst, const Base& base, [[maybe_unused]] double scale,
-                                              [[maybe_unused]] const Terms& terms, std::index_sequence<K...>) {
-  if constexpr (Dst::SizeAtCompileTime != Eigen::Dynamic) {
+[[gnu::always_inline]] inline void assign_sum(Dst& dst, [[maybe_unused]] const Base& base,
+                                              [[maybe_unused]] double scale, [[maybe_unused]] const Terms& terms,
+                                              std::index_sequence<K...>) {
+  constexpr bool fixed = Dst::SizeAtCompileTime != Eigen::Dynamic;
+  if constexpr (std::is_same_v<Base, no_base>) {
+    static_assert(R.n > 0);
+    if constexpr (fixed) {
+      for (Eigen::Index i = 0; i < Dst::SizeAtCompileTime; ++i)
+        dst.coeffRef(i) = (... + ((scale * R.w[K]) * terms[R.j[K]].coeff(i)));
+    } else {
+      dst = (... + ((scale * R.w[K]) * terms[R.j[K]]));
+    }
+  } else if constexpr (fixed) {
     for (Eigen::Index i = 0; i < Dst::SizeAtCompileTime; ++i)
       dst.coeffRef(i) = (base.coeff(i) + ... + ((scale * R.w[K]) * terms[R.j[K]].coeff(i)));
   } else {
@@ -96,22 +108,6 @@ template <const auto& R, class Dst, class Base, class Terms, std::size_t... K>
 template <const auto& R, class Dst, class Base, class Terms>
 [[gnu::always_inline]] inline void assign_sum(Dst& dst, const Base& base, double scale, const Terms& terms) {
   assign_sum<R>(dst, base, scale, terms, std::make_index_sequence<static_cast<std::size_t>(R.n)>{});
-}
-
-// dst = sum_k (scale w_k) terms[j_k] (at least one term).
-template <const auto& R, class Dst, class Terms, std::size_t... K>
-[[gnu::always_inline]] inline void assign_sum(Dst& dst, double scale, const Terms& terms, std::index_sequence<K...>) {
-  if constexpr (Dst::SizeAtCompileTime != Eigen::Dynamic) {
-    for (Eigen::Index i = 0; i < Dst::SizeAtCompileTime; ++i)
-      dst.coeffRef(i) = (... + ((scale * R.w[K]) * terms[R.j[K]].coeff(i)));
-  } else {
-    dst = (... + ((scale * R.w[K]) * terms[R.j[K]]));
-  }
-}
-template <const auto& R, class Dst, class Terms>
-[[gnu::always_inline]] inline void assign_sum(Dst& dst, double scale, const Terms& terms) {
-  static_assert(R.n > 0);
-  assign_sum<R>(dst, scale, terms, std::make_index_sequence<static_cast<std::size_t>(R.n)>{});
 }
 
 }  // namespace rk_detail
@@ -158,10 +154,9 @@ struct unrolled_rk {
     size_like(like, X);
   }
 
-  // Stages First..Last-1 from (x0, v0) at t with step h (h_im = h / m). F[0] must be
-  // set; from First = 1 the velocity form sets V[0] = v0, otherwise every stage before
-  // First must be complete (forces, and velocities in the velocity form). Nystrom selects the form (default: by the
-  // force).
+  // Stages First..Last-1 from (x0, v0) at t with step h (h_im = h / m). F[0] must be set;
+  // from First = 1 the velocity form sets V[0] = v0, otherwise every stage before First
+  // must be complete. Nystrom selects the form (default: by the force).
   template <int First, int Last, bool Nystrom = nystrom>
   [[gnu::always_inline]] inline void compute(const Sys& sys, double t, const Vec& x0, const Vec& v0, double h,
                                              double h_im) {
@@ -209,13 +204,13 @@ struct unrolled_rk {
     using w = rk_weights<T, W>;
     if constexpr (nystrom) {
       if constexpr (w::total == 0.0)
-        rk_detail::assign_sum<w::wa_row>(x, h * h_im, F);
+        rk_detail::assign_sum<w::wa_row>(x, rk_detail::no_base{}, h * h_im, F);
       else  // the weights sum to zero only up to their rounding
         rk_detail::assign_sum<w::wa_row>(x, (w::total * h) * v0, h * h_im, F);
     } else {
-      rk_detail::assign_sum<w::row>(x, h, V);
+      rk_detail::assign_sum<w::row>(x, rk_detail::no_base{}, h, V);
     }
-    rk_detail::assign_sum<w::row>(v, h_im, F);
+    rk_detail::assign_sum<w::row>(v, rk_detail::no_base{}, h_im, F);
   }
 
   // V_i = v0 + (h/m) sum_j a_ij F_j for stages First..Last-1 (the stage velocities the

@@ -43,9 +43,8 @@ struct adaptive_euler {
     }
 
     double initial_dt(const Sys& sys, double t, step_state<Vec>& s, double horizon) {
-      const Vec& f0 = current_force(sys, t, s);
       this->horizon = horizon;
-      return starting_step(sys, t, s.x, s.v, f0, order, tol, horizon, x_half, v_half, f_half);
+      return starting_step(sys, t, s, order, tol, horizon, x_half, v_half, f_half);
     }
 
     step_attempt try_step(const Sys& sys, double t, step_state<Vec>& s, double h) {

@@ -39,8 +39,7 @@ struct rk45 {
     }
 
     double initial_dt(const Sys& sys, double t, step_state<Vec>& s, double horizon) {
-      const Vec& f0 = current_force(sys, t, s);
-      return starting_step(sys, t, s.x, s.v, f0, order, tol, horizon, ex, ev, x0);
+      return starting_step(sys, t, s, order, tol, horizon, ex, ev, x0);
     }
 
     step_attempt try_step(const Sys& sys, double t, step_state<Vec>& s, double h) {

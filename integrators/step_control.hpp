@@ -27,17 +27,14 @@ inline double scaled_rms(const EX& ex, const EV& ev, const Vec& x0, const Vec& v
 // Hairer's starting step for a method of order p: with d0 = ||y0||, d1 = ||f(y0)||
 // (scaled norms), h0 = 0.01 d0 / d1; an explicit Euler step of h0 gives
 // d2 = ||f(y1) - f(y0)|| / h0; h1 = (0.01 / max(d1, d2))^(1/(p+1)); h = min(100 h0, h1).
-// `f0` is F at the start (computed by the caller); `xs, vs, fs` are workspace.
+// From the state s at t; `xs, vs, fs` are workspace.
 template <class Sys, class Vec>
-inline double starting_step(const Sys& sys, double t, const Vec& x0, const Vec& v0, const Vec& f0, int p, double tol,
-                            double horizon, Vec& xs, Vec& vs, Vec& fs) {
+inline double starting_step(const Sys& sys, double t, step_state<Vec>& s, int p, double tol, double horizon, Vec& xs,
+                            Vec& vs, Vec& fs) {
+  const Vec &x0 = s.x, &v0 = s.v, &f0 = current_force(sys, t, s);
   const double im = inverse_mass(sys);
-  const auto norm = [&](const auto& ax, const auto& av) {
-    const auto sx = tol + tol * x0.cwiseAbs().array();
-    const auto sv = tol + tol * v0.cwiseAbs().array();
-    return std::sqrt(((ax.array() / sx).square().sum() + (av.array() / sv).square().sum()) /
-                     static_cast<double>(2 * x0.size()));
-  };
+  // Scaled by y0 alone: max(|y0|, |y0|) = |y0|.
+  const auto norm = [&](const auto& ax, const auto& av) { return scaled_rms(ax, av, x0, v0, x0, v0, tol); };
   const double d0 = norm(x0, v0), d1 = norm(v0, (im * f0).eval());
   double h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
   h0 = std::min(h0, horizon);

@@ -64,7 +64,6 @@ constexpr std::complex<double> stability_function(const explicit_tableau<S>& t, 
 // needs sum w_i = 1; w palindromic keeps the composition symmetric (even order).
 template <int N>
 struct verlet_composition {
-  static constexpr int substeps = N;
   std::array<double, N> w{};
   int order = 0;
 };

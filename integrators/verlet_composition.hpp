@@ -35,39 +35,34 @@ struct composition_stepper {
 
   void step(const Sys& sys, double t, step_state<Vec>& s, double dt) {
     const double h_im = dt * inverse_mass(sys);
-    if constexpr (!Sys::force_depends_on_velocity) {
-      s.v += (Seq.kick[0] * h_im) * current_force(sys, t, s);
-      double tau = t;
-      for (int i = 0; i < substeps; ++i) {
-        s.x += (Seq.drift[i] * dt) * s.v;
-        tau += Seq.drift[i] * dt;
-        sys.force(tau, s.x, s.v, s.f);
-        s.v += (Seq.kick[i + 1] * h_im) * s.f;
-      }
-      s.f_current = true;  // F at the new x: the next step's first kick
-    } else {
-      kick(sys, t, s, Seq.kick[0] * dt, Seq.kick[0] * h_im);
-      double tau = t;
-      for (int i = 0; i < substeps; ++i) {
-        s.x += (Seq.drift[i] * dt) * s.v;
-        tau += Seq.drift[i] * dt;
-        kick(sys, tau, s, Seq.kick[i + 1] * dt, Seq.kick[i + 1] * h_im);
-      }
+    kick(sys, t, s, Seq.kick[0] * dt, Seq.kick[0] * h_im);
+    double tau = t;
+    for (int i = 0; i < substeps; ++i) {
+      s.x += (Seq.drift[i] * dt) * s.v;
       s.f_current = false;
+      tau += Seq.drift[i] * dt;
+      kick(sys, tau, s, Seq.kick[i + 1] * dt, Seq.kick[i + 1] * h_im);
     }
+    // A position-only force's last F, at the new x, is the next step's first kick.
+    s.f_current = !Sys::force_depends_on_velocity;
   }
 
  private:
-  // v' = F(t, x, v) / m at fixed x over tau (c = tau / m), by one classic RK4 step.
+  // v' = F(t, x, v) / m at fixed x over tau (c = tau / m): v += c F(x) for a position-only
+  // force (F cached in the state), else by one classic RK4 step.
   void kick(const Sys& sys, double t, step_state<Vec>& s, double tau, double c) {
-    sys.force(t, s.x, s.v, k1);
-    v_stage = s.v + (0.5 * c) * k1;
-    sys.force(t + 0.5 * tau, s.x, v_stage, k2);
-    v_stage = s.v + (0.5 * c) * k2;
-    sys.force(t + 0.5 * tau, s.x, v_stage, k3);
-    v_stage = s.v + c * k3;
-    sys.force(t + tau, s.x, v_stage, k4);
-    s.v += (c / 6.0) * (k1 + 2.0 * (k2 + k3) + k4);
+    if constexpr (!Sys::force_depends_on_velocity) {
+      s.v += c * current_force(sys, t, s);
+    } else {
+      sys.force(t, s.x, s.v, k1);
+      v_stage = s.v + (0.5 * c) * k1;
+      sys.force(t + 0.5 * tau, s.x, v_stage, k2);
+      v_stage = s.v + (0.5 * c) * k2;
+      sys.force(t + 0.5 * tau, s.x, v_stage, k3);
+      v_stage = s.v + c * k3;
+      sys.force(t + tau, s.x, v_stage, k4);
+      s.v += (c / 6.0) * (k1 + 2.0 * (k2 + k3) + k4);
+    }
   }
 };
 

@@ -14,24 +14,22 @@
 // step makes the force strongly nonlinear (a pendulum near the top).
 // Solved to round-off, so that the error a study reports is the method's and not the
 // solver's: iterated until the Newton update is a few ulps of the velocity terms
-// (4 eps (|v1| + |v0| + h |F| / m); that last update applied), or until the update stops decreasing once it is
-// small (the iteration has reached the rounding floor of the residual: x1 = x0 + h v1
+// (4 eps (|v1| + |v0| + h |F| / m); that last update applied), or until the update stops
+// decreasing once it is small (the rounding floor of the residual: x1 = x0 + h v1
 // cancels when h^2 |dF/dx| >> m, a stiff spring at a large step), or until the residual
-// is at the subnormal floor (a state decayed into subnormal numbers). No tolerance
-// relative to the residual's size: a test like |r| < 1e-12 (m |v1| + h |F|) is met by
-// small steps after one update, and its error accumulates over the steps.
+// is subnormal (a decayed state). No tolerance relative to the residual's size: a test
+// like |r| < 1e-12 (m |v1| + h |F|) is met by small steps after one update, and its error
+// accumulates over the steps.
 //
 // For a large step the relations may have several solutions (a pendulum near the top:
 // v1 - v0 + h (g/L) sin(x0 + h v1) = 0), and Newton from v0 may fail or find the wrong
-// one. The right one is the solution that continues from h = 0, so a failed solve is
-// retried by continuation in the step: solve for h/2 (recursively, up to 2^-8 h), then
-// start h from the linear extrapolation v0 + 2 (v1(h/2) - v0). Where that path ends in
-// a fold (the root it follows merges with another as h grows), the explicit Euler
-// predictor v0 + (h/m) F(t0, x0, v0), the same with the force at the predicted end,
-// v0 + (h/m) F(t1, x0 + h v0, v0), and rest (v1 = 0) are tried last, each with the
-// damped (backtracking) Newton iteration. The step is still
-// one backward-Euler step of h; only the starting guess changes, and its work is
-// counted.
+// one. The right one continues from h = 0, so a failed solve is retried by continuation
+// in the step: solve for h/2 (recursively, up to 2^-8 h), then start h from the linear
+// extrapolation v0 + 2 (v1(h/2) - v0). Where that path ends in a fold (its root merges
+// with another as h grows), the explicit Euler predictor v0 + (h/m) F(t0, x0, v0), the
+// same with the force at the predicted end, v0 + (h/m) F(t1, x0 + h v0, v0), and rest
+// (v1 = 0) are tried last. The step is still one backward-Euler step of h; only the
+// starting guess changes, and its work is counted.
 // Coulomb friction, where the problem declares it set-valued (has_set_valued_friction,
 // core/concepts.hpp), is resolved by projection onto the friction cone, as a game
 // engine's solver clamps the friction impulse (solve_with_friction): the step with the

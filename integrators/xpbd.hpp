@@ -20,8 +20,8 @@
 // `xpbd` takes one iteration a step and is stepped over the dt ladder: at a 60 Hz frame,
 // halving dt doubles the substeps. `xpbd_iterations` is the alternative the Small Steps
 // paper argues against: one step of h with 10 iterations accumulating lambda, the same
-// counted work as `xpbd` at h / 10 (at h = one frame: one step a frame). A pass over the constraints visits each spring
-// once, as a force evaluation does: it is counted as one force evaluation (the external acceleration is a constant).
+// counted work as `xpbd` at h / 10. A pass over the constraints visits each spring once,
+// as a force evaluation does, and is counted as one (the external acceleration is constant).
 #include <string>
 
 #include "core/constraints.hpp"
@@ -107,11 +107,8 @@ struct xpbd_method {
   struct adapter {
     const P& p;
     xpbd_solver solver;
-    explicit adapter(const P& problem) : p(problem), solver(particles_at_start(problem)) {}
-    static particle_system particles_at_start(const P& problem) {
-      const auto s0 = problem.initial();
-      return problem.particles(s0.x, s0.v);
-    }
+    explicit adapter(const P& problem)
+        : p(problem), solver(problem.particles(problem.initial().x, problem.initial().v)) {}
     void step(double, double h) { solver.step(h, Iterations); }
     // Called at each recorded sample and at the end: the links are checked there, not in
     // the step (which is what is timed).

@@ -16,12 +16,6 @@
 
 namespace stepbench::peers {
 
-namespace baseline_rk8_detail {
-inline constexpr auto& tab = dop853_tableau;
-inline constexpr auto a2 = rk_detail::square<12>(dop853_tableau.a);
-inline constexpr auto ba = rk_detail::times<12>(dop853_tableau.b, dop853_tableau.a);
-}  // namespace baseline_rk8_detail
-
 struct baseline_rk8 {
   static method_info describe() {
     return {.name = "baseline_rk8",
@@ -48,7 +42,9 @@ struct baseline_rk8 {
   // One step of h from (x, v).
   template <bool Velocity, class Accel>
   [[gnu::always_inline]] static inline void step(double& x, double& v, double h, const Accel& accel) {
-    using namespace baseline_rk8_detail;
+    constexpr auto& tab = dop853_tableau;
+    constexpr auto& a2 = rk_tables<dop853_tableau>::a2;
+    constexpr auto& ba = rk_weights<dop853_tableau, dop853_tableau.b>::wa;
     double a[12], vs[12];
     a[0] = accel(x, v);
     vs[0] = v;

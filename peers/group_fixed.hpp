@@ -6,7 +6,6 @@
 #include "peers/baseline_rk4.hpp"
 #include "peers/baseline_rk8.hpp"
 #include "peers/gsl_fixed.hpp"
-#include "peers/gsl_rk8pd_fixed.hpp"
 #include "peers/odeint.hpp"
 
 namespace stepbench {

@@ -2,9 +2,9 @@
 // GSL's fixed-step steppers at our dt: gsl_odeiv2_step_apply as a step adapter on our
 // fixed-step loop (core/step_adapter.hpp), as the GSL manual describes a fixed-step
 // loop: dydt_out of one step is passed as dydt_in of the next, so no stage is computed
-// twice. GSL's rk4 still estimates its error by step
-// doubling (a full step and two half steps), and rkf45 by its embedded pair: work a
-// user pays for whether or not they use the estimate.
+// twice. GSL's rk4 still estimates its error by step doubling (a full step and two half
+// steps), and rkf45 and rk8pd by their embedded pairs: work a user pays for whether or
+// not they use the estimate.
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_odeiv2.h>
 
@@ -36,8 +36,7 @@ int gsl_fixed_rhs(double t, const double y[], double dydt[], void* params) {
   return GSL_SUCCESS;
 }
 
-// The GSL steppers a user might run at a fixed step: three here, the fourth (rk8pd) in
-// peers/gsl_rk8pd_fixed.hpp.
+// The GSL steppers a user might run at a fixed step.
 struct gsl_rk4_tag {
   static constexpr const char* name = "gsl_rk4";
   static constexpr const char* description =
@@ -53,6 +52,13 @@ struct gsl_rkf45_tag {
   static constexpr const char* name = "gsl_rkf45";
   static constexpr const char* description = "GSL rkf45 at fixed dt (Fehlberg 4(5), error estimate unused)";
   static const gsl_odeiv2_step_type* type() { return gsl_odeiv2_step_rkf45; }
+};
+// Prince-Dormand 8(7), 13 stages: the library's eighth-order step, for the step-cost
+// comparison with rk8.
+struct gsl_rk8pd_tag {
+  static constexpr const char* name = "gsl_rk8pd";
+  static constexpr const char* description = "GSL rk8pd (Prince-Dormand 8(7)) at fixed dt (gsl_odeiv2_step_apply)";
+  static const gsl_odeiv2_step_type* type() { return gsl_odeiv2_step_rk8pd; }
 };
 
 // The descriptor and the step adapter of one GSL stepper (registered as

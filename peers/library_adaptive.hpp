@@ -42,37 +42,27 @@ drive_result<Vec> as_run(const reference_solution& sol, int dim) {
   return out;
 }
 
-struct gsl_rkf45_solver {
-  static constexpr const char* name = "gsl_rkf45_adaptive";
-  static constexpr const char* description = "GSL driver, rkf45 with y_new control";
-  static constexpr const char* library = "GSL";
-  static reference_solution solve(const ode_system& s, std::span<const double> t, double tol) {
-    return solve_gsl(s, t, gsl_method::rkf45, {tol, tol});
-  }
-};
-struct gsl_rk8pd_solver {
-  static constexpr const char* name = "gsl_rk8pd_adaptive";
-  static constexpr const char* description = "GSL driver, rk8pd with y_new control";
-  static constexpr const char* library = "GSL";
-  static reference_solution solve(const ode_system& s, std::span<const double> t, double tol) {
-    return solve_gsl(s, t, gsl_method::rk8pd, {tol, tol});
-  }
-};
-struct cvode_adams_solver {
-  static constexpr const char* name = "cvode_adams";
-  static constexpr const char* description = "CVODE Adams-Moulton, fixed-point iteration";
-  static constexpr const char* library = "SUNDIALS CVODE";
-  static reference_solution solve(const ode_system& s, std::span<const double> t, double tol) {
-    return solve_cvode(s, t, cvode_method::adams, {tol, tol});
-  }
-};
-struct cvode_bdf_solver {
-  static constexpr const char* name = "cvode_bdf";
+template <gsl_method M>
+struct gsl_solver {
+  static constexpr bool rkf45 = M == gsl_method::rkf45;
+  static constexpr const char* name = rkf45 ? "gsl_rkf45_adaptive" : "gsl_rk8pd_adaptive";
   static constexpr const char* description =
-      "CVODE BDF, Newton (band solver with the analytic Jacobian for a chain, else dense difference quotients)";
+      rkf45 ? "GSL driver, rkf45 with y_new control" : "GSL driver, rk8pd with y_new control";
+  static constexpr const char* library = "GSL";
+  static reference_solution solve(const ode_system& s, std::span<const double> t, double tol) {
+    return solve_gsl(s, t, M, {tol, tol});
+  }
+};
+template <cvode_method M>
+struct cvode_solver {
+  static constexpr bool adams = M == cvode_method::adams;
+  static constexpr const char* name = adams ? "cvode_adams" : "cvode_bdf";
+  static constexpr const char* description =
+      adams ? "CVODE Adams-Moulton, fixed-point iteration"
+            : "CVODE BDF, Newton (band solver with the analytic Jacobian for a chain, else dense difference quotients)";
   static constexpr const char* library = "SUNDIALS CVODE";
   static reference_solution solve(const ode_system& s, std::span<const double> t, double tol) {
-    return solve_cvode(s, t, cvode_method::bdf, {tol, tol});
+    return solve_cvode(s, t, M, {tol, tol});
   }
 };
 

@@ -30,23 +30,37 @@ inline constexpr bool fixed_size = P::vec::RowsAtCompileTime != Eigen::Dynamic;
 template <problem P>
 using state = std::array<double, 2 * P::vec::RowsAtCompileTime>;
 
+// What the first-order Odeint adapters hold: the state [x; v] in Odeint's std::array, the
+// problem through first_order_form, and the right-hand side's calls counted.
 template <problem P>
-state<P> initial_state(const P& p) {
-  constexpr int d = P::vec::RowsAtCompileTime;
+struct first_order_state {
+  static constexpr int d = P::vec::RowsAtCompileTime;
+  first_order_form<P> rhs;
+  long calls = 0;
   state<P> y;
-  const auto s0 = p.initial();
-  for (int i = 0; i < d; ++i) y[i] = s0.x[i], y[d + i] = s0.v[i];
-  return y;
-}
 
-// The state [x; v] held in Odeint's std::array, as two vectors (copied coordinate by
-// coordinate: GCC 12 misreads Eigen's packet copy from a Map of the second half of the
-// std::array as reading past it, -Wstringop-overread).
-template <class Vec, std::size_t N>
-void split_state(const std::array<double, N>& y, Vec& x, Vec& v) {
-  constexpr int d = static_cast<int>(N / 2);
-  for (int i = 0; i < d; ++i) x[i] = y[i], v[i] = y[d + i];
-}
+  explicit first_order_state(const P& p) : rhs(p) {
+    const auto s0 = p.initial();
+    for (int i = 0; i < d; ++i) y[i] = s0.x[i], y[d + i] = s0.v[i];
+  }
+  first_order_state(const first_order_state&) = delete;
+
+  // The system as Odeint calls it.
+  auto system() {
+    return [this](const state<P>& yy, state<P>& dydt, double tt) {
+      ++calls;
+      rhs(tt, yy.data(), dydt.data());
+    };
+  }
+  // The state as two vectors (copied coordinate by coordinate: GCC 12 misreads Eigen's
+  // packet copy from a Map of the second half of the std::array as reading past it,
+  // -Wstringop-overread).
+  template <class Vec>
+  void state_into(Vec& x, Vec& v) const {
+    for (int i = 0; i < d; ++i) x[i] = y[i], v[i] = y[d + i];
+  }
+  long force_evals() const { return calls; }
+};
 }  // namespace odeint_detail
 
 // A first-order Odeint stepper at our dt: [x; v] as Odeint's state, the problem through
@@ -82,29 +96,10 @@ struct odeint_fixed {
   static constexpr bool applies = odeint_detail::fixed_size<P>;
 
   template <problem P>
-  struct adapter {
-    using state = odeint_detail::state<P>;
-    first_order_form<P> rhs;
-    long calls = 0;
-    typename Tag::template stepper<state> stepper;
-    state y;
-
-    explicit adapter(const P& p) : rhs(p), y(odeint_detail::initial_state(p)) {}
-    adapter(const adapter&) = delete;
-
-    void step(double t, double h) {
-      stepper.do_step(
-          [this](const state& yy, state& dydt, double tt) {
-            ++calls;
-            rhs(tt, yy.data(), dydt.data());
-          },
-          y, t, h);
-    }
-    template <class Vec>
-    void state_into(Vec& x, Vec& v) const {
-      odeint_detail::split_state(y, x, v);
-    }
-    long force_evals() const { return calls; }
+  struct adapter : odeint_detail::first_order_state<P> {
+    typename Tag::template stepper<odeint_detail::state<P>> stepper;
+    using odeint_detail::first_order_state<P>::first_order_state;
+    void step(double t, double h) { stepper.do_step(this->system(), this->y, t, h); }
   };
 };
 

@@ -91,29 +91,13 @@ struct odeint_adaptive {
   static constexpr bool applies = odeint_detail::fixed_size<P>;
 
   template <problem P>
-  struct adapter {
-    using state = odeint_detail::state<P>;
-    first_order_form<P> rhs;
-    long calls = 0;
-    decltype(Tag::template make<state>(1.0)) stepper;
-    state y;
-
+  struct adapter : odeint_detail::first_order_state<P> {
+    decltype(Tag::template make<odeint_detail::state<P>>(1.0)) stepper;
     adapter(const P& p, double tol)
-        : rhs(p), stepper(Tag::template make<state>(tol)), y(odeint_detail::initial_state(p)) {}
-    adapter(const adapter&) = delete;
-
+        : odeint_detail::first_order_state<P>(p), stepper(Tag::template make<odeint_detail::state<P>>(tol)) {}
     bool try_step(double& t, double& h) {
-      auto system = [this](const state& yy, state& dydt, double tt) {
-        ++calls;
-        rhs(tt, yy.data(), dydt.data());
-      };
-      return stepper.try_step(system, y, t, h) == boost::numeric::odeint::success;
+      return stepper.try_step(this->system(), this->y, t, h) == boost::numeric::odeint::success;
     }
-    template <class Vec>
-    void state_into(Vec& x, Vec& v) const {
-      odeint_detail::split_state(y, x, v);
-    }
-    long force_evals() const { return calls; }
   };
 };
 

@@ -116,10 +116,4 @@ std::size_t case_book::timed_count() const {
   return n;
 }
 
-bool case_book::any_timed() const {
-  for (const auto& c : cases_)
-    if (!c->ns_per_run.empty()) return true;
-  return false;
-}
-
 }  // namespace stepbench::bench

@@ -28,10 +28,8 @@ class case_book {
   // Registers every case of the study (which must outlive the benchmark run).
   void register_all(study& s);
   timed_case* find(const std::string& registered_name);
-  std::size_t size() const { return cases_.size(); }
   // Copies the timings into the rows: the median, fastest and slowest repetition.
   void merge_into_rows();
-  bool any_timed() const;
   std::size_t timed_count() const;
 
  private:

@@ -134,11 +134,8 @@ int main(int argc, char** argv) {
     bench::case_book book(opts.case_budget_s);
     book.register_all(s);
     // The scaling families of the shard's problems only (an empty list selects every one).
-    if (sopts.shard_count == 1 || !share.empty()) {
-      const auto& scaled = sopts.shard_count == 1 ? opts.problems : share;
-      bench::register_scaling(scaled);
-      bench::register_balls(scaled);
-    }
+    if (sopts.shard_count == 1 || !share.empty())
+      bench::register_scaling(sopts.shard_count == 1 ? opts.problems : share);
     const std::size_t total = opts.list_only ? 0 : count_selected(argv[0]);
 
     // The display reporter is made after Initialize, from the flags it parsed.
@@ -160,7 +157,7 @@ int main(int argc, char** argv) {
                           std::chrono::duration<double>(std::chrono::steady_clock::now() - timing_start).count())));
     if (opts.list_only) return 0;
 
-    if (!opts.study_out.empty() && !book.any_timed() && !share.empty())
+    if (!opts.study_out.empty() && book.timed_count() == 0 && !share.empty())
       throw std::runtime_error("no case was timed (does --benchmark_filter match any?); " + opts.study_out +
                                " was not written");
     book.merge_into_rows();

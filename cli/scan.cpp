@@ -106,11 +106,7 @@ int run_scan_command(const scan_args& a) {
       throw std::invalid_argument(fmt::format(
           "--reference-budget {} is not positive (inf: run the references everywhere)", o.reference_budget));
   }
-  if (!a.shard.empty()) {
-    const auto shard = parse_shard(a.shard);
-    o.shard_index = shard.index;
-    o.shard_count = shard.count;
-  }
+  if (!a.shard.empty()) parse_shard(a.shard, o.shard_index, o.shard_count);
   o.methods = a.methods;
   o.jobs = a.jobs;
   parameter_overrides sets;
@@ -139,10 +135,7 @@ int run_scan_command(const scan_args& a) {
   judge_study(s);
   write_study(s, a.out);
   const scan_answer answer = answer_scan(scan, o.tol);
-  if (a.json)
-    std::cout << scan_answer_json(answer).dump(2) << "\n";
-  else
-    fmt::print("{}", format_scan_answer(answer));
+  print_answer(a.json, scan_answer_json(answer), format_scan_answer(answer));
   if (!a.quiet)
     std::fputs(fmt::format("wrote {} (/scan/{}: {} points, {} runs) in {:.2f} s; `stepbench advise --scan {} --tol X` "
                            "answers at another tolerance\n",

@@ -35,11 +35,7 @@ int run_sweep_command(sweep_args a) {
   for (const auto& s : a.sets) add_override(a.opts.overrides, s, a.opts.problems);
   if (a.quick) find_preset("quick").apply(a.opts);
   if (!a.parts.empty()) a.opts.parts = a.parts;
-  if (!a.shard.empty()) {
-    const auto shard = parse_shard(a.shard);
-    a.opts.shard_index = shard.index;
-    a.opts.shard_count = shard.count;
-  }
+  if (!a.shard.empty()) parse_shard(a.shard, a.opts.shard_index, a.opts.shard_count);
   a.opts.progress = !a.quiet;
   validate(a.opts);
   selected_parts(a.opts);

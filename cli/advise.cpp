@@ -17,6 +17,8 @@
 #include "study/scan.hpp"
 
 namespace stepbench {
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(wp_pick, param, interpolated, force_evals, time_ns, error, cost, cost_lo, cost_hi,
+                                   diverged_rows)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(frame_option, method, substeps, completed, diverged, err_pos_max, cost_per_frame,
                                    note)
 }  // namespace stepbench
@@ -35,20 +37,13 @@ struct advise_args {
 
 json pick_json(const advice& a, const wp_pick& p) {
   const auto& m = a.methods[p.method];
-  return {{"method", m.name},
-          {"origin", to_string(m.origin)},
-          {"param_name", param_name(m.kind)},
-          {"param", p.param},
-          {"interpolated", p.interpolated},
-          {"force_evals", p.force_evals},
-          {"time_ns", p.time_ns},  // NaN (not timed) is written as null by nlohmann::json
-          {"error", p.error},
-          {"cost", p.cost},
-          {"cost_lo", p.cost_lo},
-          {"cost_hi", p.cost_hi},
-          {"diverged_rows", p.diverged_rows},
-          {"smallest_diverged", p.smallest_diverged ? json(*p.smallest_diverged) : json(nullptr)},
-          {"largest_diverged", p.largest_diverged ? json(*p.largest_diverged) : json(nullptr)}};
+  json out = p;  // NaN (time_ns when not timed) is written as null
+  out.update({{"method", m.name},
+              {"origin", to_string(m.origin)},
+              {"param_name", param_name(m.kind)},
+              {"smallest_diverged", p.smallest_diverged ? json(*p.smallest_diverged) : json(nullptr)},
+              {"largest_diverged", p.largest_diverged ? json(*p.largest_diverged) : json(nullptr)}});
+  return out;
 }
 
 json frame_advice_json(const frame_advice& f) {

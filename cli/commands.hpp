@@ -34,11 +34,6 @@ command add_schema(CLI::App& app);
 command add_scan(CLI::App& app);
 command add_merge(CLI::App& app);
 
-// A measured number as JSON: null where it is not finite (JSON has no NaN).
-inline nlohmann::json number_or_null(double v) {
-  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
-}
-
 // A command's answer on stdout: the JSON document (indented by two) with --json, else the text.
 inline void print_answer(bool as_json, const nlohmann::json& out, const std::string& text) {
   if (as_json)

@@ -30,8 +30,7 @@ using json = nlohmann::json;
 struct energy_args {
   bool json = false;
   double periods = 1e4;
-  std::vector<std::string> problems;
-  std::vector<std::string> sets;
+  std::vector<std::string> problems, sets;
 };
 
 std::string sci(double v) { return std::isfinite(v) ? fmt::format("{:.2e}", v) : "-"; }

@@ -103,13 +103,10 @@ void print_list(const json& out) {
   fmt::print("\nParts of the study, in the order a study runs them (sweep --parts A,B runs only those):\n");
   for (const auto& p : out["parts"])
     fmt::print("  {:<12} {}\n", p["name"].get<std::string>(), p["summary"].get<std::string>());
-  fmt::print("Presets: {}\n", [&] {
-    std::string s;
-    for (const auto& p : out["presets"])
-      s += fmt::format("{}{} ({})", s.empty() ? "" : "; ", p["name"].get<std::string>(),
-                       p["summary"].get<std::string>());
-    return s;
-  }());
+  std::vector<std::string> presets;
+  for (const auto& p : out["presets"])
+    presets.push_back(fmt::format("{} ({})", p["name"].get<std::string>(), p["summary"].get<std::string>()));
+  fmt::print("Presets: {}\n", fmt::join(presets, "; "));
 }
 
 int run_list(bool as_json) {

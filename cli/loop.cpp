@@ -27,6 +27,13 @@
 #include "store/study_file.hpp"
 #include "study/loop.hpp"
 
+namespace stepbench {
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(loop_row, clock, frames, physics_steps, force_evals, shown_err_max, shown_err_rms,
+                                   final_shown_err, clock_dependence, physics_clock_dependence, judder, lag_s,
+                                   lag_clock_s, steps_per_frame_mean, steps_per_frame_max, stall_burst_steps,
+                                   clamp_hits, alpha_min, alpha_max, diverged, note)
+}  // namespace stepbench
+
 namespace stepbench::cli {
 namespace {
 
@@ -115,56 +122,38 @@ std::vector<double> state_part(const std::vector<double>& y, int offset, int dim
 json one_loop_json(const loop_args& a, const problem_instance& problem, const loop_config& c, const loop_options& opts,
                    const loop_row& r, const loop_cost& cost) {
   const int dim = problem.dim();
-  return {{"problem", a.problem},
-          {"integrator", a.method},
-          {"design", to_string(c.design)},
-          {"clock", r.clock},
-          {"display_hz", c.display_hz},
-          {"physics_hz", c.design == loop_design::variable ? json(nullptr) : json(c.physics_hz)},
-          {"dt", uses_accumulator(c.design) ? json(c.dt()) : json(nullptr)},
-          {"substeps", c.design == loop_design::substeps ? json(c.substeps()) : json(nullptr)},
-          {"clamp_s", c.clamp_s > 0.0 ? json(c.clamp_s) : json(nullptr)},
-          {"jitter_seed", c.jitter_seed ? json(*c.jitter_seed) : json(nullptr)},
-          {"jitter", c.jitter_seed ? json(c.jitter) : json(nullptr)},
-          {"stall_at_s", number_or_null(c.stall_at_s)},
-          {"stall_s", c.stalls() ? json(c.stall_s) : json(nullptr)},
-          {"horizon", c.horizon},
-          {"position_unit", std::string(problem.position_unit())},
-          {"frames", r.frames},
-          {"physics_steps", r.physics_steps},
-          {"force_evals", r.force_evals},
-          {"final_physics_t", r.physics_t},
-          {"final_physics_position", state_part(r.final_physics, 0, dim)},
-          {"final_physics_velocity", state_part(r.final_physics, dim, dim)},
-          {"final_shown_position", state_part(r.final_shown, 0, dim)},
-          {"shown_err_max", number_or_null(r.shown_err_max)},
-          {"shown_err_rms", number_or_null(r.shown_err_rms)},
-          {"final_shown_err", number_or_null(r.final_shown_err)},
-          {"reference_display_hz", opts.reference_display_hz},
-          {"clock_dependence", number_or_null(r.clock_dependence)},
-          {"physics_clock_dependence", number_or_null(r.physics_clock_dependence)},
-          {"judder", number_or_null(r.judder)},
-          {"lag_s", number_or_null(r.lag_s)},
-          {"lag_clock_s", number_or_null(r.lag_clock_s)},
-          {"steps_per_frame_mean", number_or_null(r.steps_per_frame_mean)},
-          {"steps_per_frame_max", r.steps_per_frame_max},
-          {"stall_burst_steps", r.stall_burst_steps},
-          {"clamp_hits", r.clamp_hits},
-          {"alpha_min", number_or_null(r.alpha_min)},
-          {"alpha_max", number_or_null(r.alpha_max)},
-          {"diverged", r.diverged},
-          {"note", r.note},
-          {"cost",
-           {{"step_cost_ns", cost.step_cost_ns},
-            {"source", a.step_cost.empty() ? "stated (default)" : "stated"},
-            {"frame_budget_ns", cost.schedule.frame_budget_s * 1e9},
-            {"worst_frame_work_ns", cost.schedule.worst_work_s * 1e9},
-            {"late_frames", cost.schedule.late_frames},
-            {"physics_load", cost.schedule.load},
-            {"wall_s", cost.schedule.wall_s},
-            {"outcome", to_string(cost.schedule.outcome)},
-            {"outcome_without_clamp", to_string(cost.without_clamp)},
-            {"clamp_prevented_spiral", cost.clamp_prevented_spiral}}}};
+  json out = r;  // NaN is written as null
+  out.update({{"problem", a.problem},
+              {"integrator", a.method},
+              {"design", to_string(c.design)},
+              {"display_hz", c.display_hz},
+              {"physics_hz", c.design == loop_design::variable ? json(nullptr) : json(c.physics_hz)},
+              {"dt", uses_accumulator(c.design) ? json(c.dt()) : json(nullptr)},
+              {"substeps", c.design == loop_design::substeps ? json(c.substeps()) : json(nullptr)},
+              {"clamp_s", c.clamp_s > 0.0 ? json(c.clamp_s) : json(nullptr)},
+              {"jitter_seed", c.jitter_seed ? json(*c.jitter_seed) : json(nullptr)},
+              {"jitter", c.jitter_seed ? json(c.jitter) : json(nullptr)},
+              {"stall_at_s", c.stall_at_s},
+              {"stall_s", c.stalls() ? json(c.stall_s) : json(nullptr)},
+              {"horizon", c.horizon},
+              {"position_unit", std::string(problem.position_unit())},
+              {"final_physics_t", r.physics_t},
+              {"final_physics_position", state_part(r.final_physics, 0, dim)},
+              {"final_physics_velocity", state_part(r.final_physics, dim, dim)},
+              {"final_shown_position", state_part(r.final_shown, 0, dim)},
+              {"reference_display_hz", opts.reference_display_hz},
+              {"cost",
+               {{"step_cost_ns", cost.step_cost_ns},
+                {"source", a.step_cost.empty() ? "stated (default)" : "stated"},
+                {"frame_budget_ns", cost.schedule.frame_budget_s * 1e9},
+                {"worst_frame_work_ns", cost.schedule.worst_work_s * 1e9},
+                {"late_frames", cost.schedule.late_frames},
+                {"physics_load", cost.schedule.load},
+                {"wall_s", cost.schedule.wall_s},
+                {"outcome", to_string(cost.schedule.outcome)},
+                {"outcome_without_clamp", to_string(cost.without_clamp)},
+                {"clamp_prevented_spiral", cost.clamp_prevented_spiral}}}});
+  return out;
 }
 
 void print_one_loop(const loop_args& a, const problem_instance& problem, const loop_config& c, const loop_options& opts,

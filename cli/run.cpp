@@ -14,6 +14,12 @@
 #include "core/measure.hpp"
 #include "registry/registry.hpp"
 
+namespace stepbench {
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(work_counters, force_evals, jacobian_evals, newton_iterations, linear_solves)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(run_metrics, err_pos_final, err_vel_final, err_pos_max, err_pos_rms, energy_drift,
+                                   diverged, failed)  // NaN is written as null
+}  // namespace stepbench
+
 namespace stepbench::cli {
 namespace {
 
@@ -102,7 +108,9 @@ int run_run(const run_args& a) {
     const std::vector<double> o = problem.observed(y);
     return std::vector<double>(o.begin() + offset, o.begin() + offset + dim);
   };
-  json out = {{"problem", a.problem},
+  json out = run.work;  // force_evals, jacobian_evals, newton_iterations, linear_solves
+  out.update(metrics);  // the errors, diverged and failed
+  out.update({{"problem", a.problem},
               {"integrator", m.name},
               {"origin", to_string(m.origin)},
               {"kind", to_string(m.kind)},
@@ -110,22 +118,11 @@ int run_run(const run_args& a) {
               {"horizon", horizon},
               {"steps", run.steps},
               {"rejected_steps", run.rejected_steps},
-              {"force_evals", run.work.force_evals},
-              {"jacobian_evals", run.work.jacobian_evals},
-              {"newton_iterations", run.work.newton_iterations},
-              {"linear_solves", run.work.linear_solves},
               {"position", part(run.final_y, 0)},
               {"velocity", part(run.final_y, dim)},
-              {"err_pos_final", metrics.err_pos_final},
-              {"err_vel_final", metrics.err_vel_final},
-              {"err_pos_max", metrics.err_pos_max},
-              {"err_pos_rms", metrics.err_pos_rms},
-              {"energy_drift", metrics.energy_drift},
-              {"diverged", metrics.diverged},
-              {"failed", metrics.failed},
               {"truth_source", truth.source},
               {"true_position", part(truth.y.back(), 0)},
-              {"true_velocity", part(truth.y.back(), dim)}};
+              {"true_velocity", part(truth.y.back(), dim)}});
   if (!metrics.note.empty()) out["note"] = metrics.note;
   if (a.json) {
     std::cout << out.dump(2) << "\n";

@@ -18,12 +18,9 @@ namespace {
 struct sweep_args {
   sweep_options opts;
   std::vector<std::string> sets;
-  std::string shard;  // K/N
-  std::string out = "results/study.h5";
-  bool quiet = false;
-  bool quick = false;
+  std::string shard, out = "results/study.h5";  // shard: K/N
   std::vector<std::string> parts;
-  bool strict = false;
+  bool quiet = false, quick = false, strict = false;
 };
 
 std::string observed(const method_study& ms) {

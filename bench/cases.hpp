@@ -38,8 +38,7 @@ class case_book {
   // Google Benchmark calls a case several times while it sizes the iteration count;
   // those calls of the same case do not count against it.
   bool over_budget(const timed_case& c) const;
-  // Registers the case of one completed row (a diverged, failed or skipped run has
-  // nothing worth timing).
+  // Registers the case of one completed row.
   void add(const problem_study& ps, const method_info& info, method_row& row, std::string name, std::string family);
   void record(const timed_case& c, double ns);
 

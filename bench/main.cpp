@@ -172,7 +172,6 @@ int main(int argc, char** argv) {
     ts.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     s.timed = ts;
     judge_study(s);  // the verdict again, on the measured times
-    const std::string timed = count_of(book.timed_count(), "case");
     if (opts.study_out.empty()) return report_study_outcome(s, "stepbench_bench", opts.strict);
     // The study first, then bench.json: a signal between the two leaves the new study
     // whole and the previous bench.json (the study is what the other commands read).
@@ -185,8 +184,8 @@ int main(int argc, char** argv) {
     fmt::print(stderr,
                "stepbench_bench: wrote {}{} ({} mode, {} timed) in {}; `stepbench ratios --study {}` prints the "
                "performance ratios\n",
-               opts.study_out, bench_json.empty() ? "" : " and " + bench_json, ts.mode, timed,
-               bench::format_duration(ts.wall_seconds), opts.study_out);
+               opts.study_out, bench_json.empty() ? "" : " and " + bench_json, ts.mode,
+               count_of(book.timed_count(), "case"), bench::format_duration(ts.wall_seconds), opts.study_out);
     const int status = report_study_outcome(s, "stepbench_bench", opts.strict);
     // The answer last: the verdict tables (on stderr when stdout carries Google
     // Benchmark's JSON or CSV).

@@ -37,11 +37,6 @@ using namespace stepbench;
 
 namespace {
 
-void print_help() {
-  std::fputs(bench::own_flags_help(), stdout);
-  benchmark::PrintDefaultHelp();
-}
-
 // A reporter that reports nothing: the listing below writes to its output stream.
 class listing_reporter : public benchmark::BenchmarkReporter {
  public:
@@ -86,7 +81,10 @@ int main(int argc, char** argv) {
     for (auto& e : extra) args.push_back(e.data());
     int n = static_cast<int>(args.size());
     args.push_back(nullptr);
-    benchmark::Initialize(&n, args.data(), print_help);
+    benchmark::Initialize(&n, args.data(), [] {  // --help: our flags, then Google Benchmark's
+      std::fputs(bench::own_flags_help(), stdout);
+      benchmark::PrintDefaultHelp();
+    });
     if (benchmark::ReportUnrecognizedArguments(n, args.data())) return 2;
 
     // A study run keeps the terminal for progress and the verdict: Google Benchmark's

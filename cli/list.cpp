@@ -16,6 +16,7 @@
 namespace stepbench {
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(capabilities, symplectic, reuses_last_force, needs_jacobian, error_estimate,
                                    dense_output)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(named_value, name, value, description)
 }  // namespace stepbench
 
 namespace stepbench::cli {
@@ -114,18 +115,14 @@ int run_list(bool as_json) {
   for (const auto& name : problem_names()) {
     auto p = make_problem(name);
     json params = json::array();
-    for (const auto& q : p->params()) {
-      json names = json::array();
-      for (const auto& n : q.names)
-        names.push_back({{"name", n.name}, {"value", n.value}, {"description", n.description}});
+    for (const auto& q : p->params())
       params.push_back({{"name", q.name},
                         {"default", q.default_value},
                         {"unit", q.unit},
                         {"description", q.description},
                         {"kind", q.kind()},
                         {"allowed", q.allowed.text()},
-                        {"names", names}});
-    }
+                        {"names", q.names}});
     json methods = json::array();
     for (const auto& m : p->methods()) methods.push_back(m.name);
     out["problems"].push_back({{"name", name},

@@ -20,14 +20,9 @@ void case_book::add(const problem_study& ps, const method_info& info, method_row
   if (!by_name_.emplace(c->name, c.get()).second)
     throw std::logic_error("two benchmark cases would share the name " + c->name);
   const std::function<double()> run = ps.problem->timed_run(info.name, row.param, ps.horizon, ps.truth.times);
-  timed_case* tc = c.get();
-  const auto& m = row.metrics;
-  const long steps = row.steps;
-  const work_counters work = row.work;
-  const long rejected = row.rejected_steps;
   benchmark::RegisterBenchmark(
       c->name.c_str(),
-      [this, tc, run, m, steps, work, rejected](benchmark::State& state) {
+      [this, tc = c.get(), run](benchmark::State& state) {
         if (over_budget(*tc)) {
           state.SkipWithError("cut: the previous case of this family used over half the per-case time budget");
           return;
@@ -37,18 +32,20 @@ void case_book::add(const problem_study& ps, const method_info& info, method_row
         const double ns = std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - start).count() /
                           static_cast<double>(std::max<benchmark::IterationCount>(1, state.iterations()));
         record(*tc, ns);
-        state.counters["err_pos_final"] = m.err_pos_final;
-        state.counters["err_pos_max"] = m.err_pos_max;
-        state.counters["steps"] = static_cast<double>(steps);
-        state.counters["force_evals"] = static_cast<double>(work.force_evals);
-        if (rejected) state.counters["rejected_steps"] = static_cast<double>(rejected);
-        if (work.newton_iterations) state.counters["newton_iterations"] = static_cast<double>(work.newton_iterations);
-        if (work.jacobian_evals) state.counters["jacobian_evals"] = static_cast<double>(work.jacobian_evals);
+        const method_row& r = *tc->row;  // the accuracy counters: the row the sweep measured
+        state.counters["err_pos_final"] = r.metrics.err_pos_final;
+        state.counters["err_pos_max"] = r.metrics.err_pos_max;
+        state.counters["steps"] = static_cast<double>(r.steps);
+        state.counters["force_evals"] = static_cast<double>(r.work.force_evals);
+        if (r.rejected_steps) state.counters["rejected_steps"] = static_cast<double>(r.rejected_steps);
+        if (r.work.newton_iterations)
+          state.counters["newton_iterations"] = static_cast<double>(r.work.newton_iterations);
+        if (r.work.jacobian_evals) state.counters["jacobian_evals"] = static_cast<double>(r.work.jacobian_evals);
         // Wall time per step (the case uses real time): Google Benchmark divides the elapsed
         // time by steps x iterations (an inverted iteration-invariant rate) and prints it in
         // seconds with an SI prefix (13.8n = 13.8 ns).
         state.counters["time_per_step"] =
-            benchmark::Counter(static_cast<double>(std::max(1L, steps)),
+            benchmark::Counter(static_cast<double>(std::max(1L, r.steps)),
                                benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
       })
       ->Unit(benchmark::kMicrosecond)
@@ -114,12 +111,6 @@ std::size_t case_book::timed_count() const {
   std::size_t n = 0;
   for (const auto& c : cases_) n += !c->ns_per_run.empty();
   return n;
-}
-
-bool case_book::any_timed() const {
-  for (const auto& c : cases_)
-    if (!c->ns_per_run.empty()) return true;
-  return false;
 }
 
 }  // namespace stepbench::bench

@@ -28,10 +28,8 @@ class case_book {
   // Registers every case of the study (which must outlive the benchmark run).
   void register_all(study& s);
   timed_case* find(const std::string& registered_name);
-  std::size_t size() const { return cases_.size(); }
   // Copies the timings into the rows: the median, fastest and slowest repetition.
   void merge_into_rows();
-  bool any_timed() const;
   std::size_t timed_count() const;
 
  private:
@@ -40,8 +38,7 @@ class case_book {
   // Google Benchmark calls a case several times while it sizes the iteration count;
   // those calls of the same case do not count against it.
   bool over_budget(const timed_case& c) const;
-  // Registers the case of one completed row (a diverged, failed or skipped run has
-  // nothing worth timing).
+  // Registers the case of one completed row.
   void add(const problem_study& ps, const method_info& info, method_row& row, std::string name, std::string family);
   void record(const timed_case& c, double ns);
 

@@ -63,9 +63,7 @@ options take_own_flags(int& argc, char** argv, std::vector<std::string>& extra) 
         start = comma + 1;
       }
     } else if (a.rfind("--shard=", 0) == 0) {
-      const auto shard = parse_shard(a.substr(8));
-      o.shard_index = shard.index;
-      o.shard_count = shard.count;
+      parse_shard(a.substr(8), o.shard_index, o.shard_count);
     } else if (a == "--study_out" || a == "--case_budget" || a == "--set" || a == "--problem" || a == "--shard" ||
                a == "--parts") {
       throw std::invalid_argument(a + " takes its value after '=': " + a + "=VALUE");

@@ -11,9 +11,7 @@
 namespace stepbench::bench {
 
 struct options {
-  bool quick = false;
-  bool strict = false;
-  bool verbose = false;
+  bool quick = false, strict = false, verbose = false;
   std::string study_out;
   double case_budget_s = 0.5;
   double min_time_s = 0.01;
@@ -33,8 +31,7 @@ struct options {
   // --shard=K/N: shard_index K - 1 of shard_count N, as `stepbench sweep --shard K/N`.
   int shard_index = 0, shard_count = 1;
   // Google Benchmark's flags that decide where its results go, as given (empty: not given).
-  std::string benchmark_format;
-  std::string benchmark_out;
+  std::string benchmark_format, benchmark_out;
 };
 
 // One line per flag of ours, for --help.

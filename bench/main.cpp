@@ -37,11 +37,6 @@ using namespace stepbench;
 
 namespace {
 
-void print_help() {
-  std::fputs(bench::own_flags_help(), stdout);
-  benchmark::PrintDefaultHelp();
-}
-
 // A reporter that reports nothing: the listing below writes to its output stream.
 class listing_reporter : public benchmark::BenchmarkReporter {
  public:
@@ -86,7 +81,10 @@ int main(int argc, char** argv) {
     for (auto& e : extra) args.push_back(e.data());
     int n = static_cast<int>(args.size());
     args.push_back(nullptr);
-    benchmark::Initialize(&n, args.data(), print_help);
+    benchmark::Initialize(&n, args.data(), [] {  // --help: our flags, then Google Benchmark's
+      std::fputs(bench::own_flags_help(), stdout);
+      benchmark::PrintDefaultHelp();
+    });
     if (benchmark::ReportUnrecognizedArguments(n, args.data())) return 2;
 
     // A study run keeps the terminal for progress and the verdict: Google Benchmark's
@@ -134,11 +132,8 @@ int main(int argc, char** argv) {
     bench::case_book book(opts.case_budget_s);
     book.register_all(s);
     // The scaling families of the shard's problems only (an empty list selects every one).
-    if (sopts.shard_count == 1 || !share.empty()) {
-      const auto& scaled = sopts.shard_count == 1 ? opts.problems : share;
-      bench::register_scaling(scaled);
-      bench::register_balls(scaled);
-    }
+    if (sopts.shard_count == 1 || !share.empty())
+      bench::register_scaling(sopts.shard_count == 1 ? opts.problems : share);
     const std::size_t total = opts.list_only ? 0 : count_selected(argv[0]);
 
     // The display reporter is made after Initialize, from the flags it parsed.
@@ -160,7 +155,7 @@ int main(int argc, char** argv) {
                           std::chrono::duration<double>(std::chrono::steady_clock::now() - timing_start).count())));
     if (opts.list_only) return 0;
 
-    if (!opts.study_out.empty() && !book.any_timed() && !share.empty())
+    if (!opts.study_out.empty() && book.timed_count() == 0 && !share.empty())
       throw std::runtime_error("no case was timed (does --benchmark_filter match any?); " + opts.study_out +
                                " was not written");
     book.merge_into_rows();
@@ -175,7 +170,6 @@ int main(int argc, char** argv) {
     ts.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     s.timed = ts;
     judge_study(s);  // the verdict again, on the measured times
-    const std::string timed = count_of(book.timed_count(), "case");
     if (opts.study_out.empty()) return report_study_outcome(s, "stepbench_bench", opts.strict);
     // The study first, then bench.json: a signal between the two leaves the new study
     // whole and the previous bench.json (the study is what the other commands read).
@@ -188,8 +182,8 @@ int main(int argc, char** argv) {
     fmt::print(stderr,
                "stepbench_bench: wrote {}{} ({} mode, {} timed) in {}; `stepbench ratios --study {}` prints the "
                "performance ratios\n",
-               opts.study_out, bench_json.empty() ? "" : " and " + bench_json, ts.mode, timed,
-               bench::format_duration(ts.wall_seconds), opts.study_out);
+               opts.study_out, bench_json.empty() ? "" : " and " + bench_json, ts.mode,
+               count_of(book.timed_count(), "case"), bench::format_duration(ts.wall_seconds), opts.study_out);
     const int status = report_study_outcome(s, "stepbench_bench", opts.strict);
     // The answer last: the verdict tables (on stderr when stdout carries Google
     // Benchmark's JSON or CSV).

@@ -10,19 +10,8 @@
 #include <iostream>
 
 namespace stepbench::bench {
-namespace {
 
 using clock_type = std::chrono::steady_clock;
-
-double seconds_since(clock_type::time_point t) { return std::chrono::duration<double>(clock_type::now() - t).count(); }
-
-// The terminal's width in columns (80 when it does not say).
-std::size_t terminal_columns() {
-  winsize w{};
-  return ::ioctl(STDERR_FILENO, TIOCGWINSZ, &w) == 0 && w.ws_col > 0 ? w.ws_col : 80;
-}
-
-}  // namespace
 
 std::string format_duration(double seconds) {
   const long s = std::lround(std::max(0.0, seconds));
@@ -40,7 +29,7 @@ progress_line::~progress_line() {
 }
 
 std::string progress_line::line_locked(bool bar) const {
-  const double elapsed = seconds_since(start_);
+  const double elapsed = std::chrono::duration<double>(clock_type::now() - start_).count();
   std::string out = what_;
   if (total_ > 0) {
     if (bar) {
@@ -67,7 +56,8 @@ void progress_line::draw_locked() {
     return;
   }
   std::string text = line_locked(true);
-  const std::size_t columns = terminal_columns();
+  winsize w{};  // the terminal's width in columns (80 when it does not say)
+  const std::size_t columns = ::ioctl(STDERR_FILENO, TIOCGWINSZ, &w) == 0 && w.ws_col > 0 ? w.ws_col : 80;
   if (text.size() >= columns) text.resize(columns - 1);  // a wrapped line cannot be redrawn with \r
   fmt::print(stderr, "\r\033[K{}", text);
   std::fflush(stderr);

@@ -28,8 +28,7 @@ class progress_line {
   // Starts a phase: "timing" with a total of 3348 and the unit "cases" reads "timing 12 of
   // 3348 cases"; a total of 0 (not known) shows the time elapsed only.
   void begin(std::string what, std::size_t total = 0, std::string unit = {});
-  // One more of the total done.
-  void advance();
+  void advance();  // one more of the total done
   // Ends the phase: the live line gives way to "<program>: <summary>".
   void end(const std::string& summary);
   // Runs `print` (output to the same terminal) with the live line cleared, then redraws it.

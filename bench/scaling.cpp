@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -22,18 +24,58 @@ constexpr double scaling_dt = 1e-5;
 constexpr int scaling_steps = 16;
 constexpr long chain_sizes[] = {8, 64, 512, 4096, 32768, 65536};
 
-void chain_case(benchmark::State& state, const std::string& method) {
+// The balls family (a ball pit, the lecture's closing program): 8 steps of dt = 1 ms of the
+// bouncing_balls scene at N balls (problems/bouncing_balls.hpp: the box grows with N to
+// keep the density, so a ball meets as many neighbours at every size): the integrator's
+// step, the gravity force and the end_of_step contact pass with its grid broad phase,
+// timed whole like every run (the scene's set-up is in it: about 3 % at N = 1e6). The
+// target: the cost per ball-step at 1e6 within 2x of that at 1000, where everything fits
+// in the caches.
+constexpr double balls_dt = 1e-3;
+constexpr int balls_steps = 8;
+constexpr long ball_counts[] = {1000, 10000, 100000, 1000000};
+
+// A family of cost against size: `problem` with its parameter `size` at state.range(0),
+// `steps` steps of `dt` a run with no samples recorded, timed whole; the counters
+// ns_per_<unit>_step and the size, and Google Benchmark's O(N) fit.
+struct size_family {
+  const char *problem, *size, *unit;
+  double dt;
+  int steps;
+  std::span<const long> sizes;
+  benchmark::TimeUnit time_unit;
+};
+
+void size_case(benchmark::State& state, const size_family& f, const std::string& method) {
   const long n = state.range(0);
-  auto problem = make_problem("spring_chain");
-  problem->set("masses", static_cast<double>(n));
-  const std::function<double()> run = problem->timed_run(method, scaling_dt, scaling_steps * scaling_dt, {});
+  auto problem = make_problem(f.problem);
+  problem->set(f.size, static_cast<double>(n));
+  if (const auto err = problem->validate(); !err.empty()) {
+    state.SkipWithError(err.c_str());
+    return;
+  }
+  const std::function<double()> run = problem->timed_run(method, f.dt, f.steps * f.dt, {});
   const auto start = std::chrono::steady_clock::now();
   for (auto _ : state) benchmark::DoNotOptimize(run());
   const double ns = std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - start).count();
-  const double mass_steps = static_cast<double>(state.iterations()) * scaling_steps * static_cast<double>(n);
-  state.counters["ns_per_mass_step"] = ns / mass_steps;
-  state.counters["masses"] = static_cast<double>(n);
+  const double unit_steps = static_cast<double>(state.iterations()) * f.steps * static_cast<double>(n);
+  state.counters[fmt::format("ns_per_{}_step", f.unit)] = ns / unit_steps;
+  state.counters[f.size] = static_cast<double>(n);
   state.SetComplexityN(n);
+}
+
+// The family's cases, one for each of our fixed-step methods that runs on the problem
+// (xpbd included) and `takes` it.
+template <class Takes>
+void register_family(const size_family& f, Takes takes) {
+  for (const auto& m : make_problem(f.problem)->methods()) {
+    if (m.origin != method_origin::ours || m.kind != method_kind::fixed_step || !takes(m)) continue;
+    auto* b = benchmark::RegisterBenchmark(fmt::format("{}/{}", f.problem, m.name).c_str(),
+                                           [&f, name = m.name](benchmark::State& state) { size_case(state, f, name); });
+    b->ArgName(f.size);
+    for (long n : f.sizes) b->Arg(n);
+    b->Complexity(benchmark::oN)->UseRealTime()->Unit(f.time_unit);
+  }
 }
 
 // STREAM's triad (McCalpin, "Memory Bandwidth and Machine Balance", IEEE TCCA newsletter
@@ -57,33 +99,33 @@ void triad(benchmark::State& state) {
   state.counters["doubles"] = static_cast<double>(n);
 }
 
-}  // namespace
-
 bool selected(const std::vector<std::string>& problems, const std::string& problem) {
   return problems.empty() || std::find(problems.begin(), problems.end(), problem) != problems.end();
 }
 
+}  // namespace
+
 void register_scaling(const std::vector<std::string>& problems) {
-  const bool chain = selected(problems, "spring_chain");
-  if (!chain && !selected(problems, "bouncing_balls")) return;
-  for (const auto& m : make_problem("spring_chain")->methods()) {  // ours that run on it, xpbd included
-    if (!chain || m.origin != method_origin::ours || m.kind != method_kind::fixed_step) continue;
-    auto* b = benchmark::RegisterBenchmark(fmt::format("spring_chain/{}", m.name).c_str(),
-                                           [name = m.name](benchmark::State& state) { chain_case(state, name); });
-    b->ArgName("masses");
-    for (long n : chain_sizes) b->Arg(n);
-    b->Complexity(benchmark::oN)->UseRealTime()->Unit(benchmark::kMicrosecond);
-  }
+  static const size_family chain{"spring_chain",         "masses", "mass", scaling_dt, scaling_steps, chain_sizes,
+                                 benchmark::kMicrosecond};
+  static const size_family balls{"bouncing_balls",       "balls", "ball", balls_dt, balls_steps, ball_counts,
+                                 benchmark::kMillisecond};
+  const bool chain_selected = selected(problems, "spring_chain"), balls_selected = selected(problems, "bouncing_balls");
+  if (chain_selected) register_family(chain, [](const method_info&) { return true; });
   // 2^25 doubles (256 MiB) an array: far beyond every cache of the machines here; and the
   // size of one vector of the 65536-mass chain's state (3 x 65536 doubles).
   // Of the machine, not a problem: every shard with a scaling family runs it, and `stepbench
   // merge --bench` keeps each shard's (store/bench_merge.hpp).
-  benchmark::RegisterBenchmark(std::string(stream_triad_benchmark).c_str(), triad)
-      ->ArgName("doubles")
-      ->Arg(1L << 25)
-      ->Arg(3L * 65536)
-      ->UseRealTime()
-      ->Unit(benchmark::kMillisecond);
+  if (chain_selected || balls_selected)
+    benchmark::RegisterBenchmark(std::string(stream_triad_benchmark).c_str(), triad)
+        ->ArgName("doubles")
+        ->Arg(1L << 25)
+        ->Arg(3L * 65536)
+        ->UseRealTime()
+        ->Unit(benchmark::kMillisecond);
+  // Explicit methods only: what a game steps a ball pit with. An implicit step would
+  // difference the 2N-coordinate force for its Jacobian (no analytic one here).
+  if (balls_selected) register_family(balls, [](const method_info& m) { return !m.traits.needs_jacobian; });
 }
 
 }  // namespace stepbench::bench

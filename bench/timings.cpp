@@ -3,7 +3,10 @@
 #include <sstream>
 
 namespace stepbench::bench {
+namespace {
 
+// The lines of a context header to show: every line but Google Benchmark's DEBUG-build
+// warning (all of them when `verbose`); only the "***WARNING***" lines when `warnings_only`.
 std::string shown_context(const std::string& header, bool warnings_only, bool verbose) {
   std::istringstream in(header);
   std::string out, line;
@@ -15,6 +18,8 @@ std::string shown_context(const std::string& header, bool warnings_only, bool ve
   }
   return out;
 }
+
+}  // namespace
 
 bool collecting_reporter::ReportContext(const Context& context) {
   cpu_scaling = context.cpu_info.scaling == benchmark::CPUInfo::ENABLED    ? 1

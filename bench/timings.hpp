@@ -38,8 +38,4 @@ class collecting_reporter : public benchmark::BenchmarkReporter {
   bool verbose_;
 };
 
-// The lines of a context header to show: every line but Google Benchmark's DEBUG-build
-// warning (all of them when `verbose`); only the "***WARNING***" lines when `warnings_only`.
-std::string shown_context(const std::string& header, bool warnings_only, bool verbose);
-
 }  // namespace stepbench::bench

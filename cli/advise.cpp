@@ -4,7 +4,6 @@
 
 #include <fmt/format.h>
 
-#include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "cli/args.hpp"
@@ -16,6 +15,13 @@
 #include "render/scan.hpp"
 #include "store/scan.hpp"
 #include "study/scan.hpp"
+
+namespace stepbench {
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(wp_pick, param, interpolated, force_evals, time_ns, error, cost, cost_lo, cost_hi,
+                                   diverged_rows)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(frame_option, method, substeps, completed, diverged, err_pos_max, cost_per_frame,
+                                   note)
+}  // namespace stepbench
 
 namespace stepbench::cli {
 namespace {
@@ -31,76 +37,26 @@ struct advise_args {
 
 json pick_json(const advice& a, const wp_pick& p) {
   const auto& m = a.methods[p.method];
-  return {{"method", m.name},
-          {"origin", to_string(m.origin)},
-          {"param_name", param_name(m.kind)},
-          {"param", p.param},
-          {"interpolated", p.interpolated},
-          {"force_evals", p.force_evals},
-          {"time_ns", p.time_ns},  // NaN (not timed) is written as null by nlohmann::json
-          {"error", p.error},
-          {"cost", p.cost},
-          {"cost_lo", p.cost_lo},
-          {"cost_hi", p.cost_hi},
-          {"diverged_rows", p.diverged_rows},
-          {"smallest_diverged", p.smallest_diverged ? json(*p.smallest_diverged) : json(nullptr)},
-          {"largest_diverged", p.largest_diverged ? json(*p.largest_diverged) : json(nullptr)}};
+  json out = p;  // NaN (time_ns when not timed) is written as null
+  out.update({{"method", m.name},
+              {"origin", to_string(m.origin)},
+              {"param_name", param_name(m.kind)},
+              {"smallest_diverged", p.smallest_diverged ? json(*p.smallest_diverged) : json(nullptr)},
+              {"largest_diverged", p.largest_diverged ? json(*p.largest_diverged) : json(nullptr)}});
+  return out;
 }
 
 json frame_advice_json(const frame_advice& f) {
-  auto option = [](const frame_option& o) {
-    return json{{"method", o.method},     {"substeps", o.substeps},       {"completed", o.completed},
-                {"diverged", o.diverged}, {"err_pos_max", o.err_pos_max}, {"cost_per_frame", o.cost_per_frame},
-                {"note", o.note}};
-  };
   json out = {{"problem", f.problem},     {"hz", f.hz},           {"tol", f.tol},  {"unit", f.unit},
               {"cost_kind", f.cost_kind}, {"horizon", f.horizon}, {"met", f.met()}};
-  out["choice"] = f.met() ? option(f.ranked.front()) : json(nullptr);
-  out["ranked"] = json::array();
-  for (const auto& o : f.ranked) out["ranked"].push_back(option(o));
-  out["one_step"] = json::array();
-  for (const auto& o : f.one_step) out["one_step"].push_back(option(o));
+  out["choice"] = f.met() ? json(f.ranked.front()) : json(nullptr);
+  out["ranked"] = f.ranked;
+  out["one_step"] = f.one_step;
   out["not_meeting"] = f.not_meeting;
   return out;
 }
 
-int run_advise(const advise_args& args) {
-  const double tol = parse_number(args.tol_text, "--tol");
-  if (!(tol > 0.0)) throw std::invalid_argument(fmt::format("--tol must be > 0, got {}", args.tol_text));
-  if (!args.scan.empty()) {
-    if (!args.hz_text.empty()) throw std::invalid_argument("--scan answers at the scan's frame rates; drop --hz");
-    const scan_result s = read_scan(args.scan, args.scan_name);
-    if (!args.problem.empty() && args.problem != s.options.problem)
-      throw std::invalid_argument(
-          fmt::format("the scan in '{}' is of {}, not {}", args.scan, s.options.problem, args.problem));
-    const scan_answer a = answer_scan(s, tol);
-    if (args.json)
-      std::cout << scan_answer_json(a).dump(2) << "\n";
-    else
-      fmt::print("{}", format_scan_answer(a));
-    for (const auto& c : a.choices)
-      if (!c.method.empty()) return 0;
-    return advise_exit_no_method;
-  }
-  if (args.problem.empty()) throw std::invalid_argument("--problem is required (or --scan FILE)");
-  if (!args.hz_text.empty()) {
-    const double hz = parse_number(args.hz_text, "--hz");
-    if (args.metric != "err_pos_max")
-      throw std::invalid_argument("--hz answers for err_pos_max only (the frame-rate study measures that)");
-    const frame_advice f = advise_frame(read_study(args.study), args.problem, hz, tol);
-    if (args.json)
-      std::cout << frame_advice_json(f).dump(2) << "\n";
-    else
-      fmt::print("{}", format_frame_advice(f));
-    return f.met() ? 0 : advise_exit_no_method;
-  }
-  const study s = read_study(args.study);
-  const advice a = advise(s, args.problem, args.metric, tol);
-  const int code = a.met() ? 0 : advise_exit_no_method;
-  if (!args.json) {
-    fmt::print("{}", format_advice(a));
-    return code;
-  }
+json advice_json(const advice& a) {
   const auto answer = a.result.answer(a.methods);
   json out = {{"problem", a.problem},  {"metric", a.metric}, {"tol", a.tol},  {"unit", a.unit},
               {"cost", a.result.cost}, {"timings", a.timed}, {"met", a.met()}};
@@ -112,8 +68,36 @@ int run_advise(const advise_args& args) {
   for (const auto& e : a.result.excluded)
     out["excluded"].push_back({{"method", a.methods[e.method].name}, {"reason", e.reason}});
   out["best_achieved"] = a.result.best_achieved ? pick_json(a, *a.result.best_achieved) : json(nullptr);
-  std::cout << out.dump(2) << "\n";
-  return code;
+  return out;
+}
+
+int run_advise(const advise_args& args) {
+  const double tol = parse_positive(args.tol_text, "--tol");
+  if (!args.scan.empty()) {
+    if (!args.hz_text.empty()) throw std::invalid_argument("--scan answers at the scan's frame rates; drop --hz");
+    const scan_result s = read_scan(args.scan, args.scan_name);
+    if (!args.problem.empty() && args.problem != s.options.problem)
+      throw std::invalid_argument(
+          fmt::format("the scan in '{}' is of {}, not {}", args.scan, s.options.problem, args.problem));
+    const scan_answer a = answer_scan(s, tol);
+    print_answer(args.json, scan_answer_json(a), format_scan_answer(a));
+    for (const auto& c : a.choices)
+      if (!c.method.empty()) return 0;
+    return advise_exit_no_method;
+  }
+  if (args.problem.empty()) throw std::invalid_argument("--problem is required (or --scan FILE)");
+  if (!args.hz_text.empty()) {
+    const double hz = parse_number(args.hz_text, "--hz");
+    if (args.metric != "err_pos_max")
+      throw std::invalid_argument("--hz answers for err_pos_max only (the frame-rate study measures that)");
+    const frame_advice f = advise_frame(read_study(args.study), args.problem, hz, tol);
+    print_answer(args.json, frame_advice_json(f), format_frame_advice(f));
+    return f.met() ? 0 : advise_exit_no_method;
+  }
+  const study s = read_study(args.study);
+  const advice a = advise(s, args.problem, args.metric, tol);
+  print_answer(args.json, advice_json(a), format_advice(a));
+  return a.met() ? 0 : advise_exit_no_method;
 }
 
 }  // namespace

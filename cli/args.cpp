@@ -18,6 +18,12 @@ double parse_number(std::string_view text, std::string_view what) {
   throw std::invalid_argument(fmt::format("{} must be a finite number, got '{}'", what, text));
 }
 
+double parse_positive(std::string_view text, std::string_view what) {
+  const double value = parse_number(text, what);
+  if (!(value > 0.0)) throw std::invalid_argument(fmt::format("{} must be > 0, got {}", what, text));
+  return value;
+}
+
 std::string count_of(long long n, std::string_view singular, std::string_view plural) {
   if (n == 1) return fmt::format("1 {}", singular);
   return plural.empty() ? fmt::format("{} {}s", n, singular) : fmt::format("{} {}", n, plural);
@@ -60,14 +66,15 @@ void add_override(parameter_overrides& out, std::string_view text, std::span<con
   out[problem][name] = value;
 }
 
-shard_choice parse_shard(std::string_view text) {
+void parse_shard(std::string_view text, int& index, int& count) {
   const auto slash = text.find('/');
   if (slash == std::string_view::npos) throw std::invalid_argument(fmt::format("--shard {}: expected K/N", text));
   const double k = parse_number(text.substr(0, slash), "--shard K");
   const double n = parse_number(text.substr(slash + 1), "--shard N");
   if (!(n >= 1 && n <= 1e6 && n == std::floor(n) && k >= 1 && k <= n && k == std::floor(k)))
     throw std::invalid_argument(fmt::format("--shard {}: K and N must be whole numbers with 1 <= K <= N", text));
-  return {static_cast<int>(k) - 1, static_cast<int>(n)};
+  index = static_cast<int>(k) - 1;
+  count = static_cast<int>(n);
 }
 
 }  // namespace stepbench

@@ -10,6 +10,8 @@ namespace stepbench {
 
 // Parses a finite double; throws std::invalid_argument("<what> must be a finite number, got '<text>'").
 double parse_number(std::string_view text, std::string_view what);
+// A number > 0, as parse_number; else throws std::invalid_argument("<what> must be > 0, got <text>").
+double parse_positive(std::string_view text, std::string_view what);
 
 // Parameter values by problem, then by parameter name: what every --set adds to.
 using parameter_overrides = std::map<std::string, std::map<std::string, double>>;
@@ -23,12 +25,9 @@ using parameter_overrides = std::map<std::string, std::map<std::string, double>>
 // parameter's declared constraint.
 void add_override(parameter_overrides& out, std::string_view text, std::span<const std::string> selected);
 
-// `--shard K/N`: shard K of N, 1 <= K <= N <= 10^6, as the 0-based index and the count.
+// `--shard K/N`: shard K of N, 1 <= K <= N <= 10^6, into the 0-based `index` and `count`.
 // Throws std::invalid_argument("--shard <text>: ...") on anything else.
-struct shard_choice {
-  int index = 0, count = 1;
-};
-shard_choice parse_shard(std::string_view text);
+void parse_shard(std::string_view text, int& index, int& count);
 
 // A count and its noun, the plural when the count is not one: "1 step", "2 steps",
 // "1 repetition"; `plural` for the irregular ones.

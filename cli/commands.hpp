@@ -2,9 +2,12 @@
 // The subcommands of `stepbench`, one file each. Each adds its options to the app and
 // returns the function that runs it; main() dispatches and turns exceptions into one
 // line and an exit code (2 bad usage: std::invalid_argument; 1 anything else).
+#include <fmt/format.h>
+
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <functional>
+#include <iostream>
 #include <nlohmann/json.hpp>
 
 namespace stepbench {
@@ -31,9 +34,12 @@ command add_schema(CLI::App& app);
 command add_scan(CLI::App& app);
 command add_merge(CLI::App& app);
 
-// A measured number as JSON: null where it is not finite (JSON has no NaN).
-inline nlohmann::json number_or_null(double v) {
-  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+// A command's answer on stdout: the JSON document (indented by two) with --json, else the text.
+inline void print_answer(bool as_json, const nlohmann::json& out, const std::string& text) {
+  if (as_json)
+    std::cout << out.dump(2) << "\n";
+  else
+    fmt::print("{}", text);
 }
 
 // The range answer of a scan as JSON (`scan --json`, `advise --scan --json`).

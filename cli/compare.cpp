@@ -18,15 +18,19 @@
 #include "render/verdict.hpp"
 #include "study/verdict.hpp"
 
+namespace stepbench {
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(verdict_agreement, both_decided, agree, decided_in_one, flips)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(timing_row, problem, method, param_name, param, ratio, threshold)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(timing_summary, method, problems, rows, min_ratio, max_ratio, slower, faster)
+}  // namespace stepbench
+
 namespace stepbench::cli {
 namespace {
 
 using json = nlohmann::json;
 
 struct compare_args {
-  std::string base, next;
-  std::string error_factor = "2", order_drop = "0.1";
-  std::string format = "text";
+  std::string base, next, error_factor = "2", order_drop = "0.1", format = "text";
   bool json = false, allow_removed = false, require_base = false, gate_timing = false;
 };
 
@@ -104,27 +108,20 @@ json comparison_json(const comparison& c) {
   out["removed"] = presence_json(c.removed);
   json timing = {
       {"compared", c.timing_compared}, {"note", c.timing_note}, {"rows", json::array()}, {"methods", json::array()}};
-  for (const auto& r : c.timing)
-    timing["rows"].push_back({{"problem", r.problem},
-                              {"method", r.method},
-                              {"param_name", r.param_name},
-                              {"param", r.param},
-                              {"old", side_json(r.old_time)},
-                              {"new", side_json(r.new_time)},
-                              {"ratio", r.ratio},
-                              {"threshold", r.threshold},
-                              {"flag", r.flag > 0   ? "slower"
-                                       : r.flag < 0 ? "faster"
-                                                    : ""}});
-  for (const auto& s : c.timing_summaries)
-    timing["methods"].push_back({{"method", s.method},
-                                 {"problems", s.problems},
-                                 {"rows", s.rows},
-                                 {"geomean_ratio", s.geomean},
-                                 {"min_ratio", s.min_ratio},
-                                 {"max_ratio", s.max_ratio},
-                                 {"slower", s.slower},
-                                 {"faster", s.faster}});
+  for (const auto& r : c.timing) {
+    json row = r;
+    row.update({{"old", side_json(r.old_time)},
+                {"new", side_json(r.new_time)},
+                {"flag", r.flag > 0   ? "slower"
+                         : r.flag < 0 ? "faster"
+                                      : ""}});
+    timing["rows"].push_back(std::move(row));
+  }
+  for (const auto& s : c.timing_summaries) {
+    json summary = s;
+    summary["geomean_ratio"] = s.geomean;
+    timing["methods"].push_back(std::move(summary));
+  }
   out["timing"] = std::move(timing);
   return out;
 }
@@ -151,11 +148,7 @@ int run_compare(const compare_args& a) {
       verdicts = compare_verdicts(*base_verdict, *next_verdict);
     if (format == "json") {
       json out = comparison_json(c);
-      if (verdicts)
-        out["verdicts"] = {{"both_decided", verdicts->both_decided},
-                           {"agree", verdicts->agree},
-                           {"decided_in_one", verdicts->decided_in_one},
-                           {"flips", verdicts->flips}};
+      if (verdicts) out["verdicts"] = *verdicts;
       std::cout << out.dump(2) << "\n";
     } else {
       std::cout << (format == "md" ? format_markdown(c) : format_text(c));

@@ -16,6 +16,12 @@
 #include "render/table_render.hpp"
 #include "study/energy.hpp"
 
+namespace stepbench {
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(energy_run, dt, steps, force_evals, completed, max_rel_err, final_rel_err,
+                                   drift_per_period, verdict, drift_sign, angmom_max_rel_err, angmom_drift_per_period,
+                                   note)
+}  // namespace stepbench
+
 namespace stepbench::cli {
 namespace {
 
@@ -24,8 +30,7 @@ using json = nlohmann::json;
 struct energy_args {
   bool json = false;
   double periods = 1e4;
-  std::vector<std::string> problems;
-  std::vector<std::string> sets;
+  std::vector<std::string> problems, sets;
 };
 
 std::string sci(double v) { return std::isfinite(v) ? fmt::format("{:.2e}", v) : "-"; }
@@ -54,24 +59,15 @@ int run_energy(const energy_args& a) {
   if (a.json) {
     json out = json::array();
     for (const auto& p : s.problems)
-      for (const auto& r : p.runs)
-        out.push_back({{"problem", p.problem},
-                       {"method", r.info.name},
-                       {"symplectic", r.info.traits.symplectic},
-                       {"dt", r.dt},
-                       {"steps_per_period", p.steps_per_period},
-                       {"periods", opts.periods},
-                       {"steps", r.steps},
-                       {"force_evals", r.force_evals},
-                       {"completed", r.completed},
-                       {"max_rel_err", number_or_null(r.max_rel_err)},
-                       {"final_rel_err", number_or_null(r.final_rel_err)},
-                       {"drift_per_period", number_or_null(r.drift_per_period)},
-                       {"verdict", r.verdict},
-                       {"drift_sign", r.drift_sign},
-                       {"angmom_max_rel_err", number_or_null(r.angmom_max_rel_err)},
-                       {"angmom_drift_per_period", number_or_null(r.angmom_drift_per_period)},
-                       {"note", r.note}});
+      for (const auto& r : p.runs) {
+        json run = r;  // NaN is written as null
+        run.update({{"problem", p.problem},
+                    {"method", r.info.name},
+                    {"symplectic", r.info.traits.symplectic},
+                    {"steps_per_period", p.steps_per_period},
+                    {"periods", opts.periods}});
+        out.push_back(std::move(run));
+      }
     std::cout << out.dump(2) << "\n";
     return 0;
   }

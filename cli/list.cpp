@@ -13,18 +13,16 @@
 #include "registry/registry.hpp"
 #include "render/table_render.hpp"
 
+namespace stepbench {
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(capabilities, symplectic, reuses_last_force, needs_jacobian, error_estimate,
+                                   dense_output)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(named_value, name, value, description)
+}  // namespace stepbench
+
 namespace stepbench::cli {
 namespace {
 
 using json = nlohmann::json;
-
-json capabilities_json(const capabilities& c) {
-  return {{"symplectic", c.symplectic},
-          {"reuses_last_force", c.reuses_last_force},
-          {"needs_jacobian", c.needs_jacobian},
-          {"error_estimate", c.error_estimate},
-          {"dense_output", c.dense_output}};
-}
 
 // The text form of the listing: the problems, their parameters, and the methods by origin,
 // each a table.
@@ -70,7 +68,7 @@ void print_list(const json& out) {
     for (const auto& m : all_methods()) {
       if (m.origin != origin) continue;
       std::string caps;
-      const json declared = capabilities_json(m.traits);  // named: items() of a temporary would dangle
+      const json declared = m.traits;  // named: items() of a temporary would dangle
       for (const auto& [key, on] : declared.items())
         if (on.get<bool>()) caps += (caps.empty() ? "" : ", ") + key;
       methods.add({m.name, std::string(to_string(m.kind)),
@@ -106,13 +104,10 @@ void print_list(const json& out) {
   fmt::print("\nParts of the study, in the order a study runs them (sweep --parts A,B runs only those):\n");
   for (const auto& p : out["parts"])
     fmt::print("  {:<12} {}\n", p["name"].get<std::string>(), p["summary"].get<std::string>());
-  fmt::print("Presets: {}\n", [&] {
-    std::string s;
-    for (const auto& p : out["presets"])
-      s += fmt::format("{}{} ({})", s.empty() ? "" : "; ", p["name"].get<std::string>(),
-                       p["summary"].get<std::string>());
-    return s;
-  }());
+  std::vector<std::string> presets;
+  for (const auto& p : out["presets"])
+    presets.push_back(fmt::format("{} ({})", p["name"].get<std::string>(), p["summary"].get<std::string>()));
+  fmt::print("Presets: {}\n", fmt::join(presets, "; "));
 }
 
 int run_list(bool as_json) {
@@ -120,18 +115,14 @@ int run_list(bool as_json) {
   for (const auto& name : problem_names()) {
     auto p = make_problem(name);
     json params = json::array();
-    for (const auto& q : p->params()) {
-      json names = json::array();
-      for (const auto& n : q.names)
-        names.push_back({{"name", n.name}, {"value", n.value}, {"description", n.description}});
+    for (const auto& q : p->params())
       params.push_back({{"name", q.name},
                         {"default", q.default_value},
                         {"unit", q.unit},
                         {"description", q.description},
                         {"kind", q.kind()},
                         {"allowed", q.allowed.text()},
-                        {"names", names}});
-    }
+                        {"names", q.names}});
     json methods = json::array();
     for (const auto& m : p->methods()) methods.push_back(m.name);
     out["problems"].push_back({{"name", name},
@@ -146,27 +137,25 @@ int run_list(bool as_json) {
                                {"methods", methods}});
   }
   for (const auto& m : all_methods()) {
-    json j = {{"name", m.name},
-              {"description", m.description},
-              {"origin", to_string(m.origin)},
-              {"kind", to_string(m.kind)},
-              {"library", m.library},
-              {"capabilities", capabilities_json(m.traits)}};
-    j["declared_order"] = number_or_null(m.declared_order);
-    j["evals_per_step"] = number_or_null(m.evals_per_step);
     json runs_on = json::array();
     for (const auto& p : out["problems"])
       if (std::ranges::find(p["methods"], json(m.name)) != p["methods"].end()) runs_on.push_back(p["name"]);
-    j["runs_on"] = runs_on;
-    out["methods"].push_back(j);
+    out["methods"].push_back({{"name", m.name},
+                              {"description", m.description},
+                              {"origin", to_string(m.origin)},
+                              {"kind", to_string(m.kind)},
+                              {"library", m.library},
+                              {"capabilities", m.traits},
+                              {"declared_order", m.declared_order},  // NaN is written as null
+                              {"evals_per_step", m.evals_per_step},
+                              {"runs_on", runs_on}});
   }
   for (const auto& p : study_parts()) out["parts"].push_back({{"name", p.name}, {"summary", p.summary}});
   for (const auto& p : study_presets()) out["presets"].push_back({{"name", p.name}, {"summary", p.summary}});
-  if (as_json) {
+  if (as_json)
     std::cout << out.dump(2) << "\n";
-    return 0;
-  }
-  print_list(out);
+  else
+    print_list(out);
   return 0;
 }
 

@@ -27,6 +27,13 @@
 #include "store/study_file.hpp"
 #include "study/loop.hpp"
 
+namespace stepbench {
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(loop_row, clock, frames, physics_steps, force_evals, shown_err_max, shown_err_rms,
+                                   final_shown_err, clock_dependence, physics_clock_dependence, judder, lag_s,
+                                   lag_clock_s, steps_per_frame_mean, steps_per_frame_max, stall_burst_steps,
+                                   clamp_hits, alpha_min, alpha_max, diverged, note)
+}  // namespace stepbench
+
 namespace stepbench::cli {
 namespace {
 
@@ -38,6 +45,21 @@ struct loop_args {
   std::vector<std::string> sets;
   bool json = false, quiet = false, strict = false;
 };
+
+// The options of one configuration (--design), in --help's order; each text is empty when not given.
+constexpr struct {
+  const char* name;
+  std::string loop_args::*text;
+  const char* help;
+} one_config_options[] = {
+    {"--display-hz", &loop_args::display_hz, "display rate [Hz] (default 60)"},
+    {"--physics-hz", &loop_args::physics_hz,
+     "physics rate [Hz]: dt = 1 / rate; substeps: ceil(rate / display) a frame (default 60)"},
+    {"--clamp", &loop_args::clamp, "frame-time clamp [s], or off (default 0.25)"},
+    {"--jitter", &loop_args::jitter, "jitter the frame times +-25 %, from this seed"},
+    {"--stall-at", &loop_args::stall_at, "a 1 s stall of the frame that begins at this wall time [s]"},
+    {"--step-cost", &loop_args::step_cost, "cost model: wall time of one physics step [ns] (default 1000)"},
+    {"--horizon", &loop_args::horizon, "end time [s] (default: the problem's)"}};
 
 loop_design parse_design(const std::string& text) {
   for (loop_design d : all_loop_designs)
@@ -85,22 +107,9 @@ loop_config one_loop_config(const loop_args& a, const problem_instance& problem,
   }
   if (!a.jitter.empty()) c.jitter_seed = parse_seed(a.jitter);
   if (!a.stall_at.empty()) c.stall_at_s = parse_number(a.stall_at, "--stall-at");
-  c.horizon = problem.horizon();
-  if (!a.horizon.empty()) {
-    c.horizon = parse_number(a.horizon, "--horizon");
-    if (!(c.horizon > 0.0)) throw std::invalid_argument(fmt::format("--horizon must be > 0, got {}", a.horizon));
-  }
+  c.horizon = a.horizon.empty() ? problem.horizon() : parse_positive(a.horizon, "--horizon");
   if (auto err = loop_config_error(c); !err.empty()) throw std::invalid_argument(err);
-
   return c;
-}
-
-// The stated cost of one physics step for the cost model [ns].
-double stated_step_cost_ns(const loop_args& a, const loop_options& opts) {
-  if (a.step_cost.empty()) return opts.stated_step_cost_ns;
-  const double cost_ns = parse_number(a.step_cost, "--step-cost");
-  if (!(cost_ns >= 0.0)) throw std::invalid_argument(fmt::format("--step-cost must be >= 0 ns, got {}", a.step_cost));
-  return cost_ns;
 }
 
 // The position (offset 0) or velocity (offset dim) part of a state (-0 as 0: printed "0").
@@ -113,71 +122,47 @@ std::vector<double> state_part(const std::vector<double>& y, int offset, int dim
 json one_loop_json(const loop_args& a, const problem_instance& problem, const loop_config& c, const loop_options& opts,
                    const loop_row& r, const loop_cost& cost) {
   const int dim = problem.dim();
-  auto part = [&](const std::vector<double>& y, int offset) { return state_part(y, offset, dim); };
-  const bool variable = c.design == loop_design::variable;
-  const std::string unit(problem.position_unit());
-  return {{"problem", a.problem},
-          {"integrator", a.method},
-          {"design", to_string(c.design)},
-          {"clock", r.clock},
-          {"display_hz", c.display_hz},
-          {"physics_hz", variable ? json(nullptr) : json(c.physics_hz)},
-          {"dt", uses_accumulator(c.design) ? json(c.dt()) : json(nullptr)},
-          {"substeps", c.design == loop_design::substeps ? json(c.substeps()) : json(nullptr)},
-          {"clamp_s", c.clamp_s > 0.0 ? json(c.clamp_s) : json(nullptr)},
-          {"jitter_seed", c.jitter_seed ? json(*c.jitter_seed) : json(nullptr)},
-          {"jitter", c.jitter_seed ? json(c.jitter) : json(nullptr)},
-          {"stall_at_s", number_or_null(c.stall_at_s)},
-          {"stall_s", c.stalls() ? json(c.stall_s) : json(nullptr)},
-          {"horizon", c.horizon},
-          {"position_unit", unit},
-          {"frames", r.frames},
-          {"physics_steps", r.physics_steps},
-          {"force_evals", r.force_evals},
-          {"final_physics_t", r.physics_t},
-          {"final_physics_position", part(r.final_physics, 0)},
-          {"final_physics_velocity", part(r.final_physics, dim)},
-          {"final_shown_position", part(r.final_shown, 0)},
-          {"shown_err_max", number_or_null(r.shown_err_max)},
-          {"shown_err_rms", number_or_null(r.shown_err_rms)},
-          {"final_shown_err", number_or_null(r.final_shown_err)},
-          {"reference_display_hz", opts.reference_display_hz},
-          {"clock_dependence", number_or_null(r.clock_dependence)},
-          {"physics_clock_dependence", number_or_null(r.physics_clock_dependence)},
-          {"judder", number_or_null(r.judder)},
-          {"lag_s", number_or_null(r.lag_s)},
-          {"lag_clock_s", number_or_null(r.lag_clock_s)},
-          {"steps_per_frame_mean", number_or_null(r.steps_per_frame_mean)},
-          {"steps_per_frame_max", r.steps_per_frame_max},
-          {"stall_burst_steps", r.stall_burst_steps},
-          {"clamp_hits", r.clamp_hits},
-          {"alpha_min", number_or_null(r.alpha_min)},
-          {"alpha_max", number_or_null(r.alpha_max)},
-          {"diverged", r.diverged},
-          {"note", r.note},
-          {"cost",
-           {{"step_cost_ns", cost.step_cost_ns},
-            {"source", a.step_cost.empty() ? "stated (default)" : "stated"},
-            {"frame_budget_ns", cost.schedule.frame_budget_s * 1e9},
-            {"worst_frame_work_ns", cost.schedule.worst_work_s * 1e9},
-            {"late_frames", cost.schedule.late_frames},
-            {"physics_load", cost.schedule.load},
-            {"wall_s", cost.schedule.wall_s},
-            {"outcome", to_string(cost.schedule.outcome)},
-            {"outcome_without_clamp", to_string(cost.without_clamp)},
-            {"clamp_prevented_spiral", cost.clamp_prevented_spiral}}}};
+  json out = r;  // NaN is written as null
+  out.update({{"problem", a.problem},
+              {"integrator", a.method},
+              {"design", to_string(c.design)},
+              {"display_hz", c.display_hz},
+              {"physics_hz", c.design == loop_design::variable ? json(nullptr) : json(c.physics_hz)},
+              {"dt", uses_accumulator(c.design) ? json(c.dt()) : json(nullptr)},
+              {"substeps", c.design == loop_design::substeps ? json(c.substeps()) : json(nullptr)},
+              {"clamp_s", c.clamp_s > 0.0 ? json(c.clamp_s) : json(nullptr)},
+              {"jitter_seed", c.jitter_seed ? json(*c.jitter_seed) : json(nullptr)},
+              {"jitter", c.jitter_seed ? json(c.jitter) : json(nullptr)},
+              {"stall_at_s", c.stall_at_s},
+              {"stall_s", c.stalls() ? json(c.stall_s) : json(nullptr)},
+              {"horizon", c.horizon},
+              {"position_unit", std::string(problem.position_unit())},
+              {"final_physics_t", r.physics_t},
+              {"final_physics_position", state_part(r.final_physics, 0, dim)},
+              {"final_physics_velocity", state_part(r.final_physics, dim, dim)},
+              {"final_shown_position", state_part(r.final_shown, 0, dim)},
+              {"reference_display_hz", opts.reference_display_hz},
+              {"cost",
+               {{"step_cost_ns", cost.step_cost_ns},
+                {"source", a.step_cost.empty() ? "stated (default)" : "stated"},
+                {"frame_budget_ns", cost.schedule.frame_budget_s * 1e9},
+                {"worst_frame_work_ns", cost.schedule.worst_work_s * 1e9},
+                {"late_frames", cost.schedule.late_frames},
+                {"physics_load", cost.schedule.load},
+                {"wall_s", cost.schedule.wall_s},
+                {"outcome", to_string(cost.schedule.outcome)},
+                {"outcome_without_clamp", to_string(cost.without_clamp)},
+                {"clamp_prevented_spiral", cost.clamp_prevented_spiral}}}});
+  return out;
 }
 
 void print_one_loop(const loop_args& a, const problem_instance& problem, const loop_config& c, const loop_options& opts,
                     const loop_row& r, const loop_cost& cost) {
-  const int dim = problem.dim();
-  auto part = [&](const std::vector<double>& y, int offset) { return state_part(y, offset, dim); };
-  const bool variable = c.design == loop_design::variable;
   const std::string unit(problem.position_unit());
   std::string clock = fmt::format("{:g} Hz display", c.display_hz);
   if (c.jitter_seed) clock += fmt::format(", frame times jittered +-{:g} % (seed {})", 100 * c.jitter, *c.jitter_seed);
   if (c.stalls()) clock += fmt::format(", a {:g} s stall at {:g} s", c.stall_s, c.stall_at_s);
-  std::string physics = variable ? "dt = the frame time"
+  std::string physics = c.design == loop_design::variable ? "dt = the frame time"
                         : c.design == loop_design::substeps
                             ? fmt::format("{} substeps a frame", c.substeps())
                             : fmt::format("physics {:g} Hz (dt {:.6g} s)", c.physics_hz, c.dt());
@@ -202,7 +187,8 @@ void print_one_loop(const loop_args& a, const problem_instance& problem, const l
       time_text(cost.schedule.worst_work_s), time_text(cost.schedule.frame_budget_s), cost.schedule.load,
       count_of(cost.schedule.late_frames, "late frame"), to_string(cost.schedule.outcome),
       to_string(cost.without_clamp));
-  fmt::print("  final physics      t = {:.10g} s, position {::.12g}\n", r.physics_t, part(r.final_physics, 0));
+  fmt::print("  final physics      t = {:.10g} s, position {::.12g}\n", r.physics_t,
+             state_part(r.final_physics, 0, problem.dim()));
   if (!r.note.empty()) fmt::print("  {}: {}\n", r.diverged ? "DIVERGED" : "NOTE", r.note);
 }
 
@@ -217,7 +203,9 @@ int run_one(const loop_args& a) {
     throw std::invalid_argument(fmt::format("problem {}: {}", a.problem, err));
   const loop_options opts;
   const loop_config c = one_loop_config(a, *problem, opts);
-  const double cost_ns = stated_step_cost_ns(a, opts);
+  // The stated cost of one physics step for the cost model [ns].
+  const double cost_ns = a.step_cost.empty() ? opts.stated_step_cost_ns : parse_number(a.step_cost, "--step-cost");
+  if (!(cost_ns >= 0.0)) throw std::invalid_argument(fmt::format("--step-cost must be >= 0 ns, got {}", a.step_cost));
   const loop_row r = run_loop_config(*problem, a.method, c, opts);
   const loop_cost cost = cost_verdict(c, cost_ns, "stated");
   if (a.json)
@@ -279,15 +267,9 @@ int run_study(const loop_args& a) {
 
 int run_loop_command(const loop_args& a) {
   if (!a.design.empty()) return run_one(a);
-  for (const auto& [given, name] : {std::pair{&a.display_hz, "--display-hz"},
-                                    {&a.physics_hz, "--physics-hz"},
-                                    {&a.clamp, "--clamp"},
-                                    {&a.jitter, "--jitter"},
-                                    {&a.stall_at, "--stall-at"},
-                                    {&a.step_cost, "--step-cost"},
-                                    {&a.horizon, "--horizon"}})
-    if (!given->empty())
-      throw std::invalid_argument(fmt::format("{} applies to one configuration: give --design", name));
+  for (const auto& o : one_config_options)
+    if (!(a.*o.text).empty())
+      throw std::invalid_argument(fmt::format("{} applies to one configuration: give --design", o.name));
   if (a.json) throw std::invalid_argument("--json applies to one configuration: give --design");
   return run_study(a);
 }
@@ -303,14 +285,7 @@ command add_loop(CLI::App& app) {
   sub->add_option("--set", a->sets, "override a parameter, problem.name=value or name=value (repeatable)");
   sub->add_option("--out", a->out, "the whole loop study of the pair into this study file (default results/loop.h5)");
   sub->add_option("--design", a->design, "one configuration: variable, fixed, interpolated or substeps");
-  sub->add_option("--display-hz", a->display_hz, "display rate [Hz] (default 60)");
-  sub->add_option("--physics-hz", a->physics_hz,
-                  "physics rate [Hz]: dt = 1 / rate; substeps: ceil(rate / display) a frame (default 60)");
-  sub->add_option("--clamp", a->clamp, "frame-time clamp [s], or off (default 0.25)");
-  sub->add_option("--jitter", a->jitter, "jitter the frame times +-25 %, from this seed");
-  sub->add_option("--stall-at", a->stall_at, "a 1 s stall of the frame that begins at this wall time [s]");
-  sub->add_option("--step-cost", a->step_cost, "cost model: wall time of one physics step [ns] (default 1000)");
-  sub->add_option("--horizon", a->horizon, "end time [s] (default: the problem's)");
+  for (const auto& o : one_config_options) sub->add_option(o.name, (*a).*o.text, o.help);
   sub->add_flag("--json", a->json, "print JSON (one configuration)");
   sub->add_flag("--quiet", a->quiet, "study form: print only the summary line");
   sub->add_flag("--strict", a->strict, "study form: exit 3 when a method failed on a case of its sweep");

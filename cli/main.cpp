@@ -26,11 +26,7 @@ int main(int argc, char** argv) {
                                       add_energy(app), add_schema(app),  add_scan(app),      add_merge(app)};
   try {
     app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForVersion& e) {
+  } catch (const CLI::Success& e) {  // --help, --help-all, --version: printed by exit()
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "stepbench: error: %s\n", e.what());

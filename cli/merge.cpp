@@ -74,13 +74,12 @@ int run_merge(const merge_args& a) {
   };
   std::vector<std::string> outputs{a.out};
   if (!a.bench_out.empty()) outputs.push_back(a.bench_out);
-  for (const auto& out : outputs) {
+  for (const auto& out : outputs)
     for (const auto* paths : {&a.inputs, &a.bench})
       for (const auto& path : *paths)
         if (same(path, out))
           throw std::invalid_argument(
               fmt::format("merge: the output '{}' is one of the shards; name another file", out));
-  }
   if (outputs.size() == 2 && same(a.out, a.bench_out))
     throw std::invalid_argument(fmt::format("merge: -o and --bench-out both name '{}'; name two files", a.out));
   for (std::size_t i = 0; i < a.bench.size(); ++i)
@@ -94,14 +93,13 @@ int run_merge(const merge_args& a) {
       throw std::invalid_argument(fmt::format("merge: '{}' was written by another build ({}) than '{}' ({})",
                                               a.inputs[i], b, a.inputs.front(), build));
   // Study shards (written by a sweep) or scan shards, not both.
-  std::vector<bool> study_shard;
-  for (const auto& path : a.inputs) study_shard.push_back(is_study_file(path));
+  const bool study_shards = is_study_file(a.inputs[0]);
   for (std::size_t i = 1; i < a.inputs.size(); ++i)
-    if (study_shard[i] != study_shard[0])
+    if (is_study_file(a.inputs[i]) != study_shards)
       throw std::invalid_argument(fmt::format("merge: '{}' is a {} and '{}' a {}; merge joins shards of one kind",
-                                              a.inputs[0], study_shard[0] ? "study shard" : "scan file", a.inputs[i],
-                                              study_shard[i] ? "study shard" : "scan file"));
-  if (study_shard[0]) return run_study_merge(a);
+                                              a.inputs[0], study_shards ? "study shard" : "scan file", a.inputs[i],
+                                              study_shards ? "scan file" : "study shard"));
+  if (study_shards) return run_study_merge(a);
   if (!a.bench.empty())
     throw std::invalid_argument("merge: --bench joins the benchmark JSON of timed study shards; these are scan files");
   std::map<std::string, std::vector<scan_result>> by_name;

@@ -14,6 +14,12 @@
 #include "core/measure.hpp"
 #include "registry/registry.hpp"
 
+namespace stepbench {
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(work_counters, force_evals, jacobian_evals, newton_iterations, linear_solves)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(run_metrics, err_pos_final, err_vel_final, err_pos_max, err_pos_rms, energy_drift,
+                                   diverged, failed)  // NaN is written as null
+}  // namespace stepbench
+
 namespace stepbench::cli {
 namespace {
 
@@ -25,54 +31,15 @@ struct run_args {
   bool json = false;
 };
 
-// What `run` was asked, checked: the problem with its --set overrides, the method, its
-// dt or tolerance, and the horizon. Throws std::invalid_argument naming the problem.
-struct run_request {
-  std::unique_ptr<problem_instance> problem;
-  const method_info* method = nullptr;
-  bool fixed = true;
-  double param = 0.0, horizon = 0.0;
-};
-
-run_request checked_request(const run_args& a) {
-  run_request r;
-  r.problem = make_problem(a.problem);
-  r.method = &find_method(a.method);
-  const method_info& m = *r.method;
-  parameter_overrides overrides;
-  for (const auto& s : a.sets) add_override(overrides, s, std::vector{a.problem});
-  for (const auto& [name, value] : overrides[a.problem]) r.problem->set(name, value);
-  if (auto err = r.problem->validate(); !err.empty())
-    throw std::invalid_argument(fmt::format("problem {}: {}", a.problem, err));
-  const bool fixed = r.fixed = m.kind == method_kind::fixed_step;
-  if (fixed && a.dt_text.empty())
-    throw std::invalid_argument(fmt::format("{} is a fixed-step method: give --dt", m.name));
-  if (!fixed && a.tol_text.empty()) throw std::invalid_argument(fmt::format("{} is adaptive: give --tol", m.name));
-  if (fixed && !a.tol_text.empty())
-    throw std::invalid_argument(fmt::format("{} is a fixed-step method: --tol does not apply", m.name));
-  if (!fixed && !a.dt_text.empty())
-    throw std::invalid_argument(fmt::format("{} is adaptive: --dt does not apply", m.name));
-  const double param = r.param = parse_number(fixed ? a.dt_text : a.tol_text, fixed ? "--dt" : "--tol");
-  if (!(param > 0.0))
-    throw std::invalid_argument(
-        fmt::format("{} must be > 0, got {}", fixed ? "--dt" : "--tol", fixed ? a.dt_text : a.tol_text));
-  if (!fixed && !(param < 1.0)) throw std::invalid_argument(fmt::format("--tol must be < 1, got {}", a.tol_text));
-  r.horizon = r.problem->horizon();
-  if (!a.horizon_text.empty()) {
-    r.horizon = parse_number(a.horizon_text, "--horizon");
-    if (!(r.horizon > 0.0)) throw std::invalid_argument(fmt::format("--horizon must be > 0, got {}", a.horizon_text));
-  }
-  if (fixed && param > r.horizon)
-    throw std::invalid_argument(
-        fmt::format("--dt {} s is longer than the horizon of {} ({:g} s): give a smaller --dt or a longer --horizon",
-                    a.dt_text, a.problem, r.horizon));
-  if (fixed && r.horizon / param > 1e9)
-    throw std::invalid_argument(fmt::format("--dt {} needs more than 1e9 steps to reach {}", param, r.horizon));
-  return r;
-}
-
 // One entry of a printed state: 12 significant digits, and never "-0".
 std::string entry(double x, int digits = 12) { return fmt::format("{:.{}g}", x == 0.0 ? 0.0 : x, digits); }
+
+// The Euclidean norm of a state, as printed (6 digits).
+std::string norm(const std::vector<double>& v) {
+  double sum = 0.0;
+  for (double x : v) sum += x * x;
+  return entry(std::sqrt(sum), 6);
+}
 
 // A state vector, printed once and compactly: every entry up to six, else the first and
 // last three (6 digits) with the count and the Euclidean norm.
@@ -86,26 +53,42 @@ std::string compact(const std::vector<double>& v) {
   for (std::size_t i = 0; i < ends; ++i) out += entry(v[i], 6) + ", ";
   out += "...";
   for (std::size_t i = v.size() - ends; i < v.size(); ++i) out += ", " + entry(v[i], 6);
-  double sum = 0.0;
-  for (double x : v) sum += x * x;
-  return out + fmt::format("] ({} entries, norm {})", v.size(), entry(std::sqrt(sum), 6));
+  return out + fmt::format("] ({} entries, norm {})", v.size(), norm(v));
 }
 
 // The computed vector and the true one: both in full when short; when long, the computed
 // one and the true one's norm (their difference is the error below).
 std::string with_truth(const std::vector<double>& y, const std::vector<double>& truth, const std::string& source) {
   if (y.size() <= 6) return fmt::format("{}   (true {}{})", compact(y), compact(truth), source);
-  double sum = 0.0;
-  for (double x : truth) sum += x * x;
-  return fmt::format("{}   (true: norm {}{})", compact(y), entry(std::sqrt(sum), 6), source);
+  return fmt::format("{}   (true: norm {}{})", compact(y), norm(truth), source);
 }
 
 int run_run(const run_args& a) {
-  const run_request req = checked_request(a);
-  const problem_instance& problem = *req.problem;
-  const method_info& m = *req.method;
-  const bool fixed = req.fixed;
-  const double param = req.param, horizon = req.horizon;
+  // What `run` was asked, checked: the problem with its --set overrides, the method, its
+  // dt or tolerance, and the horizon. Throws std::invalid_argument naming the problem.
+  const auto instance = make_problem(a.problem);
+  const method_info& m = find_method(a.method);
+  parameter_overrides overrides;
+  for (const auto& s : a.sets) add_override(overrides, s, std::vector{a.problem});
+  for (const auto& [name, value] : overrides[a.problem]) instance->set(name, value);
+  if (auto err = instance->validate(); !err.empty())
+    throw std::invalid_argument(fmt::format("problem {}: {}", a.problem, err));
+  const problem_instance& problem = *instance;
+  const bool fixed = m.kind == method_kind::fixed_step;
+  const char *kind = fixed ? "is a fixed-step method" : "is adaptive", *given = fixed ? "--dt" : "--tol";
+  if ((fixed ? a.dt_text : a.tol_text).empty())
+    throw std::invalid_argument(fmt::format("{} {}: give {}", m.name, kind, given));
+  if (!(fixed ? a.tol_text : a.dt_text).empty())
+    throw std::invalid_argument(fmt::format("{} {}: {} does not apply", m.name, kind, fixed ? "--tol" : "--dt"));
+  const double param = parse_positive(fixed ? a.dt_text : a.tol_text, given);
+  if (!fixed && !(param < 1.0)) throw std::invalid_argument(fmt::format("--tol must be < 1, got {}", a.tol_text));
+  const double horizon = a.horizon_text.empty() ? problem.horizon() : parse_positive(a.horizon_text, "--horizon");
+  if (fixed && param > horizon)
+    throw std::invalid_argument(
+        fmt::format("--dt {} s is longer than the horizon of {} ({:g} s): give a smaller --dt or a longer --horizon",
+                    a.dt_text, a.problem, horizon));
+  if (fixed && horizon / param > 1e9)
+    throw std::invalid_argument(fmt::format("--dt {} needs more than 1e9 steps to reach {}", param, horizon));
 
   // Fixed steps are measured at the grid times nearest j T / 32, so the run itself is
   // the one a user would make; adaptive runs at j T / 32 exactly.
@@ -125,7 +108,9 @@ int run_run(const run_args& a) {
     const std::vector<double> o = problem.observed(y);
     return std::vector<double>(o.begin() + offset, o.begin() + offset + dim);
   };
-  json out = {{"problem", a.problem},
+  json out = run.work;  // force_evals, jacobian_evals, newton_iterations, linear_solves
+  out.update(metrics);  // the errors, diverged and failed
+  out.update({{"problem", a.problem},
               {"integrator", m.name},
               {"origin", to_string(m.origin)},
               {"kind", to_string(m.kind)},
@@ -133,22 +118,11 @@ int run_run(const run_args& a) {
               {"horizon", horizon},
               {"steps", run.steps},
               {"rejected_steps", run.rejected_steps},
-              {"force_evals", run.work.force_evals},
-              {"jacobian_evals", run.work.jacobian_evals},
-              {"newton_iterations", run.work.newton_iterations},
-              {"linear_solves", run.work.linear_solves},
               {"position", part(run.final_y, 0)},
               {"velocity", part(run.final_y, dim)},
-              {"err_pos_final", metrics.err_pos_final},
-              {"err_vel_final", metrics.err_vel_final},
-              {"err_pos_max", metrics.err_pos_max},
-              {"err_pos_rms", metrics.err_pos_rms},
-              {"energy_drift", metrics.energy_drift},
-              {"diverged", metrics.diverged},
-              {"failed", metrics.failed},
               {"truth_source", truth.source},
               {"true_position", part(truth.y.back(), 0)},
-              {"true_velocity", part(truth.y.back(), dim)}};
+              {"true_velocity", part(truth.y.back(), dim)}});
   if (!metrics.note.empty()) out["note"] = metrics.note;
   if (a.json) {
     std::cout << out.dump(2) << "\n";

@@ -20,28 +20,6 @@
 #include "study/scan.hpp"
 
 namespace stepbench::cli {
-namespace {
-
-struct scan_args {
-  std::string problem, hz_text, dt_text, substeps_text, tol_text = "1e-3", name, out = "results/scan.h5";
-  std::string reference_budget_text, work_budget_text;
-  std::vector<std::string> params, sets, methods;
-  int jobs = 0;
-  std::string shard;  // K/N
-  bool json = false, quiet = false;
-};
-
-std::vector<double> number_list(const std::string& text, std::string_view what) {
-  std::vector<double> out;
-  for (std::size_t start = 0; start <= text.size();) {
-    const auto comma = std::min(text.find(',', start), text.size());
-    out.push_back(parse_number(std::string_view(text).substr(start, comma - start), what));
-    start = comma + 1;
-  }
-  return out;
-}
-
-}  // namespace
 
 nlohmann::json scan_answer_json(const scan_answer& a) {
   nlohmann::json out = {{"problem", a.problem},
@@ -69,6 +47,24 @@ nlohmann::json scan_answer_json(const scan_answer& a) {
 }
 
 namespace {
+
+struct scan_args {
+  std::string problem, hz_text, dt_text, substeps_text, tol_text = "1e-3", name, out = "results/scan.h5";
+  std::string reference_budget_text, work_budget_text, shard;  // shard: K/N
+  std::vector<std::string> params, sets, methods;
+  int jobs = 0;
+  bool json = false, quiet = false;
+};
+
+std::vector<double> number_list(const std::string& text, std::string_view what) {
+  std::vector<double> out;
+  for (std::size_t start = 0; start <= text.size();) {
+    const auto comma = std::min(text.find(',', start), text.size());
+    out.push_back(parse_number(std::string_view(text).substr(start, comma - start), what));
+    start = comma + 1;
+  }
+  return out;
+}
 
 int run_scan_command(const scan_args& a) {
   scan_options o;
@@ -106,11 +102,7 @@ int run_scan_command(const scan_args& a) {
       throw std::invalid_argument(fmt::format(
           "--reference-budget {} is not positive (inf: run the references everywhere)", o.reference_budget));
   }
-  if (!a.shard.empty()) {
-    const auto shard = parse_shard(a.shard);
-    o.shard_index = shard.index;
-    o.shard_count = shard.count;
-  }
+  if (!a.shard.empty()) parse_shard(a.shard, o.shard_index, o.shard_count);
   o.methods = a.methods;
   o.jobs = a.jobs;
   parameter_overrides sets;
@@ -139,10 +131,7 @@ int run_scan_command(const scan_args& a) {
   judge_study(s);
   write_study(s, a.out);
   const scan_answer answer = answer_scan(scan, o.tol);
-  if (a.json)
-    std::cout << scan_answer_json(answer).dump(2) << "\n";
-  else
-    fmt::print("{}", format_scan_answer(answer));
+  print_answer(a.json, scan_answer_json(answer), format_scan_answer(answer));
   if (!a.quiet)
     std::fputs(fmt::format("wrote {} (/scan/{}: {} points, {} runs) in {:.2f} s; `stepbench advise --scan {} --tol X` "
                            "answers at another tolerance\n",

@@ -16,26 +16,19 @@
 #include "render/table_render.hpp"
 #include "study/stability.hpp"
 
+namespace stepbench {
+inline void to_json(nlohmann::json& j, stability_test t) { j = to_string(t); }
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(stability_limit, integrator, test, measured, theory, unstable_for_all_dt,
+                                   unconditionally_stable, run_confirms, step_failed_at, note)
+}  // namespace stepbench
+
 namespace stepbench::cli {
 namespace {
-
-using json = nlohmann::json;
 
 int run_stability(bool as_json) {
   const stability_data d = compute_stability();
   if (as_json) {
-    json out = json::array();
-    for (const auto& l : d.limits)
-      out.push_back({{"integrator", l.integrator},
-                     {"test", to_string(l.test)},
-                     {"measured", number_or_null(l.measured)},
-                     {"theory", number_or_null(l.theory)},
-                     {"unstable_for_all_dt", l.unstable_for_all_dt},
-                     {"unconditionally_stable", l.unconditionally_stable},
-                     {"run_confirms", l.run_confirms},
-                     {"step_failed_at", number_or_null(l.step_failed_at)},
-                     {"note", l.note}});
-    std::cout << out.dump(2) << "\n";
+    std::cout << nlohmann::json(d.limits).dump(2) << "\n";  // NaN is written as null
     return 0;
   }
   const auto& s = d.settings;
@@ -57,21 +50,15 @@ int run_stability(bool as_json) {
            {"long runs"}},
           {}};
   for (const auto& l : d.limits) {
-    std::string theory, measured, diff;
-    if (l.unstable_for_all_dt) {
-      theory = "unstable";
-      measured = "-";
-      diff = "-";
-    } else if (l.unconditionally_stable) {
-      theory = "uncond.";
-      measured = "-";
-      diff = "-";
-    } else {
-      theory = std::isfinite(l.theory) ? fmt::format("{:.6f}", l.theory) : "no verdict";
-      measured = std::isfinite(l.measured) ? fmt::format("{:.6f}", l.measured) : "-";
-      diff = std::isfinite(l.rel_difference()) ? fmt::format("{:+.1e}", l.rel_difference()) : "-";
-    }
-    t.add({l.integrator, std::string(to_string(l.test)), theory, measured, diff,
+    // A method unstable, or stable, for every dt has no limit to measure.
+    const bool limit = !l.unstable_for_all_dt && !l.unconditionally_stable;
+    const std::string theory = l.unstable_for_all_dt      ? "unstable"
+                               : l.unconditionally_stable ? "uncond."
+                               : std::isfinite(l.theory)  ? fmt::format("{:.6f}", l.theory)
+                                                          : "no verdict";
+    t.add({l.integrator, std::string(to_string(l.test)), theory,
+           limit && std::isfinite(l.measured) ? fmt::format("{:.6f}", l.measured) : "-",
+           limit && std::isfinite(l.rel_difference()) ? fmt::format("{:+.1e}", l.rel_difference()) : "-",
            (l.run_confirms ? "" : "NOT CONFIRMED: ") + l.note});
   }
   fmt::print("{}", render_text(t, ""));

@@ -18,12 +18,9 @@ namespace {
 struct sweep_args {
   sweep_options opts;
   std::vector<std::string> sets;
-  std::string shard;  // K/N
-  std::string out = "results/study.h5";
-  bool quiet = false;
-  bool quick = false;
+  std::string shard, out = "results/study.h5";  // shard: K/N
   std::vector<std::string> parts;
-  bool strict = false;
+  bool quiet = false, quick = false, strict = false;
 };
 
 std::string observed(const method_study& ms) {
@@ -35,11 +32,7 @@ int run_sweep_command(sweep_args a) {
   for (const auto& s : a.sets) add_override(a.opts.overrides, s, a.opts.problems);
   if (a.quick) find_preset("quick").apply(a.opts);
   if (!a.parts.empty()) a.opts.parts = a.parts;
-  if (!a.shard.empty()) {
-    const auto shard = parse_shard(a.shard);
-    a.opts.shard_index = shard.index;
-    a.opts.shard_count = shard.count;
-  }
+  if (!a.shard.empty()) parse_shard(a.shard, a.opts.shard_index, a.opts.shard_count);
   a.opts.progress = !a.quiet;
   validate(a.opts);
   selected_parts(a.opts);

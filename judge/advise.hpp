@@ -33,8 +33,6 @@ struct advice {
 // (naming the problems it has), or a tol that is not a positive finite number.
 advice advise(const study& study, const std::string& problem, const std::string& metric, double tol);
 
-// The human-readable answer (several lines, ends with a newline).
-
 struct frame_advice {
   std::string problem, unit, cost_kind;  // cost_kind: time_ns or force_evals (per frame)
   double hz = 0.0, tol = 0.0, horizon = 0.0;

@@ -39,30 +39,40 @@ struct method_pair {
 };
 
 change problem_change(change_kind k, const problem_study& p, std::string what, compare_value old_value,
-                      compare_value new_value) {
-  change c;
-  c.kind = k;
-  c.problem = p.name;
-  c.what = std::move(what);
-  c.old_value = std::move(old_value);
-  c.new_value = std::move(new_value);
-  return c;
+                      compare_value new_value, double ratio = nan, std::string note = {}) {
+  return {k, p.name, "", "", nan, std::move(what), std::move(old_value), std::move(new_value), ratio, std::move(note)};
 }
 
 change row_change(change_kind k, const method_pair& mp, std::size_t new_row, std::string what, double old_value,
                   double new_value) {
-  change c;
-  c.kind = k;
-  c.problem = mp.next_problem.name;
-  c.method = mp.next.info.name;
-  c.param_name = std::string(param_name(mp.next.info.kind));
-  c.param = mp.next.rows[new_row].param;
-  c.what = std::move(what);
-  c.old_value = old_value;
-  c.new_value = new_value;
-  c.ratio = new_value / old_value;
-  c.note = mp.next.rows[new_row].metrics.note;
-  return c;
+  const method_row& r = mp.next.rows[new_row];
+  return {k,
+          mp.next_problem.name,
+          mp.next.info.name,
+          std::string(param_name(mp.next.info.kind)),
+          r.param,
+          std::move(what),
+          old_value,
+          new_value,
+          new_value / old_value,
+          r.metrics.note};
+}
+
+// Pairs the items of two lists by key: `both(b, n)` for each item of BASE that NEW has
+// too; what only one side has is listed, as `presence_of(item, "BASE" or "NEW")` says.
+template <class T, class Key, class Both, class Presence>
+void pair_up(const std::vector<T>& base, const std::vector<T>& next, Key key, Both both, Presence presence_of,
+             comparison& out) {
+  const auto find = [&](const std::vector<T>& in, const T& x) {
+    return std::find_if(in.begin(), in.end(), [&](const T& y) { return key(y) == key(x); });
+  };
+  for (const auto& b : base)
+    if (const auto n = find(next, b); n != next.end())
+      both(b, *n);
+    else
+      out.removed.push_back(presence_of(b, "BASE"));
+  for (const auto& n : next)
+    if (find(base, n) == base.end()) out.added.push_back(presence_of(n, "NEW"));
 }
 
 // The truth a problem's errors are measured against: its source and whether it is trusted.
@@ -77,87 +87,58 @@ void check_truth(const problem_pair& pp, comparison& out) {
 
 // The references: status (ok, failed, disagrees) and agreement with what they are compared with.
 void check_references(const problem_pair& pp, comparison& out) {
-  const auto &base = pp.base.truth.references, &next = pp.next.truth.references;
-  for (const auto& r : base) {
-    const auto it =
-        std::find_if(next.begin(), next.end(), [&](const reference_check& n) { return n.source == r.source; });
-    if (it == next.end()) {
-      out.removed.push_back({pp.base.name, "", "reference " + r.source, "status " + r.status + " in BASE"});
-      continue;
-    }
-    const reference_check& n = *it;
+  const auto both = [&](const reference_check& r, const reference_check& n) {
     const bool was_ok = r.status == "ok", is_ok = n.status == "ok";
-    if (was_ok != is_ok) {
-      auto c = problem_change(is_ok ? change_kind::improvement : change_kind::regression, pp.next,
-                              fmt::format("reference {} status", r.source), r.status, n.status);
-      c.note = n.reason;
-      out.changes.push_back(std::move(c));
-    }
-    if (r.compared_with != n.compared_with) continue;  // agreements with different things do not compare
+    if (was_ok != is_ok)
+      out.changes.push_back(problem_change(is_ok ? change_kind::improvement : change_kind::regression, pp.next,
+                                           fmt::format("reference {} status", r.source), r.status, n.status, nan,
+                                           n.reason));
+    if (r.compared_with != n.compared_with) return;  // agreements with different things do not compare
     for (const auto& [field, old_rel, new_rel] :
          {std::tuple{"err_pos_rel", r.vs.pos_rel, n.vs.pos_rel}, std::tuple{"err_vel_rel", r.vs.vel_rel, n.vs.vel_rel}})
-      if (const auto k = judge_agreement(old_rel, new_rel, pp.opts.error_factor)) {
-        auto c = problem_change(*k, pp.next, fmt::format("reference {} {}", r.source, field), old_rel, new_rel);
-        c.ratio = new_rel / old_rel;
-        c.note = fmt::format("vs {}", n.compared_with);
-        out.changes.push_back(std::move(c));
-      }
-  }
-  for (const auto& n : next)
-    if (std::none_of(base.begin(), base.end(), [&](const reference_check& r) { return r.source == n.source; }))
-      out.added.push_back({pp.next.name, "", "reference " + n.source, "status " + n.status + " in NEW"});
-}
-
-std::string param_list(const method_study& m, const std::vector<double>& params) {
-  std::string s;
-  for (double p : params) s += (s.empty() ? "" : ", ") + format_param(m.info.kind, p);
-  return s;
-}
-
-std::vector<double> params_of(const method_study& m) {
-  std::vector<double> out;
-  for (const auto& r : m.rows) out.push_back(r.param);
-  return out;
+      if (const auto k = judge_agreement(old_rel, new_rel, pp.opts.error_factor))
+        out.changes.push_back(problem_change(*k, pp.next, fmt::format("reference {} {}", r.source, field), old_rel,
+                                             new_rel, new_rel / old_rel, fmt::format("vs {}", n.compared_with)));
+  };
+  pair_up(
+      pp.base.truth.references, pp.next.truth.references, [](const reference_check& r) { return r.source; }, both,
+      [&](const reference_check& r, const char* side) {
+        return presence{pp.next.name, "", "reference " + r.source, fmt::format("status {} in {}", r.status, side)};
+      },
+      out);
 }
 
 // The ladder: rows are matched by their param, exactly. Rows only in BASE are removed,
 // rows only in NEW added; a method whose kind changed has no rows in common.
 void match_ladder(method_pair& mp, comparison& out) {
-  const auto bp = params_of(mp.base), np = params_of(mp.next);
-  const std::string& method = mp.next.info.name;
-  if (mp.base.info.kind != mp.next.info.kind) {
-    out.removed.push_back(
-        {mp.next_problem.name, method, "ladder",
-         fmt::format("was {} ({} rows), now {} ({} rows): no row compared", to_string(mp.base.info.kind), bp.size(),
-                     to_string(mp.next.info.kind), np.size())});
+  const method_study &base = mp.base, &next = mp.next;
+  if (base.info.kind != next.info.kind) {
+    out.removed.push_back({mp.next_problem.name, next.info.name, "ladder",
+                           fmt::format("was {} ({} rows), now {} ({} rows): no row compared", to_string(base.info.kind),
+                                       base.rows.size(), to_string(next.info.kind), next.rows.size())});
     return;
   }
-  std::vector<double> only_base, only_new;
-  for (std::size_t i = 0; i < bp.size(); ++i) {
-    const auto it = std::find(np.begin(), np.end(), bp[i]);
-    if (it == np.end())
-      only_base.push_back(bp[i]);
-    else
-      mp.rows.emplace_back(i, static_cast<std::size_t>(it - np.begin()));
-  }
-  for (double p : np)
-    if (std::find(bp.begin(), bp.end(), p) == bp.end()) only_new.push_back(p);
-  if (!only_base.empty())
-    out.removed.push_back({mp.next_problem.name, method, "ladder",
-                           fmt::format("ladder changed: {} of {} rows only in BASE ({}); {} compared", only_base.size(),
-                                       bp.size(), param_list(mp.base, only_base), mp.rows.size())});
-  if (!only_new.empty())
-    out.added.push_back({mp.next_problem.name, method, "ladder",
-                         fmt::format("ladder changed: {} of {} rows only in NEW ({}); {} compared", only_new.size(),
-                                     np.size(), param_list(mp.next, only_new), mp.rows.size())});
-}
-
-// The timesteps of a method's fitted levels.
-std::vector<double> fitted_params(const method_study& m) {
-  std::vector<double> out;
-  for (int level : m.fit.levels)
-    if (level >= 0 && static_cast<std::size_t>(level) < m.rows.size()) out.push_back(m.rows[level].param);
-  return out;
+  for (std::size_t i = 0; i < base.rows.size(); ++i)
+    for (std::size_t j = 0; j < next.rows.size(); ++j)
+      if (base.rows[i].param == next.rows[j].param) {
+        mp.rows.emplace_back(i, j);
+        break;
+      }
+  // The rows of `m` whose param `other` lacks.
+  const auto unmatched = [&](const method_study& m, const method_study& other, const char* side,
+                             std::vector<presence>& to) {
+    std::string params;
+    std::size_t n = 0;
+    for (const auto& r : m.rows)
+      if (std::none_of(other.rows.begin(), other.rows.end(), [&](const method_row& o) { return o.param == r.param; }))
+        params += (n++ ? ", " : "") + format_param(m.info.kind, r.param);
+    if (n > 0)
+      to.push_back({mp.next_problem.name, next.info.name, "ladder",
+                    fmt::format("ladder changed: {} of {} rows only in {} ({}); {} compared", n, m.rows.size(), side,
+                                params, mp.rows.size())});
+  };
+  unmatched(base, next, "BASE", out.removed);
+  unmatched(next, base, "NEW", out.added);
 }
 
 // The observed order of a fixed-step method (the fit of err_pos_max against dt). On the
@@ -170,29 +151,27 @@ void check_order(const method_pair& mp, comparison& out) {
   const bool same_ladder = mp.rows.size() == mp.base.rows.size() && mp.rows.size() == mp.next.rows.size();
   const fit_result &base = mp.base.fit, &next = mp.next.fit;
   const bool was = base.state == fit_result::status::fitted, is = next.state == fit_result::status::fitted;
-  change c;
-  c.problem = mp.next_problem.name;
-  c.method = mp.next.info.name;
+  const auto fitted_params = [](const method_study& m) {  // the timesteps of its fitted levels
+    std::vector<double> out;
+    for (int level : m.fit.levels)
+      if (level >= 0 && static_cast<std::size_t>(level) < m.rows.size()) out.push_back(m.rows[level].param);
+    return out;
+  };
+  const auto add = [&](change_kind k, std::string what, compare_value old_value, compare_value new_value,
+                       double ratio) {
+    out.changes.push_back({k, mp.next_problem.name, mp.next.info.name, "", nan, std::move(what), std::move(old_value),
+                           std::move(new_value), ratio, ""});
+  };
   if (was && is) {
     if (!same_ladder && fitted_params(mp.base) != fitted_params(mp.next)) return;
-    const auto k = judge_order(base.order, next.order, mp.opts.order_drop);
-    if (!k) return;
-    c.kind = *k;
-    c.what = "observed order";
-    c.old_value = base.order;
-    c.new_value = next.order;
-    c.ratio = next.order / base.order;
+    if (const auto k = judge_order(base.order, next.order, mp.opts.order_drop))
+      add(*k, "observed order", base.order, next.order, next.order / base.order);
   } else if (same_ladder && (was || (is && base.state == fit_result::status::insufficient))) {
     // Fitted and no longer is; or could not be fitted and now is. (From `exact` to fitted
     // is no improvement: the errors left round-off, which the row checks judge.)
-    c.kind = was ? change_kind::regression : change_kind::improvement;
-    c.what = "order fit";
-    c.old_value = to_string(base.state);
-    c.new_value = to_string(next.state);
-  } else {
-    return;
+    add(was ? change_kind::regression : change_kind::improvement, "order fit", std::string(to_string(base.state)),
+        std::string(to_string(next.state)), nan);
   }
-  out.changes.push_back(std::move(c));
 }
 
 // The flags that say a row has no result: diverged, failed, skipped over the work budget.
@@ -229,56 +208,41 @@ void check_rows(const method_pair& mp, comparison& out) {
   }
 }
 
-timing_side side(const method_study& m, std::size_t row) {
-  const timing& t = m.rows[row].time;
-  return {t.time_ns, t.time_ns_min, t.time_ns_max, t.repetitions};
-}
-
-bool timed_row(const method_study& m, std::size_t row) {
-  const timing& t = m.rows[row].time;
-  return std::isfinite(t.time_ns) && t.time_ns > 0 && t.repetitions >= 1 && !t.cut;
-}
-
 // Rows timed in both files: ratio, noise threshold, flag.
 void collect_timing(const method_pair& mp, comparison& out) {
+  const auto timed = [](const timing& t) {
+    return std::isfinite(t.time_ns) && t.time_ns > 0 && t.repetitions >= 1 && !t.cut;
+  };
+  const auto side = [](const timing& t) { return timing_side{t.time_ns, t.time_ns_min, t.time_ns_max, t.repetitions}; };
   if (!out.timing_compared) return;
   for (const auto& [i, j] : mp.rows) {
-    if (!timed_row(mp.base, i) || !timed_row(mp.next, j)) continue;
-    timing_row t{mp.next_problem.name,
-                 mp.next.info.name,
-                 std::string(param_name(mp.next.info.kind)),
-                 mp.next.rows[j].param,
-                 side(mp.base, i),
-                 side(mp.next, j),
-                 0.0,
-                 0.0,
-                 0};
-    t.ratio = t.new_time.median / t.old_time.median;
-    t.threshold = timing_threshold(t.old_time, t.new_time);
-    t.flag = judge_timing(t.ratio, t.threshold);
-    out.timing.push_back(std::move(t));
+    const timing &old_time = mp.base.rows[i].time, &new_time = mp.next.rows[j].time;
+    if (!timed(old_time) || !timed(new_time)) continue;
+    const timing_side o = side(old_time), n = side(new_time);
+    const double ratio = n.median / o.median, threshold = timing_threshold(o, n);
+    out.timing.push_back({mp.next_problem.name, mp.next.info.name, std::string(param_name(mp.next.info.kind)),
+                          mp.next.rows[j].param, o, n, ratio, threshold, judge_timing(ratio, threshold)});
   }
 }
 
 // Per method, over every problem: the geometric mean of its rows' ratios.
 void summarize_timing(comparison& out) {
-  std::map<std::string, timing_summary> by_method;
-  std::map<std::string, std::set<std::string>> problems;
-  std::map<std::string, double> log_sum;
+  std::map<std::string, std::tuple<timing_summary, std::set<std::string>, double>> by_method;  // problems, log sum
   for (const auto& t : out.timing) {
-    auto& s = by_method[t.method];
+    auto& [s, problems, log_sum] = by_method[t.method];
     s.method = t.method;
     s.min_ratio = s.rows == 0 ? t.ratio : std::min(s.min_ratio, t.ratio);
     s.max_ratio = s.rows == 0 ? t.ratio : std::max(s.max_ratio, t.ratio);
     ++s.rows;
     s.slower += t.flag > 0;
     s.faster += t.flag < 0;
-    problems[t.method].insert(t.problem);
-    log_sum[t.method] += std::log(t.ratio);
+    problems.insert(t.problem);
+    log_sum += std::log(t.ratio);
   }
-  for (auto& [name, s] : by_method) {
-    s.problems = problems[name].size();
-    s.geomean = std::exp(log_sum[name] / static_cast<double>(s.rows));
+  for (auto& [name, m] : by_method) {
+    auto& [s, problems, log_sum] = m;
+    s.problems = problems.size();
+    s.geomean = std::exp(log_sum / static_cast<double>(s.rows));
     out.timing_summaries.push_back(s);
   }
 }
@@ -288,21 +252,18 @@ constexpr method_check method_checks[] = {check_order, check_rows, collect_timin
 
 // The methods of a problem: present in one file only, or compared by every method check.
 void check_methods(const problem_pair& pp, comparison& out) {
-  for (const auto& m : pp.base.methods) {
-    const method_study* n = pp.next.find(m.info.name);
-    if (!n) {
-      out.removed.push_back(
-          {pp.base.name, m.info.name, "method", fmt::format("{}, {} rows", to_string(m.info.kind), m.rows.size())});
-      continue;
-    }
-    method_pair mp{pp.base, pp.next, m, *n, pp.opts, {}};
-    match_ladder(mp, out);
-    for (const auto check : method_checks) check(mp, out);
-  }
-  for (const auto& n : pp.next.methods)
-    if (!pp.base.find(n.info.name))
-      out.added.push_back(
-          {pp.next.name, n.info.name, "method", fmt::format("{}, {} rows", to_string(n.info.kind), n.rows.size())});
+  pair_up(
+      pp.base.methods, pp.next.methods, [](const method_study& m) { return m.info.name; },
+      [&](const method_study& m, const method_study& n) {
+        method_pair mp{pp.base, pp.next, m, n, pp.opts, {}};
+        match_ladder(mp, out);
+        for (const auto check : method_checks) check(mp, out);
+      },
+      [&](const method_study& m, const char*) {
+        return presence{pp.next.name, m.info.name, "method",
+                        fmt::format("{}, {} rows", to_string(m.info.kind), m.rows.size())};
+      },
+      out);
 }
 
 using problem_check = void (*)(const problem_pair&, comparison&);
@@ -437,16 +398,13 @@ std::vector<std::string> describe_thresholds(const compare_options& o) {
 }
 
 std::size_t comparison::count(change_kind k) const {
-  return static_cast<std::size_t>(
-      std::count_if(changes.begin(), changes.end(), [k](const change& c) { return c.kind == k; }));
+  return std::ranges::count_if(changes, [k](const change& c) { return c.kind == k; });
 }
 std::size_t comparison::slower() const {
-  return static_cast<std::size_t>(
-      std::count_if(timing.begin(), timing.end(), [](const timing_row& r) { return r.flag > 0; }));
+  return std::ranges::count_if(timing, [](auto& r) { return r.flag > 0; });
 }
 std::size_t comparison::faster() const {
-  return static_cast<std::size_t>(
-      std::count_if(timing.begin(), timing.end(), [](const timing_row& r) { return r.flag < 0; }));
+  return std::ranges::count_if(timing, [](auto& r) { return r.flag < 0; });
 }
 std::size_t comparison::gating() const {
   return count(change_kind::regression) + (options.require_base ? removed.size() : 0) +
@@ -458,36 +416,25 @@ std::size_t comparison::gating() const {
 // every dt or unstable for every dt, is a regression.
 void check_stability(const study& base_study, const study& next_study, comparison& out) {
   const auto& next = next_study.results.get<stability_data>().limits;
+  const auto flags = [](const stability_limit& l) {
+    return std::string(l.unconditionally_stable ? "unconditionally stable"
+                       : l.unstable_for_all_dt  ? "unstable for every dt"
+                                                : "finite limit");
+  };
   for (const auto& b : base_study.results.get<stability_data>().limits) {
     const auto it = std::find_if(next.begin(), next.end(),
                                  [&](const auto& n) { return n.integrator == b.integrator && n.test == b.test; });
     const std::string test(to_string(b.test));
     if (it == next.end()) {
       if (!next.empty()) out.removed.push_back({"stability", b.integrator, "limit " + test, "in BASE only"});
-      continue;
-    }
-    change c;
-    c.problem = "stability";
-    c.method = b.integrator;
-    auto flags = [](const stability_limit& l) {
-      return l.unconditionally_stable ? std::string("unconditionally stable")
-             : l.unstable_for_all_dt  ? std::string("unstable for every dt")
-                                      : std::string("finite limit");
-    };
-    if (flags(b) != flags(*it)) {
-      c.kind = change_kind::regression;
-      c.what = test + " stability";
-      c.old_value = flags(b);
-      c.new_value = flags(*it);
-      out.changes.push_back(c);
+    } else if (flags(b) != flags(*it)) {
+      out.changes.push_back({change_kind::regression, "stability", b.integrator, "", nan, test + " stability", flags(b),
+                             flags(*it), nan, ""});
     } else if (std::isfinite(b.theory) && std::isfinite(it->theory) &&
                std::abs(it->theory / b.theory - 1.0) > stability_tolerance) {
-      c.kind = change_kind::regression;
-      c.what = test + " stability limit (y = w dt or lambda dt)";
-      c.old_value = b.theory;
-      c.new_value = it->theory;
-      c.ratio = it->theory / b.theory;
-      out.changes.push_back(c);
+      out.changes.push_back({change_kind::regression, "stability", b.integrator, "", nan,
+                             test + " stability limit (y = w dt or lambda dt)", b.theory, it->theory,
+                             it->theory / b.theory, ""});
     }
   }
 }
@@ -526,19 +473,17 @@ comparison compare_studies(const study& base, const study& next, const compare_o
         if (d.what == k) differ += (differ.empty() ? "" : ", ") + d.what;
     if (!differ.empty()) out.timing_note = fmt::format("the files differ in {}: the ratios measure that too", differ);
   }
-  for (const auto& bp : base.problems) {
-    const problem_study* np = next.find(bp.name);
-    if (!np) {
-      out.removed.push_back({bp.name, "", "problem", plural(bp.methods.size(), "method", "methods")});
-      continue;
-    }
-    problem_differences(bp, *np, out);
-    const problem_pair pp{bp, *np, opts};
-    for (const auto check : problem_checks) check(pp, out);
-  }
-  for (const auto& np : next.problems)
-    if (!base.find(np.name))
-      out.added.push_back({np.name, "", "problem", plural(np.methods.size(), "method", "methods")});
+  pair_up(
+      base.problems, next.problems, [](const problem_study& p) { return p.name; },
+      [&](const problem_study& b, const problem_study& n) {
+        problem_differences(b, n, out);
+        const problem_pair pp{b, n, opts};
+        for (const auto check : problem_checks) check(pp, out);
+      },
+      [](const problem_study& p, const char*) {
+        return presence{p.name, "", "problem", plural(p.methods.size(), "method", "methods")};
+      },
+      out);
   check_stability(base, next, out);
   summarize_timing(out);
   return out;

@@ -1,17 +1,13 @@
 #pragma once
 // `stepbench compare BASE NEW`: did anything get worse between two study files?
 //
-// Accuracy is deterministic, so it gates: every figure of a (problem, method, row)
-// present in both files is put through a small decision function (an error growing, a
-// row newly diverging or failing, an observed order dropping, a reference or the truth
-// getting worse); each finding is a regression or an improvement. Timing is noisy, so it
-// informs: a row's time ratio is flagged only beyond a noise threshold derived from the
-// repetitions of both files, and gates only when asked (`gate_timing`).
-//
-// The checks are one function per group of the study file (truth, references, methods,
-// and within a method: its ladder, its order fit, its rows), called from one list in
-// compare.cpp, and check_stability for /stability; a new group is one more function
-// there. Comparing is this file's; drawing the result is render/compare_render.cpp's.
+// Accuracy is deterministic, so it gates: every figure of a (problem, method, row) in both
+// files goes through a decision function (an error growing, a row newly diverging or
+// failing, an observed order dropping, a reference or the truth getting worse); each
+// finding is a regression or an improvement. Timing is noisy, so it informs: a row's time
+// ratio is flagged only beyond a noise threshold from both files' repetitions, and gates
+// only when asked (`gate_timing`). The checks are one function per group of the study
+// file, called from one list in compare.cpp; render/compare_render.cpp draws the result.
 //
 // Exit status of the command: 0 nothing regressed, 1 a regression (or, with
 // gate_timing, a flagged slowdown), 2 could not compare (bad usage, a file read_study
@@ -43,8 +39,7 @@ inline constexpr double agreement_floor = 1e-13;
 // A stability limit (/stability/limits, theory) that moves by more than this regresses.
 inline constexpr double stability_tolerance = 0.01;
 
-// Timing noise (timing_noise_floor and the rest): core/work_precision.hpp, where the
-// equal-error verdict uses the same band.
+// Timing noise (timing_noise_floor and the rest): core/work_precision.hpp, shared with the equal-error verdict.
 
 struct compare_options {
   double error_factor = 2.0;  // an error or a reference's agreement growing by more than this regresses
@@ -142,17 +137,14 @@ struct comparison {
 // compared (different format versions), std::invalid_argument for bad options.
 comparison compare_studies(const study& base, const study& next, const compare_options& opts = {});
 
-// The decision functions, one per kind of figure (exposed for the tests).
-// An error of a row that completed in both files; floor: the round-off floor in its unit.
+// The decision functions, one per kind of figure (exposed for the tests): an error of a row
+// completed in both files (floor: the round-off floor in its unit), a reference's relative
+// agreement, an observed order (fit_slope of a fixed-step method, both fitted).
 std::optional<change_kind> judge_error(double old_err, double new_err, double floor, double factor);
-// A reference's agreement (relative).
 std::optional<change_kind> judge_agreement(double old_rel, double new_rel, double factor);
-// An observed order (fit_slope of a fixed-step method, both fitted).
 std::optional<change_kind> judge_order(double old_order, double new_order, double drop);
 // The noise threshold of a row timed in both files, and its flag (+1, -1, 0).
 double timing_threshold(const timing_side& old_time, const timing_side& new_time);
 int judge_timing(double ratio, double threshold);
-
-// The report of a comparison as text or Markdown: render/compare_render.hpp.
 
 }  // namespace stepbench

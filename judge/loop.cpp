@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 
 #include "core/number.hpp"
 #include "core/statistics.hpp"
@@ -40,30 +41,20 @@ std::vector<loop_cheapest> cheapest_designs(const loop_method& m, const loop_opt
   static constexpr std::array preference{loop_design::fixed, loop_design::interpolated, loop_design::substeps,
                                          loop_design::variable};
   auto rank = [](loop_design d) { return std::find(preference.begin(), preference.end(), d) - preference.begin(); };
+  // Fewest steps a frame, then the smaller error, then the design preferred.
+  const auto key = [&](const loop_row& r) {
+    return std::tuple(r.steps_per_frame_mean, r.shown_err_max, rank(r.config.design));
+  };
   std::vector<loop_cheapest> out;
   for (double hz : opts.display_hz) {
-    loop_cheapest c;
-    c.display_hz = hz;
-    c.target = opts.target;
-    c.physics_hz = c.steps_per_frame_mean = c.shown_err_max = nan;
     const loop_row* best = nullptr;
-    for (const auto& r : m.rows) {
-      if (r.clock != "constant" || r.config.display_hz != hz || r.diverged || !(r.shown_err_max <= opts.target))
-        continue;
-      if (!best || r.steps_per_frame_mean < best->steps_per_frame_mean ||
-          (r.steps_per_frame_mean == best->steps_per_frame_mean &&
-           (r.shown_err_max < best->shown_err_max ||
-            (r.shown_err_max == best->shown_err_max && rank(r.config.design) < rank(best->config.design)))))
+    for (const auto& r : m.rows)
+      if (r.clock == "constant" && r.config.display_hz == hz && !r.diverged && r.shown_err_max <= opts.target &&
+          (!best || key(r) < key(*best)))
         best = &r;
-    }
-    if (best) {
-      c.found = true;
-      c.design = to_string(best->config.design);
-      c.physics_hz = best->config.design == loop_design::variable ? nan : best->config.physics_hz;
-      c.steps_per_frame_mean = best->steps_per_frame_mean;
-      c.shown_err_max = best->shown_err_max;
-    }
-    out.push_back(std::move(c));
+    out.push_back({hz, opts.target, best != nullptr, best ? std::string(to_string(best->config.design)) : "",
+                   !best || best->config.design == loop_design::variable ? nan : best->config.physics_hz,
+                   best ? best->steps_per_frame_mean : nan, best ? best->shown_err_max : nan});
   }
   return out;
 }

@@ -10,25 +10,6 @@
 
 namespace stepbench {
 
-std::vector<std::string> failed_cases(const study& s) {
-  std::vector<std::string> out;
-  for (const auto& ps : s.problems) {
-    if (!ps.truth.trusted) continue;
-    for (const auto& ms : ps.methods)
-      for (const auto& r : ms.rows)
-        if (r.metrics.failed)
-          out.push_back(fmt::format("{}/{} at {} {:g}: {}", ps.name, ms.info.name, param_name(ms.info.kind), r.param,
-                                    r.metrics.note));
-  }
-  for (const auto& st : s.results.get<std::vector<substep_study>>())
-    for (const auto& m : st.methods)
-      for (const auto& r : m.rows)
-        if (r.row.metrics.failed)
-          out.push_back(
-              fmt::format("substeps/{}/{} at n = {}: {}", st.problem, m.info.name, r.substeps, r.row.metrics.note));
-  return out;
-}
-
 namespace {
 
 // The parameters of the failed rows: up to four named, else their range.
@@ -52,14 +33,18 @@ std::string reason_kind(std::string_view method, std::string_view note) {
   return std::string(note.substr(0, end));
 }
 
+// The failed rows of a method, each (param, metrics).
+using failed_rows = std::vector<std::pair<double, const run_metrics*>>;
+
 // "implicit_euler: 8 of 12 failed on kepler at dt 0.0368 to 0.000288: the orbit collapsed
 // (5), at periapsis (3); at dt 0.000288: <its whole reason>": the kinds with their counts,
 // then the reason at the finest parameter in full.
 std::string failure_line(std::string_view method, std::string_view where, std::string_view label,
-                         const std::vector<const run_metrics*>& failed, const std::vector<double>& params,
-                         std::size_t rows) {
+                         const failed_rows& failed, std::size_t rows) {
   std::vector<std::pair<std::string, int>> kinds;
-  for (const auto* m : failed) {
+  std::vector<double> params;
+  for (const auto& [param, m] : failed) {
+    params.push_back(param);
     const std::string k = reason_kind(method, m->note);
     auto it = std::find_if(kinds.begin(), kinds.end(), [&](const auto& e) { return e.first == k; });
     if (it == kinds.end())
@@ -70,68 +55,56 @@ std::string failure_line(std::string_view method, std::string_view where, std::s
   std::string counted;
   for (const auto& [k, n] : kinds) counted += fmt::format("{}{} ({})", counted.empty() ? "" : ", ", k, n);
   return fmt::format("{}: {} of {} failed on {} at {}: {}; at {} {:.3g}: {}", method, failed.size(), rows, where,
-                     failed_params(label, params), counted, label, params.back(), failed.back()->note);
+                     failed_params(label, params), counted, label, params.back(), failed.back().second->note);
 }
 
 }  // namespace
 
-std::vector<std::string> failure_summary(const study& s) {
-  std::vector<std::string> out;
+// The runs that failed (a solver error, a non-converging Newton iteration), summed up one
+// line per method and problem on stderr, and counted. Diverged and skipped runs are
+// outcomes the study records, not failures; a problem without a trusted truth is
+// reported as such instead.
+int report_study_outcome(const study& s, const char* program, bool strict) {
+  std::size_t failed = 0;
+  const auto report = [&](std::string_view method, const std::string& where, std::string_view label,
+                          const failed_rows& rows, std::size_t total) {
+    if (rows.empty()) return;
+    failed += rows.size();
+    std::fprintf(stderr, "%s: %s\n", program, failure_line(method, where, label, rows, total).c_str());
+  };
+  std::string untrusted;
   for (const auto& ps : s.problems) {
-    if (!ps.truth.trusted) continue;
+    if (!ps.truth.trusted) {
+      untrusted += (untrusted.empty() ? "" : ", ") + ps.name;
+      continue;
+    }
     for (const auto& ms : ps.methods) {
-      std::vector<const run_metrics*> failed;
-      std::vector<double> params;
+      failed_rows rows;
       for (const auto& r : ms.rows)
-        if (r.metrics.failed) {
-          failed.push_back(&r.metrics);
-          params.push_back(r.param);
-        }
-      if (!failed.empty())
-        out.push_back(failure_line(ms.info.name, ps.name, param_name(ms.info.kind), failed, params, ms.rows.size()));
+        if (r.metrics.failed) rows.emplace_back(r.param, &r.metrics);
+      report(ms.info.name, ps.name, param_name(ms.info.kind), rows, ms.rows.size());
     }
   }
   for (const auto& st : s.results.get<std::vector<substep_study>>())
     for (const auto& m : st.methods) {
-      std::vector<const run_metrics*> failed;
-      std::vector<double> params;
+      failed_rows rows;
       for (const auto& r : m.rows)
-        if (r.row.metrics.failed) {
-          failed.push_back(&r.row.metrics);
-          params.push_back(static_cast<double>(r.substeps));
-        }
-      if (!failed.empty())
-        out.push_back(failure_line(m.info.name, fmt::format("the substeps study of {}", st.problem), "substeps", failed,
-                                   params, m.rows.size()));
+        if (r.row.metrics.failed) rows.emplace_back(r.substeps, &r.row.metrics);
+      report(m.info.name, fmt::format("the substeps study of {}", st.problem), "substeps", rows, m.rows.size());
     }
-  return out;
-}
-
-int report_study_outcome(const study& s, const char* program, bool strict) {
-  const auto failed = failed_cases(s);
-  for (const auto& line : failure_summary(s)) std::fprintf(stderr, "%s: %s\n", program, line.c_str());
   // Every other problem has been measured and written; only then is a problem without a
   // trusted truth an error.
-  if (const auto bad = untrusted_problems(s); !bad.empty()) {
-    std::string names;
-    for (const auto& b : bad) names += (names.empty() ? "" : ", ") + b;
-    std::fprintf(stderr, "%s: error: no trusted truth for %s (errors recorded as NaN)\n", program, names.c_str());
+  if (!untrusted.empty()) {
+    std::fprintf(stderr, "%s: error: no trusted truth for %s (errors recorded as NaN)\n", program, untrusted.c_str());
     return 1;
   }
-  if (!failed.empty()) {
-    std::fprintf(stderr, "%s: %zu case%s failed, each recorded with its reason in the study file%s\n", program,
-                 failed.size(), failed.size() == 1 ? "" : "s",
+  if (failed > 0) {
+    std::fprintf(stderr, "%s: %zu case%s failed, each recorded with its reason in the study file%s\n", program, failed,
+                 failed == 1 ? "" : "s",
                  strict ? " (--strict: exit 3)" : ": findings of the study, not errors of the run");
     if (strict) return exit_failed_cases;
   }
   return 0;
-}
-
-std::vector<std::string> untrusted_problems(const study& s) {
-  std::vector<std::string> out;
-  for (const auto& ps : s.problems)
-    if (!ps.truth.trusted) out.emplace_back(ps.name);
-  return out;
 }
 
 }  // namespace stepbench

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 
+#include "core/number.hpp"
 #include "registry/registry.hpp"
 
 namespace stepbench {
@@ -48,15 +49,13 @@ scan_answer answer_scan(const scan_result& s, double tol) {
     std::vector<std::size_t> unstable;  // point indices
   };
   std::vector<combo> combos;
-  const auto find_combo = [&](double hz, const std::string& m, int n) -> combo& {
-    for (auto& c : combos)
-      if (c.hz == hz && c.method == m && c.substeps == n) return c;
-    combos.push_back({hz, m, n, 0, 0, 0, 0, 0.0, 0.0, {}});
-    return combos.back();
-  };
   for (const auto& r : s.runs) {
     const auto& p = s.points[r.point];
-    combo& c = find_combo(r.hz, r.method, r.substeps);
+    auto it = std::find_if(combos.begin(), combos.end(), [&](const combo& c) {
+      return c.hz == r.hz && c.method == r.method && c.substeps == r.substeps;
+    });
+    combo& c =
+        it != combos.end() ? *it : combos.emplace_back(combo{r.hz, r.method, r.substeps, 0, 0, 0, 0, 0.0, 0.0, {}});
     ++c.runs;
     const auto& m = r.row.metrics;
     if (m.diverged || m.failed) c.unstable.push_back(r.point);
@@ -69,7 +68,7 @@ scan_answer answer_scan(const scan_result& s, double tol) {
   }
   const std::size_t trusted = a.points - a.untrusted;
   for (double hz : s.options.hz) {
-    scan_choice best{hz, "", 0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
+    scan_choice best{hz, "", 0, nan, nan};
     for (const auto& c : combos) {
       // Within the tolerance at every point with a truth, and stable at every point.
       if (c.hz != hz || c.judged != trusted || c.within != trusted || trusted == 0 || c.runs != a.points ||

@@ -77,7 +77,7 @@ std::vector<substep_verdict> substep_verdicts(const substep_study& s, bool timed
       v.explicit_cost = v.explicit_error = v.explicit_damping = v.cost_to_match = nan;
       for (const auto& er : em.rows) {
         // Cost as run: a diverged run is still the cost of its steps (its errors are not).
-        const double c = by_time ? er.row.time.time_ns : static_cast<double>(er.row.work.force_evals);
+        const double c = cost_of(er.row, by_time);
         if (std::isfinite(c) && c <= v.implicit_cost && er.substeps > v.substeps_at_equal_cost) {
           v.substeps_at_equal_cost = er.substeps;
           v.explicit_cost = c;

@@ -16,8 +16,6 @@
 
 namespace stepbench {
 
-// The cost of a frame of a run: the measured ns per step times the steps of a frame
-// (timed), else the force evaluations of a frame.
 double cost_per_frame(const problem_study* ps, const frame_rate_study& fs, const frame_rate_run& r, bool timed) {
   const double frames = fs.horizon * r.hz;
   if (!timed) return static_cast<double>(r.row.work.force_evals) / frames;
@@ -67,16 +65,11 @@ std::vector<std::string> findings_of(const verdict_tables& v, const finding_inpu
   const bool timed = v.cost_kind == "time_ns";
   // Equal error.
   {
-    int ahead = 0, behind = 0, within = 0, bounded = 0, ours_only = 0, peers_only = 0;
+    std::map<std::string, int> n;  // by verdict
     const equal_error_verdict* best_win = nullptr;
     const equal_error_verdict* worst_loss = nullptr;
     for (const auto& e : v.equal_error) {
-      if (e.verdict == "ahead") ++ahead;
-      if (e.verdict == "behind") ++behind;
-      if (e.verdict == "within spread") ++within;
-      if (e.verdict == "bounded") ++bounded;
-      if (e.verdict == "ours only") ++ours_only;
-      if (e.verdict == "peers only") ++peers_only;
+      ++n[e.verdict];
       if (e.verdict == "ahead" && (!best_win || e.ratio < best_win->ratio)) best_win = &e;
       if (e.verdict == "behind" && (!worst_loss || e.ratio > worst_loss->ratio)) worst_loss = &e;
     }
@@ -85,8 +78,9 @@ std::vector<std::string> findings_of(const verdict_tables& v, const finding_inpu
         "fastest library peer: ahead on {}, behind on {}, within the {} on {}, undecided on {} (the side found "
         "cheaper only bounded: its ladder does not bracket the target) of the {} problem-and-target pairs both "
         "reach; only ours reach {}, only a peer {}.",
-        timed ? "measured time" : "force evaluations", ahead, behind, timed ? "timing noise" : "rounding", within,
-        bounded, ahead + behind + within + bounded, ours_only, peers_only);
+        timed ? "measured time" : "force evaluations", n["ahead"], n["behind"], timed ? "timing noise" : "rounding",
+        n["within spread"], n["bounded"], n["ahead"] + n["behind"] + n["within spread"] + n["bounded"], n["ours only"],
+        n["peers only"]);
     if (best_win)
       line += fmt::format(" Largest lead: {} on {} at {:g} {} ({:.2g}x the {} of {}).", best_win->ours.method,
                           best_win->problem, best_win->target, best_win->unit, best_win->ratio,
@@ -110,33 +104,25 @@ std::vector<std::string> findings_of(const verdict_tables& v, const finding_inpu
     else if (!std::isfinite(sv.explicit_error))
       line += fmt::format("one implicit_euler step costs as much as {} semi_implicit_euler substep{}, which diverge{}",
                           n, n == 1 ? "" : "s", n == 1 ? "s" : "");
-    else if (sv.explicit_error <= sv.implicit_error)
+    else {
+      const bool better = sv.explicit_error <= sv.implicit_error;
       line += fmt::format(
-          "{} semi_implicit_euler substep{} cost as much as one implicit_euler step and are {}x "
-          "more accurate",
-          n, n == 1 ? "" : "s", ratio_text(sv.implicit_error / sv.explicit_error));
-    else
-      line += fmt::format(
-          "{} semi_implicit_euler substep{} cost as much as one implicit_euler step and are {}x "
-          "less accurate",
-          n, n == 1 ? "" : "s", ratio_text(sv.explicit_error / sv.implicit_error));
+          "{} semi_implicit_euler substep{} cost as much as one implicit_euler step and are {}x {} accurate", n,
+          n == 1 ? "" : "s",
+          ratio_text(better ? sv.implicit_error / sv.explicit_error : sv.explicit_error / sv.implicit_error),
+          better ? "more" : "less");
+    }
     if (sv.substeps_to_match > 0) line += fmt::format("; {} substeps match its error", sv.substeps_to_match);
     out.push_back(line + ".");
   }
   // Declared orders that do not hold.
-  {
-    const auto& broken = in.broken_orders;
-    if (!broken.empty()) {
-      std::string names;
-      for (const auto& [m, ps] : broken)
-        names +=
-            fmt::format("{}{} on {} problem{}", names.empty() ? "" : ", ", m, ps.size(), ps.size() == 1 ? "" : "s");
-      out.push_back(
-          fmt::format("Library methods whose observed order differs from the order they declare: {}.", names));
-    } else {
-      out.push_back("Every library method's observed order matches its declared order where it can be fitted.");
-    }
-  }
+  std::string broken;
+  for (const auto& [m, ps] : in.broken_orders)
+    broken += fmt::format("{}{} on {} problem{}", broken.empty() ? "" : ", ", m, ps.size(), ps.size() == 1 ? "" : "s");
+  out.push_back(
+      broken.empty()
+          ? "Every library method's observed order matches its declared order where it can be fitted."
+          : fmt::format("Library methods whose observed order differs from the order they declare: {}.", broken));
   // xpbd's stability and energy over its dt ladder (at a 60 Hz frame, the substep
   // ladder): the claim that rigid links stay stable at every substep count, and
   // XPBD's projection only removing energy, as the study's own runs show them. The energy
@@ -189,21 +175,16 @@ std::vector<std::string> findings_of(const verdict_tables& v, const finding_inpu
           method, parts));
   }
   // Stability at 60 Hz, one step a frame.
-  {
-    std::map<std::string, std::vector<std::string>> unstable;  // problem -> methods
-    for (const auto& f : v.frame_rate)
-      if (f.hz == 60.0 && !f.stable) unstable[f.problem].push_back(f.method);
-    const bool any_60 =
-        std::any_of(v.frame_rate.begin(), v.frame_rate.end(), [](const auto& f) { return f.hz == 60.0; });
-    if (!any_60) {
-    } else if (unstable.empty()) {
-      out.push_back("At 60 Hz, one step a frame, every fixed-step method of ours stays stable on every problem.");
-    } else {
-      std::string parts;
-      for (const auto& [p, ms] : unstable)
-        parts += fmt::format("{}{}: {}", parts.empty() ? "" : "; ", p, fmt::join(ms, ", "));
-      out.push_back(fmt::format("At 60 Hz, one step a frame, these diverge or fail: {}.", parts));
-    }
+  std::map<std::string, std::vector<std::string>> unstable;  // problem -> methods
+  for (const auto& f : v.frame_rate)
+    if (f.hz == 60.0 && !f.stable) unstable[f.problem].push_back(f.method);
+  if (!unstable.empty()) {
+    std::string parts;
+    for (const auto& [p, ms] : unstable)
+      parts += fmt::format("{}{}: {}", parts.empty() ? "" : "; ", p, fmt::join(ms, ", "));
+    out.push_back(fmt::format("At 60 Hz, one step a frame, these diverge or fail: {}.", parts));
+  } else if (std::any_of(v.frame_rate.begin(), v.frame_rate.end(), [](const auto& f) { return f.hz == 60.0; })) {
+    out.push_back("At 60 Hz, one step a frame, every fixed-step method of ours stays stable on every problem.");
   }
   return out;
 }
@@ -262,17 +243,9 @@ verdict_tables compute_verdict(const study& s) {
         if (methods[p.method].origin == method_origin::ours && !ours) ours = &p;
         if (methods[p.method].origin == method_origin::peer && !peer) peer = &p;
       }
-      equal_error_verdict e;
-      e.problem = ps.name;
-      e.unit = unit;
-      e.target = target;
-      e.ours = cost_of(methods, ours);
-      e.peer = cost_of(methods, peer);
-      e.ratio = ours && peer ? ours->cost / peer->cost : nan;
-      e.cost_kind = r.cost;
-      e.verdict = verdict_of(e.ours, e.peer, r.cost == "time_ns");
-      e.best_error = std::isfinite(best_error) ? best_error : nan;
-      v.equal_error.push_back(std::move(e));
+      const cost_at_error o = cost_of(methods, ours), q = cost_of(methods, peer);
+      v.equal_error.push_back({ps.name, unit, target, o, q, ours && peer ? ours->cost / peer->cost : nan, r.cost,
+                               verdict_of(o, q, r.cost == "time_ns"), std::isfinite(best_error) ? best_error : nan});
     }
   }
   for (const auto& fs : s.results.get<std::vector<frame_rate_study>>()) {

@@ -25,14 +25,9 @@ std::string where(const wp_method& m, const wp_pick& p) {
 }
 
 std::string label(const wp_method& m) {
-  switch (m.origin) {
-    case method_origin::peer:
-      return m.name + " (peer)";
-    case method_origin::baseline:
-      return m.name + " (baseline, for scale)";
-    default:
-      return m.name;
-  }
+  return m.origin == method_origin::peer       ? m.name + " (peer)"
+         : m.origin == method_origin::baseline ? m.name + " (baseline, for scale)"
+                                               : m.name;
 }
 
 }  // namespace

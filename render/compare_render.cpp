@@ -146,6 +146,53 @@ std::string findings(const comparison& c, table_format f) {
   return out;
 }
 
+// The whole report. Markdown (a CI job summary) opens with the verdict and folds the
+// thresholds and the per-method timing away; text keeps the order of reading.
+std::string report(const comparison& c, table_format f) {
+  const bool md = f == table_format::markdown;
+  std::string out;
+  if (md) {
+    out = fmt::format("## stepbench compare: {}\n\n**{}** (exit {})\n\n", verdict(c), summary_line(c), c.exit_status());
+    table files{{{""}, {"file"}, {"build"}}, {}};
+    files.add({"BASE", "`" + c.base_path + "`", file_line(c.base_meta, c.base_timed)});
+    files.add({"NEW", "`" + c.new_path + "`", file_line(c.new_meta, c.new_timed)});
+    out += render_markdown(files);
+  } else {
+    out = fmt::format("stepbench compare\n  BASE {}\n       {}\n  NEW  {}\n       {}\n", c.base_path,
+                      file_line(c.base_meta, c.base_timed), c.new_path, file_line(c.new_meta, c.new_timed));
+    out += fmt::format("\nResult: {} (exit {}): {}\n", verdict(c), c.exit_status(), summary_line(c));
+  }
+  if (c.differences.empty())
+    out += "\nThe files agree in machine, build and settings.\n";
+  else
+    out += (md ? "\n### The files differ in\n\n" : "\nThe files differ in (results may differ for these reasons):\n") +
+           render(differences_table(c), f);
+  if (!md) {
+    out += "\nThresholds:\n";
+    for (const auto& line : describe_thresholds(c.options)) out += wrap(line, "  - ", "    ");
+  }
+  out += findings(c, f);
+  if (!c.timing_compared) {
+    out += md ? fmt::format("\n### Timing\n\nNot compared ({}).\n", c.timing_note)
+              : fmt::format("\nTiming: not compared ({})\n", c.timing_note);
+  } else {
+    out += md ? fmt::format("\n### Timing\n\n{}\n\n", timing_heading(c)) : wrap(timing_heading(c), "\nTiming: ", "  ");
+    if (c.slower() + c.faster() > 0) out += render(timing_flagged_table(c), f);
+    const std::string title =
+        "Timing per method (geometric mean of new/old over its rows timed in both, every problem)";
+    if (!c.timing_summaries.empty())
+      out += md ? "\n<details><summary>" + title + "</summary>\n\n" + render_markdown(timing_summary_table(c)) +
+                      "\n</details>\n"
+                : "\n" + title + ":\n" + render_text(timing_summary_table(c));
+  }
+  if (md) {
+    out += "\n<details><summary>Thresholds</summary>\n\n";
+    for (const auto& line : describe_thresholds(c.options)) out += "- " + line + "\n";
+    out += "\n</details>\n";
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string summary_line(const comparison& c) {
@@ -163,56 +210,7 @@ std::string summary_line(const comparison& c) {
   return s;
 }
 
-std::string format_text(const comparison& c) {
-  std::string out = fmt::format("stepbench compare\n  BASE {}\n       {}\n  NEW  {}\n       {}\n", c.base_path,
-                                file_line(c.base_meta, c.base_timed), c.new_path, file_line(c.new_meta, c.new_timed));
-  out += fmt::format("\nResult: {} (exit {}): {}\n", verdict(c), c.exit_status(), summary_line(c));
-  out += c.differences.empty()
-             ? "\nThe files agree in machine, build and settings.\n"
-             : "\nThe files differ in (results may differ for these reasons):\n" + render_text(differences_table(c));
-  out += "\nThresholds:\n";
-  for (const auto& line : describe_thresholds(c.options)) out += wrap(line, "  - ", "    ");
-  out += findings(c, table_format::text);
-  if (!c.timing_compared) {
-    out += fmt::format("\nTiming: not compared ({})\n", c.timing_note);
-    return out;
-  }
-  out += wrap(timing_heading(c), "\nTiming: ", "  ");
-  if (c.slower() + c.faster() > 0) out += render_text(timing_flagged_table(c));
-  if (!c.timing_summaries.empty()) {
-    out += "\nTiming per method (geometric mean of new/old over its rows timed in both, every problem):\n";
-    out += render_text(timing_summary_table(c));
-  }
-  return out;
-}
-
-std::string format_markdown(const comparison& c) {
-  std::string out = fmt::format("## stepbench compare: {}\n\n", verdict(c));
-  out += fmt::format("**{}** (exit {})\n\n", summary_line(c), c.exit_status());
-  table files{{{""}, {"file"}, {"build"}}, {}};
-  files.add({"BASE", "`" + c.base_path + "`", file_line(c.base_meta, c.base_timed)});
-  files.add({"NEW", "`" + c.new_path + "`", file_line(c.new_meta, c.new_timed)});
-  out += render_markdown(files);
-  if (c.differences.empty())
-    out += "\nThe files agree in machine, build and settings.\n";
-  else
-    out += "\n### The files differ in\n\n" + render_markdown(differences_table(c));
-  out += findings(c, table_format::markdown);
-  if (!c.timing_compared) {
-    out += fmt::format("\n### Timing\n\nNot compared ({}).\n", c.timing_note);
-  } else {
-    out += fmt::format("\n### Timing\n\n{}\n\n", timing_heading(c));
-    if (c.slower() + c.faster() > 0) out += render_markdown(timing_flagged_table(c));
-    if (!c.timing_summaries.empty())
-      out +=
-          "\n<details><summary>Timing per method (geometric mean of new/old over its rows timed in both, every "
-          "problem)</summary>\n\n" +
-          render_markdown(timing_summary_table(c)) + "\n</details>\n";
-  }
-  out += "\n<details><summary>Thresholds</summary>\n\n";
-  for (const auto& line : describe_thresholds(c.options)) out += "- " + line + "\n";
-  out += "\n</details>\n";
-  return out;
-}
+std::string format_text(const comparison& c) { return report(c, table_format::text); }
+std::string format_markdown(const comparison& c) { return report(c, table_format::markdown); }
 
 }  // namespace stepbench

@@ -71,32 +71,24 @@ std::string render(const table& t, table_format format, std::string_view indent)
 }
 
 std::string wrap(std::string_view text, std::string_view first, std::string_view rest, std::size_t width) {
-  std::string out(first), word;
+  std::string out(first);
   std::size_t col = first.size();
   bool line_empty = true;
-  const auto put = [&] {
-    if (word.empty()) return;
+  for (std::size_t start = 0, end; start <= text.size(); start = end + 1) {
+    end = std::min(text.find(' ', start), text.size());
+    const std::string_view word = text.substr(start, end - start);
+    if (word.empty()) continue;
     if (!line_empty && col + 1 + word.size() > width) {
-      out += "\n";
-      out += rest;
+      (out += "\n") += rest;
       col = rest.size();
-      line_empty = true;
-    }
-    if (!line_empty) {
+    } else if (!line_empty) {
       out += ' ';
       ++col;
     }
     out += word;
     col += word.size();
     line_empty = false;
-    word.clear();
-  };
-  for (char ch : text)
-    if (ch == ' ')
-      put();
-    else
-      word += ch;
-  put();
+  }
   return out + "\n";
 }
 

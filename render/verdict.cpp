@@ -12,13 +12,6 @@
 namespace stepbench {
 namespace {
 
-std::string hz_text(double hz) { return fmt::format("{:g} Hz", hz); }
-
-// "rk4 x4" for four substeps, "rk4" for one.
-std::string with_substeps(const std::string& method, int n) {
-  return n == 1 ? method : fmt::format("{} x{}", method, n);
-}
-
 std::string cost_text(const std::string& kind, double c) {
   if (!std::isfinite(c)) return "-";
   return kind == "time_ns" ? format_time_ns(c) : fmt::format("{:.3g} evals", c);
@@ -93,16 +86,17 @@ std::string format_verdict_text(const verdict_tables& v) {
         std::string cell = "none <= x64";
         for (const auto& a : v.frame_answers)
           if (a.problem == p && a.hz == 60.0 && a.target == t && !a.method.empty())
-            cell = with_substeps(a.method, a.substeps) + " " + cost_text(v.cost_kind, a.cost_per_frame);
+            cell = (a.substeps == 1 ? a.method : fmt::format("{} x{}", a.method, a.substeps)) + " " +
+                   cost_text(v.cost_kind, a.cost_per_frame);
         row.push_back(cell);
       }
       tb.add(row);
     }
     out += fmt::format(
-        "\nAt {} (a frame of 16.7 ms): our fixed-step methods stable at one step a frame, and the cheapest method "
+        "\nAt 60 Hz (a frame of 16.7 ms): our fixed-step methods stable at one step a frame, and the cheapest method "
         "x substeps a frame whose err_pos_max meets each target, with its {} per frame "
         "(stepbench advise --problem P --hz HZ --tol X for other rates and targets).\n",
-        hz_text(60), timed ? "measured time" : "force evaluations");
+        timed ? "measured time" : "force evaluations");
     out += render_text(tb);
   }
   out += "\nFindings:\n";

@@ -70,8 +70,7 @@ int cvode_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) noexcep
 int cvode_band_jacobian(sunrealtype t, N_Vector y, N_Vector, SUNMatrix jac, void* user_data, N_Vector, N_Vector,
                         N_Vector) noexcept {
   auto& st = *static_cast<cvode_callback_state*>(user_data);
-  if (st.error) return -1;
-  try {
+  const bool ok = st.guarded([&] {
     SUNMatZero(jac);
     const std::size_t dim = static_cast<std::size_t>(st.sys->n) / 2;
     for (std::size_t c = 0; c < dim; ++c) SM_ELEMENT_B(jac, 2 * c, 2 * c + 1) = 1.0;
@@ -79,25 +78,15 @@ int cvode_band_jacobian(sunrealtype t, N_Vector y, N_Vector, SUNMatrix jac, void
       SM_ELEMENT_B(jac, 2 * i + 1, 2 * j) = kx;
       SM_ELEMENT_B(jac, 2 * i + 1, 2 * j + 1) = kv;
     });
-  } catch (...) {
-    st.error = std::current_exception();
-    return -1;
-  }
-  return 0;
+  });
+  return ok ? 0 : -1;
 }
 
 // The contact gap as CVODE's root function (CVRootFn, user guide 6.x): one root, the
 // smallest signed distance of the problem's contacts.
 int cvode_contact_root(sunrealtype t, N_Vector y, sunrealtype* gout, void* user_data) noexcept {
   auto& st = *static_cast<cvode_callback_state*>(user_data);
-  if (st.error) return -1;
-  try {
-    gout[0] = st.sys->contact_gap(t, st.plain(N_VGetArrayPointer(y)));
-  } catch (...) {
-    st.error = std::current_exception();
-    return -1;
-  }
-  return 0;
+  return st.guarded([&] { gout[0] = st.sys->contact_gap(t, st.plain(N_VGetArrayPointer(y))); }) ? 0 : -1;
 }
 
 // Owns every SUNDIALS handle; members are freed in reverse order of creation on every path.

@@ -48,13 +48,7 @@ struct callback_state {
   // failures instead.
   bool evaluate(double t, std::span<const double> y, std::span<double> dydt) noexcept {
     ++calls;
-    if (error || non_finite) return false;
-    try {
-      sys->rhs(t, y, dydt);
-    } catch (...) {
-      error = std::current_exception();
-      return false;
-    }
+    if (non_finite || !guarded([&] { sys->rhs(t, y, dydt); })) return false;
     for (const double d : dydt)
       if (!std::isfinite(d)) {
         non_finite = true;
@@ -66,6 +60,20 @@ struct callback_state {
   bool evaluate(double t, const double* y, double* dydt) noexcept {
     const auto n = static_cast<std::size_t>(sys->n);
     return evaluate(t, std::span<const double>(y, n), std::span<double>(dydt, n));
+  }
+
+  // f() inside a library callback: false when an earlier callback failed or f throws (the
+  // exception is stashed).
+  template <class F>
+  bool guarded(F&& f) noexcept {
+    if (error) return false;
+    try {
+      f();
+    } catch (...) {
+      error = std::current_exception();
+      return false;
+    }
+    return true;
   }
 
   // "<source>: <call> failed, flag <flag> (<name>)" and what the callbacks saw.

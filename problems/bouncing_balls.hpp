@@ -105,25 +105,8 @@ struct bouncing_balls {
   // default_ball_scene's construction, in the scaled box (see above).
   phase<vec> initial() const {
     ensure_workspace();
-    const int n = count();
-    const double w = width(), h = height(), r = radius;
-    const int cols = static_cast<int>(std::ceil(std::sqrt(n * w / h)));
-    const int rows = (n + cols - 1) / cols;
-    const double cw = w / cols, ch = h / rows;
-    const double jx = 0.5 * (0.5 * cw - r), jz = 0.5 * (0.5 * ch - r), vmax = 2.0;
-    std::mt19937_64 rng(static_cast<std::uint64_t>(seed));
-    auto symmetric = [&](double amp) { return amp * (2.0 * exact::unit_draw(rng) - 1.0); };
-    vec x(dim()), v(dim());
-    for (int i = 0; i < n; ++i) {
-      const double cx = ((i % cols) + 0.5) * cw, cz = ((i / cols) + 0.5) * ch;
-      const double dx = symmetric(jx), dz = symmetric(jz);
-      x[2 * i] = cx + dx;
-      x[2 * i + 1] = cz + dz;
-      const double vx = symmetric(vmax), vz = symmetric(vmax);
-      v[2 * i] = vx;
-      v[2 * i + 1] = vz;
-    }
-    return {x, v};
+    const auto s = scene();
+    return {interleaved(s.x0), interleaved(s.v0)};
   }
 
   void force(double, const vec&, const vec&, vec& f) const {
@@ -153,11 +136,7 @@ struct bouncing_balls {
     s.restitution = restitution;
     s.friction = friction;
     s.mass = mass_kg;
-    const auto start = initial();
-    for (int i = 0; i < s.n; ++i) {
-      s.x0.emplace_back(start.x[2 * i], start.x[2 * i + 1]);
-      s.v0.emplace_back(start.v[2 * i], start.v[2 * i + 1]);
-    }
+    exact::place_on_grid(s, static_cast<std::uint64_t>(seed));
     return s;
   }
   exact::event_driven_balls truth() const {
@@ -169,12 +148,7 @@ struct bouncing_balls {
   phase<vec> exact(double t) const {
     auto sim = truth();
     sim.advance_to(t);
-    vec x(dim()), v(dim());
-    for (int i = 0; i < count(); ++i) {
-      x.segment<2>(2 * i) = sim.positions()[static_cast<std::size_t>(i)];
-      v.segment<2>(2 * i) = sim.velocities()[static_cast<std::size_t>(i)];
-    }
-    return {x, v};
+    return {interleaved(sim.positions()), interleaved(sim.velocities())};
   }
   // The number of exact contacts (walls and pairs) up to t_end; with many balls their
   // order is not comparable contact by contact, so no times or positions.
@@ -197,7 +171,6 @@ struct bouncing_balls {
       const double xi = x[2 * i], zi = x[2 * i + 1];
       gap = std::min({gap, xi - r, w - r - xi, zi - r, h - r - zi});
     }
-    build_grid(x);
     for_each_near_pair(
         x, [&](int i, int j) { gap = std::min(gap, (x.segment<2>(2 * j) - x.segment<2>(2 * i)).norm() - 2.0 * r); });
     return gap;
@@ -207,7 +180,6 @@ struct bouncing_balls {
     ensure_workspace();
     contact_outcome c;
     const double r = radius, kr = restitution, kf = friction, reach = 2.0 * r;
-    build_grid(x);
     for_each_near_pair(x, [&](int i, int j) {
       const Eigen::Vector2d d = x.segment<2>(2 * j) - x.segment<2>(2 * i);
       const double dist2 = d.squaredNorm();
@@ -261,6 +233,12 @@ struct bouncing_balls {
   bool locate_contacts() const { return false; }
 
  private:
+  // Per-ball (x, z) pairs as the state's interleaved coordinates.
+  static vec interleaved(const std::vector<exact::vec2>& balls) {
+    vec out(2 * static_cast<Eigen::Index>(balls.size()));
+    for (std::size_t i = 0; i < balls.size(); ++i) out.segment<2>(2 * static_cast<Eigen::Index>(i)) = balls[i];
+    return out;
+  }
   void note_depth(contact_outcome& c, double depth) const {
     c.depth = std::max(c.depth, depth);
     if (depth > radius) ++c.tunnelled;
@@ -304,11 +282,12 @@ struct bouncing_balls {
       order_[static_cast<std::size_t>(cursor_[static_cast<std::size_t>(cell_of_[static_cast<std::size_t>(i)])]++)] = i;
   }
 
-  // f(i, j) for every pair of balls in the same or adjacent cells, each pair once (a cell
-  // with itself, then with its neighbours right, below-left... as the half stencil
+  // f(i, j) for every pair of balls at x in the same or adjacent cells, each pair once (a
+  // cell with itself, then with its neighbours right, below-left... as the half stencil
   // (+1, 0), (-1, +1), (0, +1), (+1, +1)).
   template <class F>
-  void for_each_near_pair(const vec&, F&& f) const {
+  void for_each_near_pair(const vec& x, F&& f) const {
+    build_grid(x);
     constexpr int stencil[4][2] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
     for (int cy = 0; cy < ny_; ++cy)
       for (int cx = 0; cx < nx_; ++cx) {

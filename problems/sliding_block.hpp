@@ -104,29 +104,26 @@ struct incline_block {
   const exact::friction_record* record() const {
     return material >= 1 ? &exact::friction_table[static_cast<std::size_t>(material) - 1] : nullptr;
   }
+  // The table's mu_s or mu_k (kinetic) in the chosen column.
+  const std::optional<double>& table_cell(const exact::friction_record& r, bool kinetic) const {
+    if (lubricated != 0.0) return kinetic ? r.mu_k_lubricated : r.mu_s_lubricated;
+    return kinetic ? r.mu_k_dry : r.mu_s_dry;
+  }
   // The coefficients in force: the table's (material > 0) or the parameters'.
-  double static_coefficient() const {
-    if (const auto* r = record()) return *(lubricated != 0.0 ? r->mu_s_lubricated : r->mu_s_dry);
-    return mu_s;
-  }
-  double kinetic_coefficient() const {
-    if (const auto* r = record()) return *(lubricated != 0.0 ? r->mu_k_lubricated : r->mu_k_dry);
-    return mu_k;
-  }
+  double static_coefficient() const { return record() ? *table_cell(*record(), false) : mu_s; }
+  double kinetic_coefficient() const { return record() ? *table_cell(*record(), true) : mu_k; }
 
   // What no single parameter's constraint says: a material pair excludes mu_s and mu_k,
   // and the table must hold both coefficients in the chosen column.
   std::string scene_check() const {
     if (const auto* r = record()) {
       if (mu_s != Scene::mu_s || mu_k != Scene::mu_k) return "give either material or mu_s and mu_k, not both";
-      const bool lub = lubricated != 0.0;
-      const auto& s = lub ? r->mu_s_lubricated : r->mu_s_dry;
-      const auto& k = lub ? r->mu_k_lubricated : r->mu_k_dry;
+      const auto &s = table_cell(*r, false), &k = table_cell(*r, true);
       if (!s || !k)
         return fmt::format(
             "the lecture's table has no {} coefficient for {} ({}); choose another pair or give mu_s "
             "and mu_k",
-            !s ? "static" : "kinetic", exact::friction_name(*r), lub ? "lubricated" : "dry");
+            !s ? "static" : "kinetic", exact::friction_name(*r), lubricated != 0.0 ? "lubricated" : "dry");
     }
     return {};
   }

@@ -16,7 +16,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <exception>
 #include <stdexcept>
 #include <string>
@@ -27,17 +26,10 @@
 namespace stepbench {
 namespace {
 
-using arkode_callback_state = detail::callback_state;
-
+// -1: unrecoverable (ARKRhsFn, user guide 5.x).
 int arkode_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) noexcept {
-  auto& st = *static_cast<arkode_callback_state*>(user_data);
-  ++st.calls;
-  if (st.error || st.non_finite) return -1;
-  const auto n = static_cast<std::size_t>(st.sys->n);
-  double* dydt = N_VGetArrayPointer(ydot);
-  // -1: unrecoverable (ARKRhsFn, user guide 5.x).
-  if (!st.evaluate(t, std::span<const double>(N_VGetArrayPointer(y), n), std::span<double>(dydt, n))) return -1;
-  return 0;
+  auto& st = *static_cast<detail::callback_state*>(user_data);
+  return st.evaluate(t, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot)) ? 0 : -1;
 }
 
 struct arkode_handles {
@@ -83,18 +75,12 @@ reference_solution solve_arkode_erk(const ode_system& sys, std::span<const doubl
     throw std::invalid_argument(source + ": the fixed step must be finite and >= 0 (0: adaptive)");
   detail::validate_reference_input(source, sys, times, tol);
   const auto start = std::chrono::steady_clock::now();
-  arkode_callback_state st;
+  detail::callback_state st;
   st.sys = &sys;
   arkode_handles h;
   const auto fail = [&](const std::string& call, int flag) {
-    // ERKStepGetReturnFlagName returns a malloc'd string the caller frees (arkode_io.c).
-    char* name = ERKStepGetReturnFlagName(flag);
-    std::string what =
-        source + ": " + call + " failed, flag " + std::to_string(flag) + " (" + (name ? name : "?") + ")";
-    std::free(name);
-    if (st.non_finite) what += "; right-hand side returned a non-finite value at t=" + detail::num(st.non_finite_t);
-    if (!st.last_message.empty()) what += "; " + st.last_message;
-    throw std::runtime_error(what);
+    throw std::runtime_error(
+        st.failure(source, call, flag, detail::sundials_flag_name(ERKStepGetReturnFlagName(flag))));
   };
   const auto check = [&](const char* call, int flag) {
     if (flag != 0) fail(call, flag);
@@ -106,7 +92,7 @@ reference_solution solve_arkode_erk(const ode_system& sys, std::span<const doubl
   h.mem = ERKStepCreate(&arkode_rhs, 0.0, h.y, h.ctx);
   if (!h.mem) throw std::runtime_error(source + ": ERKStepCreate returned null");
   check("ERKStepSetErrHandlerFn",
-        ERKStepSetErrHandlerFn(h.mem, &detail::keep_sundials_message<arkode_callback_state, ARK_WARNING>, &st));
+        ERKStepSetErrHandlerFn(h.mem, &detail::keep_sundials_message<detail::callback_state, ARK_WARNING>, &st));
   check("ERKStepSetUserData", ERKStepSetUserData(h.mem, &st));
   check("ERKStepSetOrder", ERKStepSetOrder(h.mem, order));
   check("ERKStepSStolerances", ERKStepSStolerances(h.mem, tol.rtol, tol.atol));

@@ -17,7 +17,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <exception>
 #include <stdexcept>
 #include <string>
@@ -56,23 +55,14 @@ void to_solver_layout(const cvode_callback_state& st, std::span<const double> pl
 }
 
 // Every call of f, including those of the difference-quotient Jacobian, goes through here.
+// A failure is unrecoverable: negative, CVODE stops (user guide 6.x, CVRhsFn).
 int cvode_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) noexcept {
   auto& st = *static_cast<cvode_callback_state*>(user_data);
-  ++st.calls;
-  // Once failed, fail every later call too. SUNDIALS 6.4.1's fixed-point solver (Adams) turns
-  // our unrecoverable -1 into a recoverable convergence failure (seen here: CVODE then shrinks
-  // the step towards the bad point until mxstep, ~10^7 steps). Failing every attempt makes
-  // CVODE stop after MXNCF = 10 consecutive failures instead.
-  if (st.error || st.non_finite) return -1;
-  const auto n = static_cast<std::size_t>(st.sys->n);
   double* dydt = N_VGetArrayPointer(ydot);
-  // A failure is unrecoverable: negative, CVODE stops (user guide 6.x, CVRhsFn).
-  if (st.interleaved) {
-    if (!st.evaluate(t, st.plain(N_VGetArrayPointer(y)), st.dydt_plain)) return -1;
-    to_solver_layout(st, st.dydt_plain, dydt);
-    return 0;
-  }
-  return st.evaluate(t, std::span<const double>(N_VGetArrayPointer(y), n), std::span<double>(dydt, n)) ? 0 : -1;
+  if (!st.interleaved) return st.evaluate(t, N_VGetArrayPointer(y), dydt) ? 0 : -1;
+  if (!st.evaluate(t, st.plain(N_VGetArrayPointer(y)), st.dydt_plain)) return -1;
+  to_solver_layout(st, st.dydt_plain, dydt);
+  return 0;
 }
 
 // The first-order Jacobian in the interleaved layout: d(x_c)'/d(v_c) = 1,
@@ -80,8 +70,7 @@ int cvode_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) noexcep
 int cvode_band_jacobian(sunrealtype t, N_Vector y, N_Vector, SUNMatrix jac, void* user_data, N_Vector, N_Vector,
                         N_Vector) noexcept {
   auto& st = *static_cast<cvode_callback_state*>(user_data);
-  if (st.error) return -1;
-  try {
+  const bool ok = st.guarded([&] {
     SUNMatZero(jac);
     const std::size_t dim = static_cast<std::size_t>(st.sys->n) / 2;
     for (std::size_t c = 0; c < dim; ++c) SM_ELEMENT_B(jac, 2 * c, 2 * c + 1) = 1.0;
@@ -89,25 +78,15 @@ int cvode_band_jacobian(sunrealtype t, N_Vector y, N_Vector, SUNMatrix jac, void
       SM_ELEMENT_B(jac, 2 * i + 1, 2 * j) = kx;
       SM_ELEMENT_B(jac, 2 * i + 1, 2 * j + 1) = kv;
     });
-  } catch (...) {
-    st.error = std::current_exception();
-    return -1;
-  }
-  return 0;
+  });
+  return ok ? 0 : -1;
 }
 
 // The contact gap as CVODE's root function (CVRootFn, user guide 6.x): one root, the
 // smallest signed distance of the problem's contacts.
 int cvode_contact_root(sunrealtype t, N_Vector y, sunrealtype* gout, void* user_data) noexcept {
   auto& st = *static_cast<cvode_callback_state*>(user_data);
-  if (st.error) return -1;
-  try {
-    gout[0] = st.sys->contact_gap(t, st.plain(N_VGetArrayPointer(y)));
-  } catch (...) {
-    st.error = std::current_exception();
-    return -1;
-  }
-  return 0;
+  return st.guarded([&] { gout[0] = st.sys->contact_gap(t, st.plain(N_VGetArrayPointer(y))); }) ? 0 : -1;
 }
 
 // Owns every SUNDIALS handle; members are freed in reverse order of creation on every path.
@@ -133,18 +112,10 @@ struct cvode_handles {
   }
 };
 
-// Which family of return codes a call uses: CVODE's CV_*, the linear solver interface's
-// CVLS_*, or another SUNDIALS code without a name function.
-enum class flag_kind { cv, cvls, other };
-
-std::string flag_name(int flag, flag_kind kind) {
-  if (kind == flag_kind::other) return "see SUNDIALS docs";
-  // Both name functions return a malloc'd string the caller frees (cvode_io.c, cvode_ls.c).
-  char* name = kind == flag_kind::cv ? CVodeGetReturnFlagName(flag) : CVodeGetLinReturnFlagName(flag);
-  std::string s = name ? name : "?";
-  std::free(name);
-  return s;
-}
+// The name function of a call's family of return codes: CVODE's CV_* (the default), the
+// linear solver interface's CVLS_* (CVodeGetLinReturnFlagName), or none for another
+// SUNDIALS code.
+using flag_namer = char* (*)(long int);
 
 // One CVODE solve, in the stages a reader of the user guide expects: create and
 // initialise, attach the linear or nonlinear solver, enable root finding at contacts,
@@ -162,7 +133,7 @@ class cvode_session {
     st_.interleaved = banded();
     if (st_.interleaved)
       st_.y_plain.resize(static_cast<std::size_t>(sys_.n)), st_.dydt_plain.resize(static_cast<std::size_t>(sys_.n));
-    check("SUNContext_Create", SUNContext_Create(nullptr, &h_.ctx), flag_kind::other);
+    check("SUNContext_Create", SUNContext_Create(nullptr, &h_.ctx), nullptr);
     h_.y = N_VNew_Serial(sys_.n, h_.ctx);
     check_ptr("N_VNew_Serial", h_.y);
     to_solver_layout(st_, sys_.y0, N_VGetArrayPointer(h_.y));
@@ -183,8 +154,8 @@ class cvode_session {
       check_ptr("SUNBandMatrix", h_.a);
       h_.ls = SUNLinSol_Band(h_.y, h_.a, h_.ctx);
       check_ptr("SUNLinSol_Band", h_.ls);
-      check("CVodeSetLinearSolver", CVodeSetLinearSolver(h_.mem, h_.ls, h_.a), flag_kind::cvls);
-      check("CVodeSetJacFn", CVodeSetJacFn(h_.mem, &cvode_band_jacobian), flag_kind::cvls);
+      check("CVodeSetLinearSolver", CVodeSetLinearSolver(h_.mem, h_.ls, h_.a), &CVodeGetLinReturnFlagName);
+      check("CVodeSetJacFn", CVodeSetJacFn(h_.mem, &cvode_band_jacobian), &CVodeGetLinReturnFlagName);
     } else if (method_ == cvode_method::bdf) {
       // No Jacobian function is set, so CVLS uses its dense difference-quotient Jacobian,
       // whose n calls of f per evaluation count in CVodeGetNumLinRhsEvals, not in nfe.
@@ -192,7 +163,7 @@ class cvode_session {
       check_ptr("SUNDenseMatrix", h_.a);
       h_.ls = SUNLinSol_Dense(h_.y, h_.a, h_.ctx);
       check_ptr("SUNLinSol_Dense", h_.ls);
-      check("CVodeSetLinearSolver", CVodeSetLinearSolver(h_.mem, h_.ls, h_.a), flag_kind::cvls);
+      check("CVodeSetLinearSolver", CVodeSetLinearSolver(h_.mem, h_.ls, h_.a), &CVodeGetLinReturnFlagName);
     } else {
       // Adams is for non-stiff problems: functional iteration, no linear solver (m = 0: no
       // Anderson acceleration).
@@ -273,15 +244,12 @@ class cvode_session {
     return method_ == cvode_method::bdf && sys_.force_jacobian && sys_.coupling_bandwidth >= 0 &&
            2 * (2 * sys_.coupling_bandwidth + 1) + 1 < sys_.n;
   }
-  [[noreturn]] void fail(const std::string& call, int flag, flag_kind kind = flag_kind::cv) const {
-    std::string what = std::string(source_) + ": " + call + " failed, flag " + std::to_string(flag) + " (" +
-                       flag_name(flag, kind) + ")";
-    if (st_.non_finite) what += "; right-hand side returned a non-finite value at t=" + detail::num(st_.non_finite_t);
-    if (!st_.last_message.empty()) what += "; " + st_.last_message;
-    throw std::runtime_error(what);
+  [[noreturn]] void fail(const std::string& call, int flag, flag_namer namer = &CVodeGetReturnFlagName) const {
+    throw std::runtime_error(
+        st_.failure(source_, call, flag, namer ? detail::sundials_flag_name(namer(flag)) : "see SUNDIALS docs"));
   }
-  void check(const char* call, int flag, flag_kind kind = flag_kind::cv) const {
-    if (flag != 0) fail(call, flag, kind);
+  void check(const char* call, int flag, flag_namer namer = &CVodeGetReturnFlagName) const {
+    if (flag != 0) fail(call, flag, namer);
   }
   void check_ptr(const char* call, const void* p) const {
     if (!p) throw std::runtime_error(std::string(source_) + ": " + call + " returned null");
@@ -297,8 +265,8 @@ class cvode_session {
     into.rhs_evals += rhs;
     if (method_ == cvode_method::bdf) {
       check("CVodeGetNumNonlinSolvIters", CVodeGetNumNonlinSolvIters(h_.mem, &nni));
-      check("CVodeGetNumLinRhsEvals", CVodeGetNumLinRhsEvals(h_.mem, &lin_rhs), flag_kind::cvls);
-      check("CVodeGetNumJacEvals", CVodeGetNumJacEvals(h_.mem, &jac), flag_kind::cvls);
+      check("CVodeGetNumLinRhsEvals", CVodeGetNumLinRhsEvals(h_.mem, &lin_rhs), &CVodeGetLinReturnFlagName);
+      check("CVodeGetNumJacEvals", CVodeGetNumJacEvals(h_.mem, &jac), &CVodeGetLinReturnFlagName);
       into.newton_iterations += nni;
       into.lin_rhs_evals += lin_rhs;
       into.jac_evals += jac;

@@ -2,6 +2,7 @@
 // Shared by the GSL, CVODE and ARKODE wrappers; not part of the interface (reference.hpp).
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <span>
 #include <string>
@@ -33,20 +34,21 @@ struct callback_state {
   double non_finite_t = 0.0;
   std::string last_message;  // SUNDIALS' error handler's, instead of its printing to stderr
 
-  // The system's f(t, y) into dydt, for a library callback: false when it threw (the
-  // exception is stashed) or gave a non-finite derivative (recorded with its time). A
-  // reference must never silently return NaN, and a non-finite derivative is a broken
-  // model, not a step that is too large: each callback then returns its library's
-  // unrecoverable failure, so the library stops at once rather than shrinking the step
-  // towards the bad point (GSL's y_new control would even accept a NaN error ratio:
-  // GSL 2.7.1 ode-initval2/cstd.c takes rmax = GSL_MAX_DBL(r, rmax), which drops a NaN).
+  // The system's f(t, y) into dydt, for a library callback, counting every call: false
+  // when it threw (the exception is stashed) or gave a non-finite derivative (recorded
+  // with its time). A reference must never silently return NaN, and a non-finite
+  // derivative is a broken model, not a step that is too large: each callback then
+  // returns its library's unrecoverable failure, so the library stops at once rather than
+  // shrinking the step towards the bad point (GSL's y_new control would even accept a NaN
+  // error ratio: GSL 2.7.1 ode-initval2/cstd.c takes rmax = GSL_MAX_DBL(r, rmax), which
+  // drops a NaN). Once failed, every later call fails too: SUNDIALS 6.4.1's fixed-point
+  // solver (CVODE's Adams) turns an unrecoverable -1 into a recoverable convergence
+  // failure (seen here: CVODE then shrinks the step towards the bad point until mxstep,
+  // ~10^7 steps); failing every attempt makes CVODE stop after MXNCF = 10 consecutive
+  // failures instead.
   bool evaluate(double t, std::span<const double> y, std::span<double> dydt) noexcept {
-    try {
-      sys->rhs(t, y, dydt);
-    } catch (...) {
-      error = std::current_exception();
-      return false;
-    }
+    ++calls;
+    if (non_finite || !guarded([&] { sys->rhs(t, y, dydt); })) return false;
     for (const double d : dydt)
       if (!std::isfinite(d)) {
         non_finite = true;
@@ -55,7 +57,42 @@ struct callback_state {
       }
     return true;
   }
+  bool evaluate(double t, const double* y, double* dydt) noexcept {
+    const auto n = static_cast<std::size_t>(sys->n);
+    return evaluate(t, std::span<const double>(y, n), std::span<double>(dydt, n));
+  }
+
+  // f() inside a library callback: false when an earlier callback failed or f throws (the
+  // exception is stashed).
+  template <class F>
+  bool guarded(F&& f) noexcept {
+    if (error) return false;
+    try {
+      f();
+    } catch (...) {
+      error = std::current_exception();
+      return false;
+    }
+    return true;
+  }
+
+  // "<source>: <call> failed, flag <flag> (<name>)" and what the callbacks saw.
+  std::string failure(std::string_view source, std::string_view call, int flag, std::string_view name) const {
+    std::string what = std::string(source) + ": " + std::string(call) + " failed, flag " + std::to_string(flag) + " (" +
+                       std::string(name) + ")";
+    if (non_finite) what += "; right-hand side returned a non-finite value at t=" + num(non_finite_t);
+    if (!last_message.empty()) what += "; " + last_message;
+    return what;
+  }
 };
+
+// The name of a SUNDIALS return flag from one of its name functions (CVodeGetReturnFlagName
+// and the like), which return a malloc'd string the caller frees (cvode_io.c, arkode_io.c).
+inline std::string sundials_flag_name(char* name) {
+  std::string s = name ? name : "?";
+  std::free(name);
+  return s;
+}
 
 // SUNDIALS' error handler (CVodeSetErrHandlerFn, ERKStepSetErrHandlerFn): keeps the
 // message for the exception the wrapper throws; warnings (code `Warning`) are dropped.

@@ -18,16 +18,10 @@ namespace stepbench {
 
 namespace {
 
-using gsl_callback_state = detail::callback_state;
-
-// Every call of f goes through here; GSL itself counts none.
+// Every call of f goes through here; GSL itself counts none. GSL_EBADFUNC: evolve_apply
+// returns it at once, without retrying.
 int gsl_rhs(double t, const double y[], double dydt[], void* params) noexcept {
-  auto& st = *static_cast<gsl_callback_state*>(params);
-  ++st.calls;
-  const auto n = static_cast<std::size_t>(st.sys->n);
-  // GSL_EBADFUNC: evolve_apply returns it at once, without retrying.
-  if (!st.evaluate(t, std::span<const double>(y, n), std::span<double>(dydt, n))) return GSL_EBADFUNC;
-  return GSL_SUCCESS;
+  return static_cast<detail::callback_state*>(params)->evaluate(t, y, dydt) ? GSL_SUCCESS : GSL_EBADFUNC;
 }
 
 struct driver_deleter {
@@ -40,11 +34,10 @@ reference_solution solve_gsl(const ode_system& sys, std::span<const double> time
                              reference_tolerances tol) {
   const std::string source = method == gsl_method::rk8pd ? "gsl_rk8pd" : "gsl_rkf45";
   const gsl_odeiv2_step_type* stepper = method == gsl_method::rk8pd ? gsl_odeiv2_step_rk8pd : gsl_odeiv2_step_rkf45;
-  const char* source_name = source.c_str();
-  detail::validate_reference_input(source_name, sys, times, tol);
+  detail::validate_reference_input(source, sys, times, tol);
   const auto start = std::chrono::steady_clock::now();
 
-  gsl_callback_state st;
+  detail::callback_state st;
   st.sys = &sys;
   gsl_odeiv2_system gsys{&gsl_rhs, nullptr, static_cast<std::size_t>(sys.n), &st};
 

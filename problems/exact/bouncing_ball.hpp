@@ -100,24 +100,15 @@ struct bouncing_ball {
   // D = 2 v_1 / g: flight k after the first lasts D k_r^k.
   double flight_scale() const { return 2.0 * impact_speed() / g; }
   // Accumulation time of the contacts (+inf for k_r = 1).
-  double rest_time() const {
-    if (k_r == 1.0) return inf;
-    return first_contact_time() + flight_scale() * (k_r * geometric_sum(k_r, inf));
-  }
+  double rest_time() const { return k_r == 1.0 ? inf : flights(k_r, inf); }
   // Horizontal speed on the ground after t_inf: vx0 (1 - k_f)^infinity.
   double rest_speed() const { return k_f > 0.0 ? 0.0 : vx0; }
-  double rest_position() const {
-    return vx0 * (first_contact_time() + flight_scale() * (q() * geometric_sum(q(), inf)));
-  }
+  double rest_position() const { return vx0 * flights(q(), inf); }
 
   // Time of contact k >= 1: t_1 + D S_{k-1}.
-  double contact_time(long long k) const {
-    return first_contact_time() + flight_scale() * (k_r * geometric_sum(k_r, double(k - 1)));
-  }
+  double contact_time(long long k) const { return flights(k_r, double(k - 1)); }
   // Where contact k >= 1 happens: vx0 (t_1 + D (q + ... + q^{k-1})).
-  double contact_position(long long k) const {
-    return vx0 * (first_contact_time() + flight_scale() * (q() * geometric_sum(q(), double(k - 1))));
-  }
+  double contact_position(long long k) const { return vx0 * flights(q(), double(k - 1)); }
   ball_contact contact(long long k) const {
     const double kr_in = std::pow(k_r, double(k - 1)), kf_in = std::pow(1.0 - k_f, double(k - 1));
     const double vz_out = k_r * kr_in * impact_speed();
@@ -205,6 +196,8 @@ struct bouncing_ball {
  private:
   static constexpr double inf = std::numeric_limits<double>::infinity();
   double q() const { return (1.0 - k_f) * k_r; }
+  // t_1 + D (r + ... + r^j).
+  double flights(double r, double j) const { return first_contact_time() + flight_scale() * (r * geometric_sum(r, j)); }
 };
 
 }  // namespace stepbench::exact

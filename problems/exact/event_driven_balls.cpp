@@ -31,18 +31,16 @@ std::string ball_scene::validate() const {
   return {};
 }
 
-ball_scene default_ball_scene(int n, std::uint64_t seed) {
-  ball_scene s;
-  if (n < 1) throw std::invalid_argument("default_ball_scene: n must be >= 1");
-  s.n = n;
+double place_on_grid(ball_scene& s, std::uint64_t seed) {
+  const int n = s.n;
   const int cols = static_cast<int>(std::ceil(std::sqrt(n * s.width / s.height)));
   const int rows = (n + cols - 1) / cols;
   const double cw = s.width / cols, ch = s.height / rows;
-  if (std::min(cw, ch) <= 2.0 * s.radius)
-    throw std::invalid_argument("default_ball_scene: too many balls for a loose grid in the box");
   const double jx = 0.5 * (0.5 * cw - s.radius), jz = 0.5 * (0.5 * ch - s.radius), vmax = 2.0;
   std::mt19937_64 rng(seed);
   auto symmetric = [&](double amp) { return amp * (2.0 * unit_draw(rng) - 1.0); };
+  s.x0.clear();
+  s.v0.clear();
   for (int i = 0; i < n; ++i) {
     const double cx = ((i % cols) + 0.5) * cw, cz = ((i / cols) + 0.5) * ch;
     const double dx = symmetric(jx), dz = symmetric(jz);
@@ -50,6 +48,15 @@ ball_scene default_ball_scene(int n, std::uint64_t seed) {
     const double vx = symmetric(vmax), vz = symmetric(vmax);
     s.v0.emplace_back(vx, vz);
   }
+  return std::min(cw, ch);
+}
+
+ball_scene default_ball_scene(int n, std::uint64_t seed) {
+  ball_scene s;
+  if (n < 1) throw std::invalid_argument("default_ball_scene: n must be >= 1");
+  s.n = n;
+  if (place_on_grid(s, seed) <= 2.0 * s.radius)
+    throw std::invalid_argument("default_ball_scene: too many balls for a loose grid in the box");
   return s;
 }
 
@@ -137,14 +144,11 @@ double accelerated_pair_delay(const vec2& d, const vec2& u, const vec2& a, doubl
   if (!(T >= 0.0) || !std::isfinite(T)) return inf;
   // Cannot touch before T: the gap exceeds what the relative motion can close.
   if (d.norm() - s > T * (u.norm() + 0.5 * a.norm() * T)) return inf;
-  auto f = [&](double t) -> double {
-    const vec2 p = d + t * (u + 0.5 * t * a);
-    return p.squaredNorm() - s * s;
-  };
   auto f_df = [&](double t) -> std::pair<double, double> {
     const vec2 p = d + t * (u + 0.5 * t * a), w = u + t * a;
     return {p.squaredNorm() - s * s, 2.0 * p.dot(w)};
   };
+  auto f = [&](double t) { return f_df(t).first; };
   auto df_ddf = [&](double t) -> std::pair<double, double> {
     const vec2 p = d + t * (u + 0.5 * t * a), w = u + t * a;
     return {2.0 * p.dot(w), 2.0 * (w.squaredNorm() + p.dot(a))};
@@ -155,16 +159,14 @@ double accelerated_pair_delay(const vec2& d, const vec2& u, const vec2& a, doubl
   // f''/2 = 3/2 |a|^2 t^2 + 3 (u.a) t + (|u|^2 + d.a).
   double r2[2];
   const int n2 = quadratic_roots(1.5 * a.squaredNorm(), 3.0 * u.dot(a), u.squaredNorm() + d.dot(a), r2);
-  std::array<double, 4> bp{0.0, 0.0, 0.0, 0.0};
-  int nb = 0;
-  bp[nb++] = 0.0;
+  std::array<double, 4> bp{};  // bp[0] = 0
+  int nb = 1;
   for (int k = 0; k < n2; ++k)
     if (r2[k] > bp[nb - 1] && r2[k] < T) bp[nb++] = r2[k];
   bp[nb++] = T;
 
-  std::array<double, 5> cp{0.0, 0.0, 0.0, 0.0, 0.0};
-  int nc = 0;
-  cp[nc++] = 0.0;
+  std::array<double, 5> cp{};  // cp[0] = 0
+  int nc = 1;
   for (int k = 0; k + 1 < nb; ++k) {
     const double g0 = df_ddf(bp[k]).first, g1 = df_ddf(bp[k + 1]).first;
     if ((g0 < 0.0 && g1 > 0.0) || (g0 > 0.0 && g1 < 0.0)) {
@@ -174,7 +176,7 @@ double accelerated_pair_delay(const vec2& d, const vec2& u, const vec2& a, doubl
   }
   cp[nc++] = T;
 
-  std::array<double, 5> fc{0.0, 0.0, 0.0, 0.0, 0.0};
+  std::array<double, 5> fc{};
   for (int k = 0; k < nc; ++k) fc[k] = f(cp[k]);
   for (int k = 0; k + 1 < nc; ++k) {
     const double lo = cp[k], hi = cp[k + 1];
@@ -359,43 +361,25 @@ void event_driven_balls::process_next() {
   vec2 xi, vi;
   evaluate(i, t, xi, vi);
   if (c.k.slot < pair_slot) {
-    // Wall: snap the centre onto the contact line, apply v <- (1 - k_f) v_t - k_r v_n.
-    switch (c.k.slot) {
-      case 0:
-        ev.kind = contact_kind::left_wall;
-        ev.normal_speed = -vi.x();
-        xi.x() = r;
-        vi = {-kr * vi.x(), (1.0 - kf) * vi.y()};
-        ev.point = {0.0, xi.y()};
-        break;
-      case 1:
-        ev.kind = contact_kind::right_wall;
-        ev.normal_speed = vi.x();
-        xi.x() = s_.width - r;
-        vi = {-kr * vi.x(), (1.0 - kf) * vi.y()};
-        ev.point = {s_.width, xi.y()};
-        break;
-      case 2:
-        ev.kind = contact_kind::floor;
-        ev.normal_speed = -vi.y();
-        xi.y() = r;
-        vi = {(1.0 - kf) * vi.x(), -kr * vi.y()};
-        ev.point = {xi.x(), 0.0};
-        // Zeno guard: a bounce lower than rest_height ends the bounce sequence.
-        if (s_.gravity > 0.0 && vi.y() * vi.y() < w_rest_sq_) {
-          vi.y() = 0.0;
-          if (kf > 0.0) vi.x() = 0.0;  // the limit of (1 - k_f)^n over the remaining bounces
-          resting_[i] = 1;
-          ev.came_to_rest = true;
-        }
-        break;
-      default:
-        ev.kind = contact_kind::ceiling;
-        ev.normal_speed = vi.y();
-        xi.y() = s_.height - r;
-        vi = {(1.0 - kf) * vi.x(), -kr * vi.y()};
-        ev.point = {xi.x(), s_.height};
-        break;
+    // Wall: slots 0, 1 the sides (axis x), 2, 3 the floor and ceiling (axis z), the even
+    // slot the wall at 0. Snap the centre onto the contact line, apply
+    // v <- (1 - k_f) v_t - k_r v_n.
+    const int axis = c.k.slot / 2, along = 1 - axis;
+    const bool lower = c.k.slot % 2 == 0;  // the wall at 0
+    const double extent = axis == 0 ? s_.width : s_.height;
+    ev.kind = static_cast<contact_kind>(c.k.slot);
+    ev.normal_speed = lower ? -vi[axis] : vi[axis];
+    xi[axis] = lower ? r : extent - r;
+    vi[axis] = -kr * vi[axis];
+    vi[along] = (1.0 - kf) * vi[along];
+    ev.point[axis] = lower ? 0.0 : extent;
+    ev.point[along] = xi[along];
+    // Zeno guard: a bounce lower than rest_height ends the bounce sequence.
+    if (ev.kind == contact_kind::floor && s_.gravity > 0.0 && vi.y() * vi.y() < w_rest_sq_) {
+      vi.y() = 0.0;
+      if (kf > 0.0) vi.x() = 0.0;  // the limit of (1 - k_f)^n over the remaining bounces
+      resting_[i] = 1;
+      ev.came_to_rest = true;
     }
     anchor(i, t, xi, vi);
   } else {

@@ -166,8 +166,11 @@ inline double unit_draw(std::mt19937_64& rng) { return static_cast<double>(rng()
 // z, v_x, v_z, each one unit_draw of std::mt19937_64(seed). Throws
 // std::invalid_argument when the cells are too small for the balls (n > 171).
 ball_scene default_ball_scene(int n = 16, std::uint64_t seed = 1);
+// Its placement of s.n balls in the box and radius of s (x0 and v0 replaced); returns the
+// smaller side of a cell, which must exceed 2 r.
+double place_on_grid(ball_scene& s, std::uint64_t seed);
 
-enum class contact_kind { left_wall, right_wall, floor, ceiling, ball };
+enum class contact_kind { left_wall, right_wall, floor, ceiling, ball };  // the walls in slot order
 
 struct contact_event {
   double time;

@@ -63,8 +63,6 @@ void run(study& s, const part_context& ctx) {
   for (auto& ps : swept) s.problems.push_back(std::move(ps));
 }
 
-void write(H5::Group& root, const study& s) { write_problems(root, s); }
-
 }  // namespace
 
 extern const study_part sweep_part{
@@ -74,7 +72,7 @@ extern const study_part sweep_part{
     .merge = merge_rule::per_problem,
     .describe = describe,
     .run = run,
-    .write = write,
+    .write = write_problems,
     .read = read_problems,
 };
 

@@ -113,14 +113,15 @@ double judder(const loop_result& run, const truth_table& truth, std::size_t coun
   return std::sqrt(var / static_cast<double>(pairs));
 }
 
-}  // namespace
-
+// The exact state at the frames' display times: the closed form, or the references.
 truth_table loop_truth(const problem_instance& problem, const loop_result& run) {
   truth_options opts;
   opts.run_references = !problem.has_closed_form();
   return build_truth(problem, run.display_t, opts);
 }
 
+// A simulated run against the truth at its display times; `reference` is the same
+// configuration on the reference clock.
 loop_row measure_loop(const loop_config& config, std::string clock, const loop_result& run, const truth_table& truth,
                       const loop_result* reference) {
   loop_row row;
@@ -191,6 +192,8 @@ loop_row measure_loop(const loop_config& config, std::string clock, const loop_r
   }
   return row;
 }
+
+}  // namespace
 
 loop_row run_loop_config(const problem_instance& problem, std::string_view method, const loop_config& config,
                          const loop_options& opts) {

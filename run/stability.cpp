@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -381,18 +382,6 @@ std::vector<double> linspace(double a, double b, int n) {
   return out;
 }
 
-template <class F>
-void with_integrator(std::string_view name, F&& f) {
-  bool found = false;
-  for_each_type(all_integrators{}, [&]<class I>() {
-    if (I::name == name) {
-      found = true;
-      f.template operator()<I>();
-    }
-  });
-  if (!found) throw std::invalid_argument(fmt::format("unknown integrator '{}'", name));
-}
-
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -413,12 +402,14 @@ double spectral_radius(const Eigen::Matrix2d& m) {
 }
 
 Eigen::Matrix2d amplification_matrix(std::string_view integrator, stability_test test, double y) {
-  Eigen::Matrix2d m;
-  with_integrator(integrator, [&]<class I>() {
-    m = test == stability_test::oscillator ? amplification<I>(oscillator_problem{}, y)
-                                           : amplification<I>(decay_problem{}, y);
+  std::optional<Eigen::Matrix2d> m;
+  for_each_type(all_integrators{}, [&]<class I>() {
+    if (I::name == integrator)
+      m = test == stability_test::oscillator ? amplification<I>(oscillator_problem{}, y)
+                                             : amplification<I>(decay_problem{}, y);
   });
-  return m;
+  if (!m) throw std::invalid_argument(fmt::format("unknown integrator '{}'", integrator));
+  return *m;
 }
 
 const std::vector<double>& stability_regions::of(std::string_view integrator) const {

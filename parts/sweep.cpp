@@ -69,7 +69,6 @@ extern const study_part sweep_part{
     .name = "sweep",
     .summary = "every method on every problem over its dt or tolerance ladder, measured against the truth",
     .group = "problems",
-    .merge = merge_rule::per_problem,
     .describe = describe,
     .run = run,
     .write = write_problems,

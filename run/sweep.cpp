@@ -36,8 +36,8 @@ void validate(const sweep_options& opts) {
     if (!(tol > 0.0 && tol < 1.0)) throw std::invalid_argument(fmt::format("tolerance {:g} is not in (0, 1)", tol));
   // The parts' own method and problem lists name registry entries: a renamed method or
   // problem fails here, at the start, instead of dropping out of a part unseen.
-  for (const auto* names : {&opts.methods, &opts.loop.methods, &opts.substeps.explicit_methods, &opts.substeps.implicit_methods,
-                            &opts.challenge.competitors, &opts.energy.methods})
+  for (const auto* names : {&opts.methods, &opts.loop.methods, &opts.substeps.explicit_methods,
+                            &opts.substeps.implicit_methods, &opts.challenge.competitors, &opts.energy.methods})
     for (const auto& name : *names) find_method(name);
   for (const auto* names : {&opts.loop.problems, &opts.substeps.problems})
     for (const auto& name : *names) make_problem(name);

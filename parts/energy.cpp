@@ -16,7 +16,6 @@ extern const study_part energy_part{
     .name = "energy",
     .summary = "energy over 10^4 periods: which methods keep it bounded and which drift",
     .group = "energy",
-    .merge = merge_rule::per_problem,
     .describe =
         [](const sweep_options& o) {
           std::vector<std::string> scenes;

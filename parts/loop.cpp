@@ -14,7 +14,6 @@ extern const study_part loop_part{
     .name = "loop",
     .summary = "the game loop's designs and clocks: the error the player sees, judder, lag and the spiral of death",
     .group = "loop",
-    .merge = merge_rule::per_problem,
     .describe =
         [](const sweep_options& o) {
           const auto& lp = o.loop;

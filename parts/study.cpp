@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <mutex>
 
+#include "core/contains.hpp"
 #include "parts/part.hpp"
 #include "run/sweep.hpp"
 #include "store/h5.hpp"
@@ -68,9 +69,7 @@ study run_sweep(const sweep_options& opts) {
 
 void judge_study(study& s) {
   for (const auto& p : study_parts())
-    if (p.judge && (s.options.parts.empty() ||
-                    std::find(s.options.parts.begin(), s.options.parts.end(), p.name) != s.options.parts.end()))
-      p.judge(s);
+    if (p.judge && (s.options.parts.empty() || contains(s.options.parts, std::string(p.name)))) p.judge(s);
 }
 
 std::vector<study> read_studies(const std::vector<std::string>& paths) {

@@ -14,7 +14,6 @@ extern const study_part substeps_part{
     .name = "substeps",
     .summary = "n explicit substeps a frame against one implicit step, at equal cost and equal error",
     .group = "substeps",
-    .merge = merge_rule::per_problem,
     .describe =
         [](const sweep_options& o) {
           const auto& ss = o.substeps;

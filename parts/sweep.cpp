@@ -63,18 +63,15 @@ void run(study& s, const part_context& ctx) {
   for (auto& ps : swept) s.problems.push_back(std::move(ps));
 }
 
-void write(H5::Group& root, const study& s) { write_problems(root, s); }
-
 }  // namespace
 
 extern const study_part sweep_part{
     .name = "sweep",
     .summary = "every method on every problem over its dt or tolerance ladder, measured against the truth",
     .group = "problems",
-    .merge = merge_rule::per_problem,
     .describe = describe,
     .run = run,
-    .write = write,
+    .write = write_problems,
     .read = read_problems,
 };
 

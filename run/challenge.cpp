@@ -58,38 +58,24 @@ struct ladder_point {
   bool completed = false;
   std::string note;
 };
+// An adaptive method (a finite `tol`) runs at that relative tolerance over the whole horizon
+// in one run (its step size carries across frames, as a game would keep it), timed with a
+// state at every frame end, which a game draws; a fixed-step one is timed to the horizon.
 ladder_point measure_at(const problem_instance& p, const truth_table& truth, const std::string& method, int k,
-                        double hz, double horizon) {
+                        double hz, double horizon, double tol = nan) {
   ladder_point out;
-  out.k = k;
-  const double dt = 1.0 / (hz * k);
-  const run_metrics m = measure(p, p.run(method, dt, horizon, truth.times), truth);
+  out.tolerance = tol;
+  const bool adaptive = std::isfinite(tol);
+  const double param = adaptive ? tol : 1.0 / (hz * k);
+  const run_result r = p.run(method, param, horizon, truth.times);
+  const run_metrics m = measure(p, r, truth);
+  out.k = adaptive ? static_cast<int>(std::lround(static_cast<double>(r.steps) / (horizon * hz))) : k;
   out.completed = m.completed();
   out.err = m.err_pos_max;
   out.note = m.note;
   if (!out.completed) return out;
   const std::vector<double> end{horizon};
-  auto once = p.timed_run(method, dt, horizon, end);
-  volatile double sink = 0.0;
-  out.ns_per_frame = median_ns([&] { sink = sink + once(); }) / (horizon * hz);
-  return out;
-}
-
-// An adaptive method at relative tolerance `tol`, over the whole horizon in one run (its
-// step size carries across frames, as a game would keep it); timed with a state at every
-// frame end, which a game draws.
-ladder_point measure_at_tolerance(const problem_instance& p, const truth_table& truth, const std::string& method,
-                                  double tol, double hz, double horizon) {
-  ladder_point out;
-  out.tolerance = tol;
-  const run_result r = p.run(method, tol, horizon, truth.times);
-  const run_metrics m = measure(p, r, truth);
-  out.k = static_cast<int>(std::lround(static_cast<double>(r.steps) / (horizon * hz)));
-  out.completed = m.completed();
-  out.err = m.err_pos_max;
-  out.note = m.note;
-  if (!out.completed) return out;
-  auto once = p.timed_run(method, tol, horizon, truth.times);
+  auto once = p.timed_run(method, param, horizon, adaptive ? truth.times : end);
   volatile double sink = 0.0;
   out.ns_per_frame = median_ns([&] { sink = sink + once(); }) / (horizon * hz);
   return out;
@@ -284,7 +270,7 @@ challenge_result run_challenge(const challenge_options& o, void (*progress)(cons
       // curve) and the time is past xpbd's (the accuracy at equal time: the tightest
       // tolerance whose measured time per frame is at most xpbd's; the loosest when none is).
       for (int e = 1; e <= 13; ++e) {
-        pts.push_back(measure_at_tolerance(*p, truth, method, std::pow(10.0, -e), o.hz, o.horizon));
+        pts.push_back(measure_at(*p, truth, method, 0, o.hz, o.horizon, std::pow(10.0, -e)));
         const auto& b = pts.back();
         if (b.completed && b.err <= x.err_pos_max && b.ns_per_frame > x.ns_per_frame) break;
       }
@@ -313,12 +299,7 @@ challenge_result run_challenge(const challenge_options& o, void (*progress)(cons
     // Its cheapest setting (one step a frame, tolerance 1e-1) may already cost more than
     // xpbd's frame: then it is not an entry at xpbd's time, and the verdict says so.
     e.over_xpbd_time = at.completed && at.ns_per_frame > x.ns_per_frame;
-    if (e.stable) {
-      if (std::isfinite(at.tolerance))
-        energy_of(e, method, at.tolerance);
-      else
-        energy_of(e, method, 1.0 / (o.hz * at.k));
-    }
+    if (e.stable) energy_of(e, method, std::isfinite(at.tolerance) ? at.tolerance : 1.0 / (o.hz * at.k));
     e.ns_per_frame_at_xpbd_error = time_at_error(pts, x.err_pos_max);
     out.entries.push_back(e);
   }

@@ -9,6 +9,17 @@
 
 namespace stepbench {
 
+frames frames_of(double problem_horizon, const std::vector<double>& hz) {
+  const double slowest = *std::min_element(hz.begin(), hz.end());
+  const double fastest = *std::max_element(hz.begin(), hz.end());
+  frames f;
+  const long slow_frames = std::max(1L, static_cast<long>(std::floor(problem_horizon * slowest * (1.0 + 1e-12))));
+  f.horizon = static_cast<double>(slow_frames) / slowest;
+  const long fast_frames = std::lround(f.horizon * fastest);
+  for (long j = 1; j <= fast_frames; ++j) f.times.push_back(static_cast<double>(j) / fastest);
+  return f;
+}
+
 truth_table every_nth(const truth_table& t, std::size_t stride) {
   truth_table out = t;
   out.times.clear();
@@ -28,18 +39,13 @@ std::vector<frame_rate_study> run_frame_rates(const study& s, const frame_rate_o
   const double finest_target = verdict_targets().back();
   for (const auto& ps : s.problems) {
     if (!ps.truth.trusted) continue;
-    // Whole frames of the slowest rate; every rate divides the fastest, so the truth at
-    // the fastest rate's frame ends holds every rate's.
-    const long slow_frames = static_cast<long>(std::floor(ps.horizon * slowest * (1.0 + 1e-12)));
-    if (slow_frames < 1) continue;
+    if (static_cast<long>(std::floor(ps.horizon * slowest * (1.0 + 1e-12))) < 1) continue;  // no whole frame
+    const frames f = frames_of(ps.horizon, opts.hz);
     frame_rate_study fs;
     fs.problem = std::string(ps.problem->name());
     fs.unit = std::string(ps.problem->position_unit());
-    fs.horizon = static_cast<double>(slow_frames) / slowest;
-    const long fast_frames = std::lround(fs.horizon * fastest);
-    std::vector<double> times;
-    for (long j = 1; j <= fast_frames; ++j) times.push_back(static_cast<double>(j) / fastest);
-    const truth_table fine = build_truth(*ps.problem, times, {.tol = s.options.tol});
+    fs.horizon = f.horizon;
+    const truth_table fine = build_truth(*ps.problem, f.times, {.tol = s.options.tol});
     if (!fine.trusted) continue;
     for (double hz : opts.hz) {
       const auto stride = static_cast<std::size_t>(std::lround(fastest / hz));

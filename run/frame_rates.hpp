@@ -7,11 +7,20 @@
 
 namespace stepbench {
 
-// Runs the frame-rate study on every problem of `s` (their truths are rebuilt at the frame
-// ends of the fastest rate). A problem whose horizon holds no whole frame is left out.
+// The frames at rates `hz` within a problem's horizon: whole frames of the slowest rate (at
+// least one), the truth's times at the fastest rate's frame ends (every rate divides the
+// fastest). The frame-rate study's and the scan's.
+struct frames {
+  double horizon = 0.0;
+  std::vector<double> times;
+};
+frames frames_of(double problem_horizon, const std::vector<double>& hz);
+
 // The truth at every stride-th sample of `t` (the frame ends of a slower rate).
 truth_table every_nth(const truth_table& t, std::size_t stride);
 
+// Runs the frame-rate study on every problem of `s` (their truths are rebuilt at the frame
+// ends of the fastest rate). A problem whose horizon holds no whole frame is left out.
 std::vector<frame_rate_study> run_frame_rates(const study& s, const frame_rate_options& opts);
 
 }  // namespace stepbench

@@ -20,24 +20,6 @@ double distance(const double* a, const double* b, int dim) {
   return std::sqrt(s);
 }
 
-// The truths of one problem's runs, by their display times: every design and physics
-// rate on one clock shows its frames at the same times, so each clock's truth is built
-// once.
-class truth_cache {
- public:
-  explicit truth_cache(const problem_instance& p) : problem_(p) {}
-  const truth_table& at(const loop_result& run) {
-    for (const auto& [times, truth] : entries_)
-      if (times == run.display_t) return truth;
-    entries_.emplace_back(run.display_t, loop_truth(problem_, run));
-    return entries_.back().second;
-  }
-
- private:
-  const problem_instance& problem_;
-  std::vector<std::pair<std::vector<double>, truth_table>> entries_;
-};
-
 // The study's clocks for a run of `horizon`: constant at each display rate, jittered,
 // and the stall with the clamp and without it. The clamp is on everywhere else (it
 // never cuts a frame of those clocks).
@@ -83,10 +65,6 @@ bool same_run(const loop_config& a, const loop_config& b) {
          ((std::isnan(a.stall_at_s) && std::isnan(b.stall_at_s)) ||
           (a.stall_at_s == b.stall_at_s && a.stall_s == b.stall_s)) &&
          a.horizon == b.horizon;
-}
-
-void check_truth_times(const truth_table& truth, const loop_result& run) {
-  if (truth.times != run.display_t) throw std::logic_error("measure_loop: the truth's times are not the run's frames");
 }
 
 // Steps per frame over the counted frames, the stall's burst, the clamp, the clock's lag
@@ -135,14 +113,15 @@ double judder(const loop_result& run, const truth_table& truth, std::size_t coun
   return std::sqrt(var / static_cast<double>(pairs));
 }
 
-}  // namespace
-
+// The exact state at the frames' display times: the closed form, or the references.
 truth_table loop_truth(const problem_instance& problem, const loop_result& run) {
   truth_options opts;
   opts.run_references = !problem.has_closed_form();
   return build_truth(problem, run.display_t, opts);
 }
 
+// A simulated run against the truth at its display times; `reference` is the same
+// configuration on the reference clock.
 loop_row measure_loop(const loop_config& config, std::string clock, const loop_result& run, const truth_table& truth,
                       const loop_result* reference) {
   loop_row row;
@@ -186,7 +165,7 @@ loop_row measure_loop(const loop_config& config, std::string clock, const loop_r
                                  frames ? run.display_t.back() : 0.0));
   }
   if (!truth.trusted) return no_errors("no trusted truth: " + truth.note);
-  check_truth_times(truth, run);
+  if (truth.times != run.display_t) throw std::logic_error("measure_loop: the truth's times are not the run's frames");
 
   // Shown error, and the lag that best explains it: shown(t) = exact(t - tau).
   double sum_sq = 0.0, lag_num = 0.0, lag_den = 0.0;
@@ -214,6 +193,8 @@ loop_row measure_loop(const loop_config& config, std::string clock, const loop_r
   return row;
 }
 
+}  // namespace
+
 loop_row run_loop_config(const problem_instance& problem, std::string_view method, const loop_config& config,
                          const loop_options& opts) {
   const loop_result run = problem.loop(method, config);  // throws std::invalid_argument for bad input
@@ -225,7 +206,14 @@ loop_row run_loop_config(const problem_instance& problem, std::string_view metho
 
 loop_method run_loop_method(const problem_instance& problem, const method_info& method, const loop_options& opts) {
   loop_method out{method, {}};
-  truth_cache truths(problem);
+  // The truths by their display times: every design and physics rate on one clock shows
+  // its frames at the same times, so each clock's truth is built once.
+  std::vector<truth_table> truths;
+  const auto truth_at = [&](const loop_result& run) -> const truth_table& {
+    for (const auto& t : truths)
+      if (t.times == run.display_t) return t;
+    return truths.emplace_back(loop_truth(problem, run));
+  };
   const double horizon = problem.horizon();
   for (loop_design design : all_loop_designs) {
     // The variable design has no physics rate: it runs once per clock.
@@ -241,7 +229,7 @@ loop_method run_loop_method(const problem_instance& problem, const method_info& 
       for (const auto& [clock, config] : clocks) {
         const bool is_reference = same_run(config, ref_config);
         const loop_result run = is_reference ? reference : problem.loop(method.name, config);
-        out.rows.push_back(measure_loop(config, clock, run, truths.at(run), &reference));
+        out.rows.push_back(measure_loop(config, clock, run, truth_at(run), &reference));
       }
     }
   }
@@ -275,7 +263,5 @@ loop_study run_loop_study(const study& s, const loop_options& opts) {
                  out.problems.size() == 1 ? "" : "s", configs, out.wall_seconds);
   return out;
 }
-
-namespace {}  // namespace
 
 }  // namespace stepbench

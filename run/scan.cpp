@@ -11,6 +11,7 @@
 #include "core/measure.hpp"
 #include "registry/registry.hpp"
 #include "run/balanced_share.hpp"
+#include "run/frame_rates.hpp"
 #include "run/machine.hpp"
 #include "study/verdict.hpp"
 
@@ -35,22 +36,36 @@ std::vector<std::string_view> split(std::string_view text, char sep) {
   }
 }
 
-// The frame-rate study's frames: whole frames of the slowest rate within the problem's
-// horizon, the truth at the fastest rate's frame ends (every rate divides the fastest).
-struct frames {
-  double horizon = 0.0;
-  std::vector<double> times;
-};
-
-frames frames_of(double problem_horizon, const std::vector<double>& hz) {
-  const double slowest = *std::min_element(hz.begin(), hz.end());
-  const double fastest = *std::max_element(hz.begin(), hz.end());
-  frames f;
-  const long slow_frames = std::max(1L, static_cast<long>(std::floor(problem_horizon * slowest * (1.0 + 1e-12))));
-  f.horizon = static_cast<double>(slow_frames) / slowest;
-  const long fast_frames = std::lround(f.horizon * fastest);
-  for (long j = 1; j <= fast_frames; ++j) f.times.push_back(static_cast<double>(j) / fastest);
-  return f;
+// The grid points of this run's shard (validate checked it exists), in grid order: each
+// point's size is counted as its problem's coordinates (the force work of a step grows
+// with them), and the points, largest first (ties in grid order), go each to the shard
+// with the least so far (ties to the lowest shard). Deterministic: every machine computes
+// the same split.
+std::vector<std::size_t> scan_shard(const scan_options& opts) {
+  const int k = opts.shard_index, n = opts.shard_count;
+  const auto grid = scan_grid(opts.axes);
+  std::vector<std::size_t> all(grid.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+  if (n == 1) return all;
+  // A point's size: its runs' coordinate-steps (each rate's frames x the substeps), plus
+  // its references' predicted work where they run (in coordinate evaluations: at large N
+  // the references are most of a point's time). The same for every method, so not counted.
+  double substeps = 0.0, rates = 0.0;
+  for (int n : opts.substeps) substeps += n;
+  for (double hz : opts.hz) rates += hz;
+  std::vector<double> size(grid.size(), 1.0);
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    auto p = make_problem(opts.problem);
+    for (const auto& [name, value] : opts.fixed) p->set(name, value);
+    for (std::size_t a = 0; a < opts.axes.size(); ++a) p->set(opts.axes[a].param, grid[i][a]);
+    if (!p->validate().empty()) continue;
+    const double horizon = frames_of(p->horizon(), opts.hz).horizon;
+    size[i] = static_cast<double>(p->dim()) * horizon * rates * substeps;
+    if (!p->has_closed_form())
+      if (const double refs = predicted_reference_work(*p, horizon); refs <= opts.reference_budget)
+        size[i] += reference_work_in_evaluations * refs;
+  }
+  return balanced_share(size, k, n);
 }
 
 }  // namespace
@@ -162,33 +177,6 @@ void validate(const scan_options& opts) {
   }
 }
 
-std::vector<std::size_t> scan_shard(const scan_options& opts, int k, int n) {
-  if (n < 1 || k < 0 || k >= n) throw std::invalid_argument(fmt::format("shard {} of {} does not exist", k + 1, n));
-  const auto grid = scan_grid(opts.axes);
-  std::vector<std::size_t> all(grid.size());
-  for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
-  if (n == 1) return all;
-  // A point's size: its runs' coordinate-steps (each rate's frames x the substeps), plus
-  // its references' predicted work where they run (in coordinate evaluations: at large N
-  // the references are most of a point's time). The same for every method, so not counted.
-  double substeps = 0.0, rates = 0.0;
-  for (int n : opts.substeps) substeps += n;
-  for (double hz : opts.hz) rates += hz;
-  std::vector<double> size(grid.size(), 1.0);
-  for (std::size_t i = 0; i < grid.size(); ++i) {
-    auto p = make_problem(opts.problem);
-    for (const auto& [name, value] : opts.fixed) p->set(name, value);
-    for (std::size_t a = 0; a < opts.axes.size(); ++a) p->set(opts.axes[a].param, grid[i][a]);
-    if (!p->validate().empty()) continue;
-    const double horizon = frames_of(p->horizon(), opts.hz).horizon;
-    size[i] = static_cast<double>(p->dim()) * horizon * rates * substeps;
-    if (!p->has_closed_form())
-      if (const double refs = predicted_reference_work(*p, horizon); refs <= opts.reference_budget)
-        size[i] += reference_work_in_evaluations * refs;
-  }
-  return balanced_share(size, k, n);
-}
-
 std::vector<scan_options> default_scans(bool quick) {
   scan_options spring;
   spring.problem = "stiff_spring";
@@ -234,7 +222,7 @@ scan_result run_scan(const scan_options& opts) {
   out.options.methods.clear();  // the file records the methods run, which merge compares
   for (const auto& m : methods) out.options.methods.push_back(m.name);
   const auto grid = scan_grid(opts.axes);
-  const auto mine = scan_shard(opts, opts.shard_index, opts.shard_count);
+  const auto mine = scan_shard(opts);
   out.grid_points = grid.size();
   const double fastest = *std::max_element(opts.hz.begin(), opts.hz.end());
 

@@ -28,10 +28,4 @@ scan_result run_scan(const scan_options& opts);
 // The grid points in order: the first axis varies slowest.
 std::vector<std::vector<double>> scan_grid(const std::vector<scan_axis>& axes);
 
-// The grid points of shard k of n (0-based), in grid order: each point's size is counted
-// as its problem's coordinates (the force work of a step grows with them), and the points,
-// largest first (ties in grid order), go each to the shard with the least so far (ties to
-// the lowest shard). Deterministic: every machine computes the same split.
-std::vector<std::size_t> scan_shard(const scan_options& opts, int k, int n);
-
 }  // namespace stepbench

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -25,27 +26,31 @@ namespace {
 // solve a linear problem in one Newton iteration, to round-off) and `size`, the
 // quantity whose boundedness is the stability of the motion.
 
+// What they share: N coordinates, a mass (a parameter), Jacobians of fixed size.
+template <int N>
+struct test_problem {
+  static constexpr std::string_view position_unit = "m";
+  using vec = Eigen::Matrix<double, N, 1>;
+  using jacobian_matrix = Eigen::Matrix<double, N, N>;
+  double mass_kg = 1.0;
+  int dim() const { return N; }
+  double mass() const { return mass_kg; }
+  jacobian_matrix make_jacobian() const { return jacobian_matrix::Zero(); }
+};
+
 // x'' = -omega^2 x: the force F = -m omega^2 x of a spring with k = m omega^2.
-struct oscillator_problem {
+struct oscillator_problem : test_problem<1> {
   static constexpr std::string_view name = "stability_oscillator";
   static constexpr std::string_view description = "undamped oscillator x'' = -omega^2 x (F = -m omega^2 x)";
-  static constexpr std::string_view position_unit = "m";
   static constexpr bool force_depends_on_velocity = false;
-  using vec = Eigen::Matrix<double, 1, 1>;
-  using jacobian_matrix = Eigen::Matrix<double, 1, 1>;
-
   double omega = 1.0;
-  double mass_kg = 1.0;
 
   static constexpr auto parameters() {
     using p = param<oscillator_problem>;
     return std::array{p{"omega", &oscillator_problem::omega, "rad/s", "angular frequency", positive},
                       p{"mass_kg", &oscillator_problem::mass_kg, "kg", "mass", positive}};
   }
-  int dim() const { return 1; }
-  double mass() const { return mass_kg; }
   void force(double, const vec& x, const vec&, vec& f) const { f = (-mass_kg * omega * omega) * x; }
-  jacobian_matrix make_jacobian() const { return jacobian_matrix::Zero(); }
   void jacobian(double, const vec&, const vec&, jacobian_matrix& dfdx, jacobian_matrix& dfdv) const {
     dfdx(0, 0) = -mass_kg * omega * omega;
     dfdv(0, 0) = 0.0;
@@ -59,26 +64,18 @@ struct oscillator_problem {
 // Pure decay as a game writes it: a damper F = -m lambda v, so v' = -lambda v and x only
 // integrates v (x -> x0 + v0 / lambda). It is the velocity equation that must stay
 // bounded; x follows it.
-struct decay_problem {
+struct decay_problem : test_problem<1> {
   static constexpr std::string_view name = "stability_decay";
   static constexpr std::string_view description = "pure damper F = -m lambda v (v' = -lambda v)";
-  static constexpr std::string_view position_unit = "m";
   static constexpr bool force_depends_on_velocity = true;
-  using vec = Eigen::Matrix<double, 1, 1>;
-  using jacobian_matrix = Eigen::Matrix<double, 1, 1>;
-
   double lambda = 1.0;
-  double mass_kg = 1.0;
 
   static constexpr auto parameters() {
     using p = param<decay_problem>;
     return std::array{p{"lambda", &decay_problem::lambda, "1/s", "decay rate", positive},
                       p{"mass_kg", &decay_problem::mass_kg, "kg", "mass", positive}};
   }
-  int dim() const { return 1; }
-  double mass() const { return mass_kg; }
   void force(double, const vec&, const vec& v, vec& f) const { f = (-mass_kg * lambda) * v; }
-  jacobian_matrix make_jacobian() const { return jacobian_matrix::Zero(); }
   void jacobian(double, const vec&, const vec&, jacobian_matrix& dfdx, jacobian_matrix& dfdv) const {
     dfdx(0, 0) = 0.0;
     dfdv(0, 0) = -mass_kg * lambda;
@@ -92,17 +89,12 @@ struct decay_problem {
 // F = m L v, L = [[a, -b], [b, a]], so v' = L v is the complex equation v' = lambda v
 // with v = v_0 + i v_1. One step of dt maps v to R(dt lambda) v (a complex
 // multiplication), and |R| = |v_1| / |v_0|.
-struct complex_damper_problem {
+struct complex_damper_problem : test_problem<2> {
   static constexpr std::string_view name = "stability_complex_damper";
   static constexpr std::string_view description = "damper with a complex rate, F = m L v, L = [[a, -b], [b, a]]";
-  static constexpr std::string_view position_unit = "m";
   static constexpr bool force_depends_on_velocity = true;
-  using vec = Eigen::Vector2d;
-  using jacobian_matrix = Eigen::Matrix2d;
-
   double rate_re = -1.0;
   double rate_im = 0.0;
-  double mass_kg = 1.0;
 
   static constexpr auto parameters() {
     using p = param<complex_damper_problem>;
@@ -110,13 +102,10 @@ struct complex_damper_problem {
                       p{"rate_im", &complex_damper_problem::rate_im, "1/s", "imaginary part b of the rate"},
                       p{"mass_kg", &complex_damper_problem::mass_kg, "kg", "mass", positive}};
   }
-  int dim() const { return 2; }
-  double mass() const { return mass_kg; }
   void force(double, const vec&, const vec& v, vec& f) const {
     f[0] = mass_kg * (rate_re * v[0] - rate_im * v[1]);
     f[1] = mass_kg * (rate_im * v[0] + rate_re * v[1]);
   }
-  jacobian_matrix make_jacobian() const { return jacobian_matrix::Zero(); }
   void jacobian(double, const vec&, const vec&, jacobian_matrix& dfdx, jacobian_matrix& dfdv) const {
     dfdx.setZero();
     dfdv << rate_re, -rate_im, rate_im, rate_re;
@@ -369,12 +358,6 @@ stability_limit limit_of(const P& p, stability_test test, const stability_settin
   return f.out;
 }
 
-template <class I>
-stability_limit limit_of(stability_test test, const stability_settings& s) {
-  if (test == stability_test::oscillator) return limit_of<I>(oscillator_problem{}, test, s);
-  return limit_of<I>(decay_problem{}, test, s);
-}
-
 // ---------------------------------------------------------------------------------
 // The regions: one step of dt = 1 on the complex damper with rate z, from v = (1, 0).
 
@@ -399,18 +382,6 @@ std::vector<double> linspace(double a, double b, int n) {
   return out;
 }
 
-template <class F>
-void with_integrator(std::string_view name, F&& f) {
-  bool found = false;
-  for_each_type(all_integrators{}, [&]<class I>() {
-    if (I::name == name) {
-      found = true;
-      f.template operator()<I>();
-    }
-  });
-  if (!found) throw std::invalid_argument(fmt::format("unknown integrator '{}'", name));
-}
-
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -431,12 +402,14 @@ double spectral_radius(const Eigen::Matrix2d& m) {
 }
 
 Eigen::Matrix2d amplification_matrix(std::string_view integrator, stability_test test, double y) {
-  Eigen::Matrix2d m;
-  with_integrator(integrator, [&]<class I>() {
-    m = test == stability_test::oscillator ? amplification<I>(oscillator_problem{}, y)
-                                           : amplification<I>(decay_problem{}, y);
+  std::optional<Eigen::Matrix2d> m;
+  for_each_type(all_integrators{}, [&]<class I>() {
+    if (I::name == integrator)
+      m = test == stability_test::oscillator ? amplification<I>(oscillator_problem{}, y)
+                                             : amplification<I>(decay_problem{}, y);
   });
-  return m;
+  if (!m) throw std::invalid_argument(fmt::format("unknown integrator '{}'", integrator));
+  return *m;
 }
 
 const std::vector<double>& stability_regions::of(std::string_view integrator) const {
@@ -451,7 +424,8 @@ stability_data compute_stability(const stability_settings& settings) {
   auto start = std::chrono::steady_clock::now();
   for_each_type(all_integrators{}, [&]<class I>() {
     for (auto test : {stability_test::oscillator, stability_test::decay})
-      out.limits.push_back(limit_of<I>(test, settings));
+      out.limits.push_back(test == stability_test::oscillator ? limit_of<I>(oscillator_problem{}, test, settings)
+                                                              : limit_of<I>(decay_problem{}, test, settings));
   });
   out.limits_seconds = seconds_since(start);
   start = std::chrono::steady_clock::now();

@@ -2,6 +2,7 @@
 
 #include <limits>
 
+#include "core/contains.hpp"
 #include "core/number.hpp"
 
 namespace stepbench {
@@ -29,15 +30,13 @@ substep_row run_one(const problem_study& ps, const std::string& method, int n, d
 std::vector<substep_study> run_substeps(const study& s, const substep_options& opts) {
   std::vector<substep_study> out;
   for (const auto& ps : s.problems) {
-    if (std::find(opts.problems.begin(), opts.problems.end(), ps.problem->name()) == opts.problems.end()) continue;
+    if (!contains(opts.problems, ps.problem->name())) continue;
     substep_study st;
     st.problem = ps.problem->name();
     st.frame_dt = ps.horizon / opts.frames;
     for (const auto& info : ps.problem->methods()) {
-      const bool is_implicit = std::find(opts.implicit_methods.begin(), opts.implicit_methods.end(), info.name) !=
-                               opts.implicit_methods.end();
-      const bool is_explicit = std::find(opts.explicit_methods.begin(), opts.explicit_methods.end(), info.name) !=
-                               opts.explicit_methods.end();
+      const bool is_implicit = contains(opts.implicit_methods, info.name);
+      const bool is_explicit = contains(opts.explicit_methods, info.name);
       if (!is_implicit && !is_explicit) continue;
       substep_method m{info, {}};
       for (int n : is_implicit ? std::vector<int>{1} : opts.counts)

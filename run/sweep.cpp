@@ -34,11 +34,10 @@ void validate(const sweep_options& opts) {
   if (!(opts.tol.rtol > 0.0 && opts.tol.atol > 0.0)) throw std::invalid_argument("reference tolerances must be > 0");
   for (double tol : opts.tolerances)
     if (!(tol > 0.0 && tol < 1.0)) throw std::invalid_argument(fmt::format("tolerance {:g} is not in (0, 1)", tol));
-  for (const auto& name : opts.methods) find_method(name);
   // The parts' own method and problem lists name registry entries: a renamed method or
   // problem fails here, at the start, instead of dropping out of a part unseen.
-  for (const auto* names : {&opts.loop.methods, &opts.substeps.explicit_methods, &opts.substeps.implicit_methods,
-                            &opts.challenge.competitors, &opts.energy.methods})
+  for (const auto* names : {&opts.methods, &opts.loop.methods, &opts.substeps.explicit_methods,
+                            &opts.substeps.implicit_methods, &opts.challenge.competitors, &opts.energy.methods})
     for (const auto& name : *names) find_method(name);
   for (const auto* names : {&opts.loop.problems, &opts.substeps.problems})
     for (const auto& name : *names) make_problem(name);
@@ -82,15 +81,12 @@ void validate(const sweep_options& opts) {
   }
 }
 
-std::vector<double> dt_ladder(double horizon, const sweep_options& opts) {
+std::vector<double> param_ladder(const method_info& m, double horizon, const sweep_options& opts) {
+  if (m.kind != method_kind::fixed_step) return opts.tolerances;
   std::vector<double> out;
   for (int k = 0; k < opts.max_levels; ++k)
     out.push_back(horizon / (static_cast<double>(opts.base_steps) * std::ldexp(1.0, k)));
   return out;
-}
-
-std::vector<double> param_ladder(const method_info& m, double horizon, const sweep_options& opts) {
-  return m.kind == method_kind::fixed_step ? dt_ladder(horizon, opts) : opts.tolerances;
 }
 
 void fit_rows(method_study& ms, double pos_scale) {
@@ -164,8 +160,9 @@ method_study run_method(const problem_study& ps, const method_info& m, const swe
   method_study ms;
   ms.info = m;
   const double dim = ps.problem->dim();
-  if (m.kind == method_kind::fixed_step) {
-    for (double param : dt_ladder(ps.horizon, opts)) {
+  const bool fixed = m.kind == method_kind::fixed_step;
+  for (double param : param_ladder(m, ps.horizon, opts)) {
+    if (fixed) {
       if (ms.ladder_end = fixed_ladder_end(ms.rows, dim, ps.truth.pos_scale, opts); !ms.ladder_end.empty()) break;
       // A level within `levels` whose work (twice the previous level's force evaluations,
       // times the coordinates) would exceed the budget is skipped, with the reason.
@@ -177,18 +174,13 @@ method_study run_method(const problem_study& ps, const method_info& m, const swe
                         2.0 * static_cast<double>(ms.rows.back().work.force_evals), dim, opts.limits.work_budget)));
         continue;
       }
-      const run_result run = ps.problem->run(m.name, param, ps.horizon, ps.truth.times, opts.limits);
-      ms.rows.push_back({param, run.steps, run.rejected_steps, run.work, measure(*ps.problem, run, ps.truth), {}});
     }
-    if (ms.ladder_end.empty()) ms.ladder_end = fixed_ladder_end(ms.rows, dim, ps.truth.pos_scale, opts);
-  } else {
-    for (double param : opts.tolerances) {
-      const run_result run = ps.problem->run(m.name, param, ps.horizon, ps.truth.times, opts.limits);
-      ms.rows.push_back({param, run.steps, run.rejected_steps, run.work, measure(*ps.problem, run, ps.truth), {}});
-    }
-    if (!opts.tolerances.empty())
-      ms.ladder_end = fmt::format("the tolerance ladder's end ({:g})", opts.tolerances.back());
+    const run_result run = ps.problem->run(m.name, param, ps.horizon, ps.truth.times, opts.limits);
+    ms.rows.push_back({param, run.steps, run.rejected_steps, run.work, measure(*ps.problem, run, ps.truth), {}});
   }
+  if (fixed && ms.ladder_end.empty()) ms.ladder_end = fixed_ladder_end(ms.rows, dim, ps.truth.pos_scale, opts);
+  if (!fixed && !opts.tolerances.empty())
+    ms.ladder_end = fmt::format("the tolerance ladder's end ({:g})", opts.tolerances.back());
   fit_rows(ms, ps.truth.pos_scale);
   return ms;
 }

@@ -37,10 +37,8 @@ int sweep_jobs(const sweep_options& opts, std::size_t problems);
 // with a one-line message on the first problem found; run before any work or output.
 void validate(const sweep_options& opts);
 
-// The ladder's timesteps for a horizon, to its longest (max_levels): a fixed-step
-// method's rows are a prefix of it, at least `levels` long.
-std::vector<double> dt_ladder(double horizon, const sweep_options& opts);
-// The ladder of a method: dts or tolerances.
+// The ladder of a method: a fixed-step one's timesteps for a horizon, to its longest
+// (max_levels; its rows are a prefix, at least `levels` long), or the tolerances.
 std::vector<double> param_ladder(const method_info& m, double horizon, const sweep_options& opts);
 
 // The problem with its overrides applied and checked.

@@ -103,14 +103,6 @@ struct scan_result {
   std::string source;         // the file it was read from ("" when run here): merge names it
 };
 
-// The cheapest run meeting the tolerance at each point and rate (scan_result::best), from
-// its runs: after a scan's run, its read and its merge.
-void compute_best(scan_result& s);
-
-}  // namespace stepbench
-
-namespace stepbench {
-
 // The range question answered from a scan at a tolerance (which may differ from the
 // scan's own): at each rate, the cheapest method and substep count that completes within
 // `tol` at every trusted grid point (cost: its largest force evaluations a frame over the

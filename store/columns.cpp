@@ -3,17 +3,9 @@
 namespace stepbench::columns_detail {
 
 h5::column empty_column(schema::field_type type) {
-  switch (type) {
-    case schema::field_type::f64:
-      return std::vector<double>{};
-    case schema::field_type::i64:
-      return std::vector<std::int64_t>{};
-    case schema::field_type::i8:
-      return std::vector<std::int8_t>{};
-    case schema::field_type::str:
-      break;
-  }
-  return std::vector<std::string>{};
+  static const h5::column empty[] = {std::vector<double>{}, std::vector<std::int64_t>{}, std::vector<std::int8_t>{},
+                                     std::vector<std::string>{}};  // in field_type's order, as h5::column's
+  return empty[static_cast<int>(type)];
 }
 
 read_column column_of(const h5::table_data& t, const std::string& field, schema::field_type type) {

@@ -1,14 +1,15 @@
 #pragma once
-// A table's row-to-column mapping, written once for the writer and the reader alike: each
-// field of a schema table (store/schema.hpp) bound by name to a member of the row struct,
-// through an accessor that returns a reference to it. The writer builds an h5::table from
-// rows through it, the reader builds rows from an h5::table_data through it; both follow
-// the schema's table (names, order, types, timed-only groups).
+// A table's row-to-column mapping, written once for the writer, the reader and the schema
+// (store/schema.cpp lists these maps' tables): each field of a study file table, in order,
+// bound by name to a member of the row struct (its type the field's), through an accessor
+// that returns a reference to it. The writer builds an h5::table from rows through it, the
+// reader builds rows from an h5::table_data through it.
 //
 // Member and file types: bool <-> i8, integers <-> i64, double <-> f64, std::string <->
 // str. A field the file stores derived from the row (a flag or ratio of it) is written
 // only (`derived`); one stored in another form is written by a getter and read by a
 // setter.
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <initializer_list>
@@ -51,17 +52,10 @@ auto stored(const T& v) {
     return std::string(v);
 }
 
+// A member's field type: that of the column holding its stored values.
 template <class T>
-constexpr schema::field_type type_of() {
-  using S = decltype(stored(std::declval<T>()));
-  if constexpr (std::is_same_v<S, std::int8_t>)
-    return schema::field_type::i8;
-  else if constexpr (std::is_same_v<S, std::int64_t>)
-    return schema::field_type::i64;
-  else if constexpr (std::is_same_v<S, double>)
-    return schema::field_type::f64;
-  else
-    return schema::field_type::str;
+schema::field_type type_of() {
+  return h5::type_of(std::vector<decltype(stored(std::declval<T>()))>{});
 }
 
 // A column of a table read back, as the reader holds it (i8 and i64 both as int64).
@@ -98,101 +92,113 @@ read_column column_of(const h5::table_data& t, const std::string& field, schema:
 template <class Row>
 class column_map {
  public:
-  explicit column_map(std::string_view table) : spec_(&schema::find(table)) {}
-  // A table the schema does not list: a study part's own (parts/part.hpp), which outlives the map.
-  explicit column_map(const schema::table& spec) : spec_(&spec) {}
+  // The schema's table `name`, stored at `where` (for the reader and the docs): its fields
+  // are those bound below, in their order (store/schema.cpp lists the tables).
+  column_map(std::string_view name, std::string_view where) : spec_{name, where, {}} {}
+  // A study part's own table, declared in its file (parts/part.hpp) and outliving the map:
+  // the fields bound below are written checked against it.
+  explicit column_map(const schema::table& declared) : column_map(declared.name, declared.where) {
+    declared_ = &declared;
+  }
+  // spec_ points into the map's vectors: a move keeps their buffers, a copy would not.
+  column_map(column_map&&) = default;
+  column_map(const column_map&) = delete;
+
+  const schema::table& spec() const { return declared_ ? *declared_ : spec_; }
 
   // The field `name` is the member at `path` (member pointers, outermost first): row.*a.*b.
   template <class... Path>
-  column_map& member(std::string_view name, Path... path) {
+  column_map&& member(std::string_view name, Path... path) {
     static_assert((std::is_member_object_pointer_v<Path> && ...), "a path of member pointers");
     return field(
         name, [=](auto& r) -> auto& { return columns_detail::member_at(r, path...); });
   }
   // The field `name` is the member access(row) refers to; written and read.
   template <class Access>
-  column_map& field(std::string_view name, Access access) {
+  column_map&& field(std::string_view name, Access access) {
     using M = std::remove_cvref_t<decltype(access(std::declval<Row&>()))>;
-    return add(name, columns_detail::type_of<M>(), writer(access),
-               [access](Row& r, const columns_detail::read_column& c, std::size_t i) {
-                 access(r) = columns_detail::value_at<M>(c, i);
-               });
+    return add(
+        name, columns_detail::type_of<M>(), writer(access),
+        [access](Row& r, const columns_detail::read_column& c, std::size_t i) {
+          access(r) = columns_detail::value_at<M>(c, i);
+        },
+        timed_);
   }
   // The field `name` is get(row), read back by set(row, value).
   template <class Get, class Set>
-  column_map& field(std::string_view name, Get get, Set set) {
+  column_map&& field(std::string_view name, Get get, Set set) {
     using M = std::remove_cvref_t<decltype(get(std::declval<const Row&>()))>;
-    return add(name, columns_detail::type_of<M>(), writer(get),
-               [set](Row& r, const columns_detail::read_column& c, std::size_t i) {
-                 set(r, columns_detail::value_at<M>(c, i));
-               });
+    return add(
+        name, columns_detail::type_of<M>(), writer(get),
+        [set](Row& r, const columns_detail::read_column& c, std::size_t i) {
+          set(r, columns_detail::value_at<M>(c, i));
+        },
+        timed_);
   }
   // The field `name` is get(row), derived from the row: written only.
   template <class Get>
-  column_map& derived(std::string_view name, Get get) {
+  column_map&& derived(std::string_view name, Get get) {
     using M = std::remove_cvref_t<decltype(get(std::declval<const Row&>()))>;
-    return add(name, columns_detail::type_of<M>(), writer(get), nullptr);
+    return add(name, columns_detail::type_of<M>(), writer(get), nullptr, timed_);
   }
   // Every field of `inner`, bound to the member access(row) of this row.
   template <class Inner, class Access>
-  column_map& fields(const column_map<Inner>& inner, Access access) {
+  column_map&& fields(const column_map<Inner>& inner, Access access) {
     for (const auto& b : inner.bindings_) {
       getter get;
       if (b.get)
         get = [g = b.get, access](Row& r, const columns_detail::read_column& c, std::size_t i) { g(access(r), c, i); };
       add(
-          b.name, b.type, [p = b.put, access](const Row& r, h5::column& c) { p(access(r), c); }, std::move(get));
+          b.name, b.type, [p = b.put, access](const Row& r, h5::column& c) { p(access(r), c); }, std::move(get),
+          b.timed);
       bindings_.back().missing = b.missing;
     }
-    return *this;
+    return std::move(*this);
   }
   // The last field, absent from files written before it was added, reads as `value`.
-  column_map& missing_as(double value) {
+  column_map&& missing_as(double value) {
     bindings_.back().missing = value;
-    return *this;
+    return std::move(*this);
+  }
+  // The fields bound after this one form a timed-only group: present exactly when the study
+  // was timed (stepbench_bench --study_out), as a whole.
+  column_map&& timed_only() {
+    timed_ = true;
+    return std::move(*this);
   }
 
-  // The rows as the schema's table (its timed-only groups when `timed`).
+  // The rows as the table (its timed-only fields when `timed`).
   h5::table table(std::span<const Row> rows, bool timed = false) const {
     h5::table t;
-    std::size_t bound = 0;
-    for (const auto& group : spec_->groups)
-      for (const auto& f : group.fields) {
-        const binding& b = find(f.name);
-        ++bound;
-        if (group.timed_only && !timed) continue;
-        h5::column c = columns_detail::empty_column(f.type);
+    for (const auto& b : bindings_)
+      if (timed || !b.timed) {
+        h5::column c = columns_detail::empty_column(b.type);
         for (const auto& r : rows) b.put(r, c);
-        t.add(std::string(f.name), std::move(c));
+        t.add(std::string(b.name), std::move(c));
       }
-    if (bound != bindings_.size())
-      throw std::logic_error(std::string("a column map binds a field its schema table ") + std::string(spec_->name) +
-                             " lacks");
     return t;
   }
   void write(H5::Group& g, const std::string& dataset, std::span<const Row> rows, bool timed = false) const {
-    table(rows, timed).write(g, dataset, *spec_);
+    table(rows, timed).write(g, dataset, spec());
   }
 
-  // The rows of a table read back: every field the schema declares, of its type (a
-  // timed-only group present whole or absent); fields the schema lacks (added by a newer
-  // build of the same format) are left alone.
+  // The rows of a table read back: every field bound, of its type (the timed-only group
+  // present whole or absent); fields not bound (added by a newer build of the same format)
+  // are left alone.
   std::vector<Row> read(const h5::table_data& t) const {
     std::vector<Row> out(t.rows());
-    for (const auto& group : spec_->groups) {
-      if (group.timed_only && !t.has(std::string(group.fields.front().name))) continue;
-      for (const auto& f : group.fields) {
-        const binding& b = find(f.name);
-        if (!b.get) continue;
-        const std::string name(f.name);
-        if (!t.has(name) && b.missing) {
-          const std::vector<double> fill(t.rows(), *b.missing);
-          for (std::size_t i = 0; i < out.size(); ++i) b.get(out[i], &fill, i);
-          continue;
-        }
-        const auto c = columns_detail::column_of(t, name, f.type);  // throws naming a missing field
-        for (std::size_t i = 0; i < out.size(); ++i) b.get(out[i], c, i);
+    const auto first_timed = std::find_if(bindings_.begin(), bindings_.end(), [](const auto& b) { return b.timed; });
+    const bool timed = first_timed != bindings_.end() && t.has(std::string(first_timed->name));
+    for (const auto& b : bindings_) {
+      if (!b.get || (b.timed && !timed)) continue;
+      const std::string name(b.name);
+      if (!t.has(name) && b.missing) {
+        const std::vector<double> fill(t.rows(), *b.missing);
+        for (std::size_t i = 0; i < out.size(); ++i) b.get(out[i], &fill, i);
+        continue;
       }
+      const auto c = columns_detail::column_of(t, name, b.type);  // throws naming a missing field
+      for (std::size_t i = 0; i < out.size(); ++i) b.get(out[i], c, i);
     }
     return out;
   }
@@ -209,6 +215,7 @@ class column_map {
   struct binding {
     std::string_view name;
     schema::field_type type;
+    bool timed;
     putter put;
     getter get;  // empty: written only
     std::optional<double> missing;
@@ -221,28 +228,24 @@ class column_map {
       std::get<std::vector<decltype(v)>>(c).push_back(std::move(v));
     };
   }
-  column_map& add(std::string_view name, schema::field_type type, putter put, getter get) {
-    for (const auto& group : spec_->groups)
-      for (const auto& f : group.fields)
-        if (f.name == name) {
-          if (f.type != type)
-            throw std::logic_error(std::string("column ") + std::string(name) + " of table " +
-                                   std::string(spec_->name) + " is bound to a member of another type");
-          bindings_.push_back({f.name, type, std::move(put), std::move(get), std::nullopt});
-          return *this;
-        }
-    throw std::logic_error(std::string("the schema's table ") + std::string(spec_->name) + " has no field " +
-                           std::string(name));
-  }
-  const binding& find(std::string_view name) const {
-    for (const auto& b : bindings_)
-      if (b.name == name) return b;
-    throw std::logic_error(std::string("no column bound to field ") + std::string(name) + " of table " +
-                           std::string(spec_->name));
+  column_map&& add(std::string_view name, schema::field_type type, putter put, getter get, bool timed) {
+    bindings_.push_back({name, type, timed, std::move(put), std::move(get), std::nullopt});
+    fields_.push_back({name, type});
+    if (groups_.empty() || groups_.back().timed_only != timed) groups_.push_back({{}, timed});
+    // The groups' spans into fields_, set again as it grows (a span keeps its size).
+    groups_.back().fields = {fields_.data(), groups_.back().fields.size() + 1};
+    for (std::size_t g = 0, at = 0; g < groups_.size(); at += groups_[g++].fields.size())
+      groups_[g].fields = {fields_.data() + at, groups_[g].fields.size()};
+    spec_.groups = groups_;
+    return std::move(*this);
   }
 
-  const schema::table* spec_;
+  schema::table spec_;
+  const schema::table* declared_ = nullptr;
   std::vector<binding> bindings_;
+  std::vector<schema::field> fields_;
+  std::vector<schema::field_group> groups_;
+  bool timed_ = false;
 };
 
 }  // namespace stepbench

@@ -10,7 +10,7 @@ namespace {
 
 const column_map<energy_run>& energy_columns() {
   using R = energy_run;
-  static const auto columns = column_map<R>("energy_summary")
+  static const auto columns = column_map<R>("energy_summary", "/energy/<p>/summary")
                                   .field(
                                       "method", [](auto& r) -> auto& { return r.info.name; })
                                   .field(
@@ -35,6 +35,8 @@ const column_map<energy_run>& energy_columns() {
 }
 
 }  // namespace
+
+std::vector<schema::table> energy_tables() { return {energy_columns().spec()}; }
 
 void write_energy(H5::Group& root, const energy_study& s) {
   if (s.problems.empty()) return;

@@ -41,58 +41,50 @@ void attr(H5::H5Object& obj, const std::string& name, long value) {
       .write(H5::PredType::NATIVE_INT64, &v);
 }
 void attr(H5::H5Object& obj, const std::string& name, int value) { attr(obj, name, static_cast<long>(value)); }
-void attr(H5::H5Object& obj, const std::string& name, const std::vector<int>& values) {
+template <class T>
+static void array_attr(H5::H5Object& obj, const std::string& name, const std::vector<T>& values,
+                       const H5::PredType& type) {
   const hsize_t n = values.size();
-  H5::DataSpace space = n ? H5::DataSpace(1, &n) : H5::DataSpace(H5S_NULL);
-  auto a = obj.createAttribute(name, H5::PredType::NATIVE_INT, space);
-  if (n) a.write(H5::PredType::NATIVE_INT, values.data());
+  auto a = obj.createAttribute(name, type, n ? H5::DataSpace(1, &n) : H5::DataSpace(H5S_NULL));
+  if (n) a.write(type, values.data());
+}
+void attr(H5::H5Object& obj, const std::string& name, const std::vector<int>& values) {
+  array_attr(obj, name, values, H5::PredType::NATIVE_INT);
 }
 void attr(H5::H5Object& obj, const std::string& name, const std::vector<double>& values) {
-  const hsize_t n = values.size();
-  H5::DataSpace space = n ? H5::DataSpace(1, &n) : H5::DataSpace(H5S_NULL);
-  auto a = obj.createAttribute(name, H5::PredType::NATIVE_DOUBLE, space);
-  if (n) a.write(H5::PredType::NATIVE_DOUBLE, values.data());
+  array_attr(obj, name, values, H5::PredType::NATIVE_DOUBLE);
 }
 
 void dataset(H5::Group& g, const std::string& name, const std::vector<double>& v) {
   const hsize_t n = v.size();
   g.createDataSet(name, H5::PredType::NATIVE_DOUBLE, H5::DataSpace(1, &n)).write(v.data(), H5::PredType::NATIVE_DOUBLE);
 }
-void dataset(H5::Group& g, const std::string& name, const std::vector<std::vector<double>>& rows) {
-  const hsize_t dims[2] = {rows.size(), rows.empty() ? 0 : rows.front().size()};
-  std::vector<double> flat;
-  for (const auto& r : rows) flat.insert(flat.end(), r.begin(), r.end());
-  g.createDataSet(name, H5::PredType::NATIVE_DOUBLE, H5::DataSpace(2, dims))
-      .write(flat.data(), H5::PredType::NATIVE_DOUBLE);
-}
-
-void compressed_grid(H5::Group& g, const std::string& name, const std::vector<std::vector<double>>& rows) {
+// A 2-D dataset of `rows`, stored as `type` (converted from double), chunked and deflated when `compressed`.
+static void write_grid(H5::Group& g, const std::string& name, const std::vector<std::vector<double>>& rows,
+                       const H5::PredType& type, bool compressed) {
   const hsize_t dims[2] = {rows.size(), rows.empty() ? 0 : rows.front().size()};
   std::vector<double> flat;
   for (const auto& r : rows) flat.insert(flat.end(), r.begin(), r.end());
   H5::DSetCreatPropList props;
-  props.setChunk(2, dims);
-  props.setShuffle();
-  props.setDeflate(6);
-  g.createDataSet(name, H5::PredType::IEEE_F32LE, H5::DataSpace(2, dims), props)
+  if (compressed) {
+    props.setChunk(2, dims);
+    props.setShuffle();
+    props.setDeflate(6);
+  }
+  g.createDataSet(name, type, H5::DataSpace(2, dims), compressed ? props : H5::DSetCreatPropList::DEFAULT)
       .write(flat.data(), H5::PredType::NATIVE_DOUBLE);
+}
+void dataset(H5::Group& g, const std::string& name, const std::vector<std::vector<double>>& rows) {
+  write_grid(g, name, rows, H5::PredType::NATIVE_DOUBLE, false);
+}
+void compressed_grid(H5::Group& g, const std::string& name, const std::vector<std::vector<double>>& rows) {
+  write_grid(g, name, rows, H5::PredType::IEEE_F32LE, true);
 }
 
 void table::add(std::string name, column values) { columns_.emplace_back(std::move(name), std::move(values)); }
 
 void table::check(const std::string& name, const schema::table& spec) const {
   std::size_t c = 0;
-  auto type_of = [](const column& col) {
-    return std::visit(
-        [](const auto& v) {
-          using T = typename std::decay_t<decltype(v)>::value_type;
-          if constexpr (std::is_same_v<T, double>) return schema::field_type::f64;
-          if constexpr (std::is_same_v<T, std::int64_t>) return schema::field_type::i64;
-          if constexpr (std::is_same_v<T, std::int8_t>) return schema::field_type::i8;
-          return schema::field_type::str;
-        },
-        col);
-  };
   for (const auto& group : spec.groups) {
     const bool present = c < columns_.size() && columns_[c].first == group.fields.front().name;
     if (!present && group.timed_only) continue;
@@ -118,15 +110,9 @@ void table::write(H5::Group& g, const std::string& name, const schema::table& sp
     if (!offset.empty() && n != rows)
       throw std::logic_error(fmt::format("table {}: column {} has {} rows, not {}", name, col_name, n, rows));
     rows = n;
-    const std::size_t size = std::visit(
-        [](const auto& v) -> std::size_t {
-          using T = typename std::decay_t<decltype(v)>::value_type;
-          if constexpr (std::is_same_v<T, std::string>)
-            return sizeof(const char*);
-          else
-            return sizeof(T);
-        },
-        col);
+    // In the memory record, in h5::column's order of types: a string as its char*.
+    constexpr std::size_t sizes[] = {sizeof(double), sizeof(std::int64_t), sizeof(std::int8_t), sizeof(const char*)};
+    const std::size_t size = sizes[col.index()];
     width = (width + size - 1) / size * size;  // natural alignment in memory
     offset.push_back(width);
     width += size;
@@ -309,20 +295,21 @@ std::vector<double> table_data::doubles(const std::string& field) const {
   if (const auto it = integers_.find(field); it != integers_.end()) return {it->second.begin(), it->second.end()};
   throw std::runtime_error(fmt::format("missing numeric field '{}' in {}", field, name_));
 }
-const std::vector<double>& table_data::reals(const std::string& field) const {
-  const auto it = reals_.find(field);
-  if (it == reals_.end()) throw std::runtime_error(fmt::format("missing real field '{}' in {}", field, name_));
+template <class T>
+static const std::vector<T>& column_named(const std::map<std::string, std::vector<T>>& columns,
+                                          const std::string& field, const char* kind, const std::string& table) {
+  const auto it = columns.find(field);
+  if (it == columns.end()) throw std::runtime_error(fmt::format("missing {} field '{}' in {}", kind, field, table));
   return it->second;
+}
+const std::vector<double>& table_data::reals(const std::string& field) const {
+  return column_named(reals_, field, "real", name_);
 }
 const std::vector<std::int64_t>& table_data::ints(const std::string& field) const {
-  const auto it = integers_.find(field);
-  if (it == integers_.end()) throw std::runtime_error(fmt::format("missing integer field '{}' in {}", field, name_));
-  return it->second;
+  return column_named(integers_, field, "integer", name_);
 }
 const std::vector<std::string>& table_data::strings(const std::string& field) const {
-  const auto it = texts_.find(field);
-  if (it == texts_.end()) throw std::runtime_error(fmt::format("missing string field '{}' in {}", field, name_));
-  return it->second;
+  return column_named(texts_, field, "string", name_);
 }
 
 table_data read_table(const H5::DataSet& ds) {
@@ -340,16 +327,12 @@ table_data read_table(const H5::DataSet& ds) {
   for (const auto& m : members) {
     out.fields_.emplace_back(m.name, m.kind);
     // Every field has its column, empty in a table of no rows (a shard without points).
-    switch (m.kind) {
-      case table_data::kind::real:
-        out.reals_[m.name];
-        break;
-      case table_data::kind::integer:
-        out.integers_[m.name];
-        break;
-      case table_data::kind::text:
-        out.texts_[m.name];
-    }
+    if (m.kind == table_data::kind::real)
+      out.reals_[m.name];
+    else if (m.kind == table_data::kind::integer)
+      out.integers_[m.name];
+    else
+      out.texts_[m.name];
   }
   if (out.rows_ == 0) return out;
   std::vector<unsigned char> raw(out.rows_ * record, 0);
@@ -474,24 +457,24 @@ long long_attr(const H5::H5Object& obj, const std::string& name) {
   a.read(H5::PredType::NATIVE_INT64, &v);
   return static_cast<long>(v);
 }
-std::vector<long> int_array_attr(const H5::H5Object& obj, const std::string& name) {
-  const H5::Attribute a = checked_attr(obj, name, attr_kind::integer, false);
+// The array attribute `name` of obj, checked as `kind` and read as `type` (empty for a null dataspace).
+template <class T>
+static std::vector<T> read_array_attr(const H5::H5Object& obj, const std::string& name, attr_kind kind,
+                                      const H5::PredType& type) {
+  const H5::Attribute a = checked_attr(obj, name, kind, false);
   const H5::DataSpace space = a.getSpace();
   if (space.getSimpleExtentType() == H5S_NULL) return {};
   const std::string what = fmt::format("attribute '{}' on {}", name, object_name(obj));
-  std::vector<std::int64_t> raw(checked_extent(space, a.getDataType().getSize(), file_size(obj), what));
-  if (!raw.empty()) a.read(H5::PredType::NATIVE_INT64, raw.data());
+  std::vector<T> out(checked_extent(space, a.getDataType().getSize(), file_size(obj), what));
+  if (!out.empty()) a.read(type, out.data());
+  return out;
+}
+std::vector<long> int_array_attr(const H5::H5Object& obj, const std::string& name) {
+  const auto raw = read_array_attr<std::int64_t>(obj, name, attr_kind::integer, H5::PredType::NATIVE_INT64);
   return {raw.begin(), raw.end()};
 }
-
 std::vector<double> double_array_attr(const H5::H5Object& obj, const std::string& name) {
-  const H5::Attribute a = checked_attr(obj, name, attr_kind::number, false);
-  const H5::DataSpace space = a.getSpace();
-  if (space.getSimpleExtentType() == H5S_NULL) return {};
-  const std::string what = fmt::format("attribute '{}' on {}", name, object_name(obj));
-  std::vector<double> out(checked_extent(space, a.getDataType().getSize(), file_size(obj), what));
-  if (!out.empty()) a.read(H5::PredType::NATIVE_DOUBLE, out.data());
-  return out;
+  return read_array_attr<double>(obj, name, attr_kind::number, H5::PredType::NATIVE_DOUBLE);
 }
 
 std::map<std::string, std::string> string_attrs(const H5::H5Object& obj) {
@@ -499,11 +482,20 @@ std::map<std::string, std::string> string_attrs(const H5::H5Object& obj) {
       obj, [](H5T_class_t c) { return c == H5T_STRING; }, attr_kind::string, read_string);
 }
 std::map<std::string, double> number_attrs(const H5::H5Object& obj, bool floats_only) {
-  return floats_only ? scan_attrs<double>(
-                           obj, [](H5T_class_t c) { return c == H5T_FLOAT; }, attr_kind::number, read_double)
-                     : scan_attrs<double>(
-                           obj, [](H5T_class_t c) { return c == H5T_FLOAT || c == H5T_INTEGER; }, attr_kind::number,
-                           read_double);
+  const auto wanted = floats_only ? +[](H5T_class_t c) { return c == H5T_FLOAT; }
+                                  : +[](H5T_class_t c) { return c == H5T_FLOAT || c == H5T_INTEGER; };
+  return scan_attrs<double>(obj, wanted, attr_kind::number, read_double);
+}
+
+std::vector<std::string> split(const std::string& text, char sep) {
+  std::vector<std::string> out;
+  if (text.empty()) return out;
+  for (std::size_t a = 0;;) {
+    const auto b = text.find(sep, a);
+    out.push_back(text.substr(a, b == std::string::npos ? std::string::npos : b - a));
+    if (b == std::string::npos) return out;
+    a = b + 1;
+  }
 }
 
 }  // namespace stepbench::h5

@@ -29,10 +29,11 @@ void dataset(H5::Group& g, const std::string& name, const std::vector<std::vecto
 // shuffle and deflate, a quarter of the doubles' size; readers get it converted back.
 void compressed_grid(H5::Group& g, const std::string& name, const std::vector<std::vector<double>>& rows);
 
-// A column of a table: f64, i64, i8 or str (variable-length strings), by the schema's
-// field types (store/schema.hpp).
+// A column of a table: f64, i64, i8 or str (variable-length strings), its index the
+// schema's field type (store/schema.hpp).
 using column =
     std::variant<std::vector<double>, std::vector<std::int64_t>, std::vector<std::int8_t>, std::vector<std::string>>;
+inline schema::field_type type_of(const column& c) { return static_cast<schema::field_type>(c.index()); }
 
 // A table under construction: columns of equal length, written as one compound dataset
 // (packed in the file; fields in the order added).
@@ -96,5 +97,7 @@ std::vector<double> double_array_attr(const H5::H5Object& obj, const std::string
 // too), by name; attributes of other kinds are skipped, damaged ones refused.
 std::map<std::string, std::string> string_attrs(const H5::H5Object& obj);
 std::map<std::string, double> number_attrs(const H5::H5Object& obj, bool floats_only);
+// The items of a list attribute's text, separated by `sep` (none for ""; the items hold no `sep`).
+std::vector<std::string> split(const std::string& text, char sep);
 
 }  // namespace stepbench::h5

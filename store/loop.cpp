@@ -15,7 +15,7 @@ struct loop_run {
   loop_cost cost;
 };
 
-void write_runs(H5::Group& g, const loop_method& m, double step_cost_ns, const std::string& source) {
+const column_map<loop_run>& loop_run_columns() {
   using R = loop_run;
   using L = loop_row;
   using S = loop_schedule;
@@ -26,7 +26,7 @@ void write_runs(H5::Group& g, const loop_method& m, double step_cost_ns, const s
     return [=](auto& r) -> auto& { return (r.cost.*....*path); };
   };
   static const auto columns =
-      column_map<R>("loop_runs")
+      column_map<R>("loop_runs", "/loop/<p>/<m>/runs")
           .derived("design", [](const R& r) { return to_string(r.row.config.design); })
           .field("clock", run(&L::clock))
           .field("display_hz", run(&L::config, &loop_config::display_hz))
@@ -70,19 +70,12 @@ void write_runs(H5::Group& g, const loop_method& m, double step_cost_ns, const s
           .derived("outcome", [](const R& r) { return to_string(r.cost.schedule.outcome); })
           .derived("outcome_without_clamp", [](const R& r) { return to_string(r.cost.without_clamp); })
           .field("clamp_prevented_spiral", cost(&loop_cost::clamp_prevented_spiral));
-  std::vector<R> rows;
-  std::vector<std::vector<double>> finals;
-  for (const auto& r : m.rows) {
-    rows.push_back({r, cost_verdict(r.config, step_cost_ns, source)});
-    finals.push_back(r.final_physics);
-  }
-  columns.write(g, "runs", rows);
-  h5::dataset(g, "final_physics_state", finals);
+  return columns;
 }
 
-void write_cheapest(H5::Group& g, const loop_method& m, const loop_options& opts) {
+const column_map<loop_cheapest>& loop_cheapest_columns() {
   using R = loop_cheapest;
-  static const auto columns = column_map<R>("loop_cheapest")
+  static const auto columns = column_map<R>("loop_cheapest", "/loop/<p>/<m>/cheapest")
                                   .member("display_hz", &R::display_hz)
                                   .member("target", &R::target)
                                   .member("found", &R::found)
@@ -90,10 +83,12 @@ void write_cheapest(H5::Group& g, const loop_method& m, const loop_options& opts
                                   .member("physics_hz", &R::physics_hz)
                                   .member("steps_per_frame_mean", &R::steps_per_frame_mean)
                                   .member("shown_err_max", &R::shown_err_max);
-  columns.write(g, "cheapest", cheapest_designs(m, opts));
+  return columns;
 }
 
 }  // namespace
+
+std::vector<schema::table> loop_tables() { return {loop_run_columns().spec(), loop_cheapest_columns().spec()}; }
 
 void write_loop(H5::Group& root, const study& s) {
   const loop_study& ls = s.results.get<loop_study>();
@@ -136,8 +131,15 @@ void write_loop(H5::Group& root, const study& s) {
       const std::string source = is_measured ? "measured" : "stated";
       h5::attr(mg, "step_cost_ns", cost);
       h5::attr(mg, "step_cost_source", source);
-      write_runs(mg, m, cost, source);
-      write_cheapest(mg, m, o);
+      std::vector<loop_run> rows;
+      std::vector<std::vector<double>> finals;
+      for (const auto& r : m.rows) {
+        rows.push_back({r, cost_verdict(r.config, cost, source)});
+        finals.push_back(r.final_physics);
+      }
+      loop_run_columns().write(mg, "runs", rows);
+      h5::dataset(mg, "final_physics_state", finals);
+      loop_cheapest_columns().write(mg, "cheapest", cheapest_designs(m, o));
     }
   }
 }

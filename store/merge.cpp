@@ -10,23 +10,13 @@
 #include <stdexcept>
 
 #include "run/machine.hpp"
+#include "store/columns.hpp"
 #include "store/h5.hpp"
 #include "store/schema.hpp"
 #include "store/study_file.hpp"
 
 namespace stepbench {
 namespace {
-
-std::vector<std::string> split(const std::string& text, char sep) {
-  std::vector<std::string> out;
-  if (text.empty()) return out;
-  for (std::size_t a = 0;;) {
-    const auto b = text.find(sep, a);
-    out.push_back(text.substr(a, b == std::string::npos ? std::string::npos : b - a));
-    if (b == std::string::npos) return out;
-    a = b + 1;
-  }
-}
 
 bool has_attr(const H5::H5Object& obj, const std::string& name) { return H5Aexists(obj.getId(), name.c_str()) > 0; }
 
@@ -146,7 +136,7 @@ shard_file read_shard(const std::string& path) {
 
 // The first line where two `sweep_options` texts differ, from each.
 std::pair<std::string, std::string> first_difference(const std::string& a, const std::string& b) {
-  const auto la = split(a, '\n'), lb = split(b, '\n');
+  const auto la = h5::split(a, '\n'), lb = h5::split(b, '\n');
   for (std::size_t i = 0; i < std::max(la.size(), lb.size()); ++i) {
     const std::string x = i < la.size() ? la[i] : "(none)", y = i < lb.size() ? lb[i] : "(none)";
     if (x != y) return {x, y};
@@ -180,41 +170,25 @@ void join_table(const std::vector<shard_file>& shards, H5::Group& dst, const std
     if (group.timed_only && !parts.front().has(std::string(group.fields.front().name))) continue;
     for (const auto& f : group.fields) {
       const std::string field(f.name);
-      // The field's values in the merged order, from each part's column (looked up once a part).
-      const auto gather = [&]<class T, class Column>(const std::vector<const Column*>& columns) {
-        std::vector<T> v;
-        v.reserve(rows.size());
-        for (const auto& [r, k, i] : rows) v.push_back(static_cast<T>((*columns[k])[i]));
-        return v;
-      };
-      const auto columns_of = [&](auto read) {
-        std::vector<std::remove_cvref_t<decltype(&read(parts.front()))>> out;
-        for (const auto& p : parts) out.push_back(&read(p));
-        return out;
-      };
-      switch (f.type) {
-        case schema::field_type::f64: {
-          std::vector<std::vector<double>> copies;  // doubles() returns a copy: read each part once
-          std::vector<const std::vector<double>*> cols;
-          for (const auto& p : parts) copies.push_back(p.doubles(field));
-          for (const auto& c : copies) cols.push_back(&c);
-          t.add(field, gather.template operator()<double>(cols));
-          break;
-        }
-        case schema::field_type::i64:
-        case schema::field_type::i8: {
-          const auto cols = columns_of([&](const h5::table_data& p) -> const auto& { return p.ints(field); });
-          if (f.type == schema::field_type::i64)
-            t.add(field, gather.template operator()<std::int64_t>(cols));
-          else
-            t.add(field, gather.template operator()<std::int8_t>(cols));
-          break;
-        }
-        case schema::field_type::str:
-          t.add(field, gather.template operator()<std::string>(
-                           columns_of([&](const h5::table_data& p) -> const auto& { return p.strings(field); })));
-          break;
-      }
+      // The field's values in the merged order, from each part's column (read once a part).
+      h5::column joined = columns_detail::empty_column(f.type);
+      std::visit(
+          [&]<class T>(std::vector<T>& v) {
+            const auto column_of = [&](const h5::table_data& p) {
+              if constexpr (std::is_same_v<T, double>)
+                return p.doubles(field);
+              else if constexpr (std::is_same_v<T, std::string>)
+                return p.strings(field);
+              else
+                return p.ints(field);
+            };
+            std::vector<decltype(column_of(parts.front()))> columns;
+            for (const auto& p : parts) columns.push_back(column_of(p));
+            v.reserve(rows.size());
+            for (const auto& [r, k, i] : rows) v.push_back(static_cast<T>(columns[k][i]));
+          },
+          joined);
+      t.add(field, std::move(joined));
     }
   }
   t.write(dst, name, spec);
@@ -240,10 +214,6 @@ void merge_per_problem(const std::vector<const shard_file*>& having, H5::H5File&
     for (const auto& child : h5::children(s->file.openGroup(top)))
       if (!owner.count(child) || owner.at(child) != s)
         throw std::runtime_error(fmt::format("'{}': /{}/{} is not one of its problems", s->path, top, child));
-}
-
-std::string machine_of(const H5::Group& g) {
-  return fmt::format("{} ({} cores)", h5::string_attr(g, "cpu"), h5::long_attr(g, "cores"));
 }
 
 }  // namespace
@@ -291,7 +261,7 @@ study_merge_result merge_studies(const std::vector<std::string>& paths, const st
       }
   }
   // Every selected problem once.
-  const auto selection = split(first.selection, ',');
+  const auto selection = h5::split(first.selection, ',');
   std::map<long, const shard_file*> by_index;
   std::map<std::string, const shard_file*> owner;
   for (const auto& s : shards) {
@@ -401,12 +371,9 @@ study_merge_result merge_studies(const std::vector<std::string>& paths, const st
       std::vector<std::string> cpus;
       for (const auto& p : result.problems) {
         const H5::Group g = dst.openGroup("problems/" + p);
-        const std::string m = machine_of(g);
+        const std::string m = fmt::format("{} ({} cores)", h5::string_attr(g, "cpu"), h5::long_attr(g, "cores"));
         auto it = std::find_if(machines.begin(), machines.end(), [&](const auto& e) { return e.first == m; });
-        if (it == machines.end()) {
-          machines.push_back({m, {}});
-          it = machines.end() - 1;
-        }
+        if (it == machines.end()) it = machines.insert(it, {m, {}});
         it->second.push_back(p);
         if (const auto cpu = h5::string_attr(g, "cpu"); std::find(cpus.begin(), cpus.end(), cpu) == cpus.end())
           cpus.push_back(cpu);

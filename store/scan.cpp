@@ -10,21 +10,9 @@
 namespace stepbench {
 namespace {
 
-// The names of a comma-separated attribute ("" : none; the names hold no commas).
-std::vector<std::string> names_of(const std::string& text) {
-  std::vector<std::string> out;
-  if (text.empty()) return out;
-  for (std::size_t start = 0; start <= text.size();) {
-    const auto comma = std::min(text.find(',', start), text.size());
-    out.push_back(text.substr(start, comma - start));
-    start = comma + 1;
-  }
-  return out;
-}
-
 const column_map<scan_point>& scan_point_columns() {
   using R = scan_point;
-  static const auto columns = column_map<R>("scan_points")
+  static const auto columns = column_map<R>("scan_points", "/scan/<name>/points")
                                   .member("point", &R::index)
                                   .member("trusted", &R::trusted)
                                   .member("truth_source", &R::truth_source)
@@ -48,7 +36,7 @@ const column_map<scan_run>& scan_run_columns() {
   using R = scan_run;
   using M = run_metrics;
   static const auto columns =
-      column_map<R>("scan_runs")
+      column_map<R>("scan_runs", "/scan/<name>/runs")
           .member("point", &R::point)
           .member("hz", &R::hz)
           .member("method", &R::method)
@@ -71,7 +59,7 @@ const column_map<scan_run>& scan_run_columns() {
 
 const column_map<scan_best>& scan_best_columns() {
   using R = scan_best;
-  static const auto columns = column_map<R>("scan_best")
+  static const auto columns = column_map<R>("scan_best", "/scan/<name>/best")
                                   .member("point", &R::point)
                                   .member("hz", &R::hz)
                                   .member("method", &R::method)
@@ -92,7 +80,7 @@ scan_result read_scan_group(const H5::Group& all, const std::string& which) {
   o.tol = h5::double_attr(g, "tol");
   const auto lo = h5::double_array_attr(g, "axis_lo"), hi = h5::double_array_attr(g, "axis_hi");
   const auto count = h5::int_array_attr(g, "axis_count"), log = h5::int_array_attr(g, "axis_log");
-  const std::vector<std::string> axis_names = names_of(h5::string_attr(g, "axes"));
+  const std::vector<std::string> axis_names = h5::split(h5::string_attr(g, "axes"), ',');
   if (axis_names.size() != lo.size() || lo.size() != hi.size() || hi.size() != count.size() ||
       count.size() != log.size())
     throw std::runtime_error(fmt::format("scan '{}': its axis attributes differ in length", which));
@@ -101,8 +89,8 @@ scan_result read_scan_group(const H5::Group& all, const std::string& which) {
   o.hz = h5::double_array_attr(g, "hz");
   o.substeps.clear();  // the file's counts replace the defaults, not extend them
   for (long n : h5::int_array_attr(g, "substeps")) o.substeps.push_back(static_cast<int>(n));
-  o.methods = names_of(h5::string_attr(g, "methods"));
-  const auto fixed_names = names_of(h5::string_attr(g, "fixed_params"));
+  o.methods = h5::split(h5::string_attr(g, "methods"), ',');
+  const auto fixed_names = h5::split(h5::string_attr(g, "fixed_params"), ',');
   const auto fixed_values = h5::double_array_attr(g, "fixed_values");
   if (fixed_names.size() != fixed_values.size())
     throw std::runtime_error(
@@ -152,6 +140,10 @@ scan_result read_scan_group(const H5::Group& all, const std::string& which) {
 }
 
 }  // namespace
+
+std::vector<schema::table> scan_tables() {
+  return {scan_point_columns().spec(), scan_run_columns().spec(), scan_best_columns().spec()};
+}
 
 std::vector<scan_result> read_scans(const std::string& path) {
   study file = std::move(read_studies({path}, [](const H5::Group& root, study& s) {

@@ -23,6 +23,9 @@ std::string file_build(const std::string& path);
 
 // /scan/<name> of each scan (docs/study-format.md).
 void write_scans(H5::Group& root, const std::vector<scan_result>& scans);
+// A scan's tables: its grid points, every run, and the cheapest run at each point and rate,
+// in the schema's order (store/schema.cpp).
+std::vector<schema::table> scan_tables();
 
 // Joins shards of one scan (the same problem, axes, rates, substeps, methods, tolerance,
 // fixed parameters, reference tolerances and work budget) into one scan, points in grid

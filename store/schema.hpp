@@ -1,8 +1,8 @@
 #pragma once
-// The study file's schema, declared once: its format version, every table's fields with
-// their types, the "row completed" rule and what a method's `param` is (core/method.hpp). The C++ writer
-// checks each table it writes against it (h5::table::write), the C++ readers take their
-// fields from it, and the Python report reads the same declaration from
+// The study file's schema: its format version, every table's fields with their types (the
+// tables of the column maps that write and read them, store/columns.hpp), the "row
+// completed" rule and what a method's `param` is (core/method.hpp). The C++ writer checks
+// each table it writes against it (h5::table::write), and the Python report reads it from
 // scripts/stepbench_report/schema.json, which `stepbench schema` prints and a test
 // compares with this file's (docs/study-format.md says what each field means).
 #include <array>

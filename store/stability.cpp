@@ -7,7 +7,7 @@ namespace stepbench {
 const column_map<stability_limit>& stability_limit_columns() {
   using R = stability_limit;
   static const auto columns =
-      column_map<R>("stability_limits")
+      column_map<R>("stability_limits", "/stability/limits")
           .member("integrator", &R::integrator)
           .field(
               "test", [](const R& l) { return std::string(to_string(l.test)); },
@@ -24,6 +24,8 @@ const column_map<stability_limit>& stability_limit_columns() {
           .member("note", &R::note);
   return columns;
 }
+
+std::vector<schema::table> stability_tables() { return {stability_limit_columns().spec()}; }
 
 void write_stability(H5::Group& root, const stability_data& d) {
   using h5::attr;

@@ -27,10 +27,6 @@ namespace {
 
 using h5::attr;
 
-std::string metric_unit(const std::string& metric, std::string_view unit) {
-  return metric == "err_vel_final" ? std::string(unit) + "/s" : std::string(unit);
-}
-
 void write_reference(H5::Group& parent, const reference_check& ref, const std::string& truth_source, int dim) {
   H5::Group g = parent.createGroup(ref.source);
   attr(g, "status", ref.status);
@@ -102,12 +98,10 @@ struct equal_error_row {
   bool is_answer = false;
 };
 
-// The equal-error table: for each metric and target, every method that reaches it with
-// its cost at equal error interpolated on its measured curve, ranked (core/work_precision.hpp).
-void write_equal_error(H5::Group& g, const problem_study& ps, bool timed) {
+const column_map<equal_error_row>& ranked_equal_error_columns() {
   using R = equal_error_row;
   using P = wp_pick;
-  static const auto columns = column_map<R>("equal_error")
+  static const auto columns = column_map<R>("equal_error", "/problems/<p>/equal_error")
                                   .member("metric", &R::metric)
                                   .member("target", &R::target)
                                   .member("rank", &R::rank)
@@ -124,11 +118,17 @@ void write_equal_error(H5::Group& g, const problem_study& ps, bool timed) {
                                   .member("force_evals", &R::pick, &P::force_evals)
                                   .member("interpolated", &R::pick, &P::interpolated)
                                   .member("is_answer", &R::is_answer);
-  std::vector<R> rows;
+  return columns;
+}
+
+// The equal-error table: for each metric and target, every method that reaches it with
+// its cost at equal error interpolated on its measured curve, ranked (core/work_precision.hpp).
+void write_equal_error(H5::Group& g, const problem_study& ps, bool timed) {
+  std::vector<equal_error_row> rows;
   for (const char* m : {"err_pos_max", "err_pos_final"}) {
     const auto methods = work_precision_input(ps, m);
     for (double tgt : equal_error_targets()) {
-      const auto r = cheapest(methods, tgt, timed, m, metric_unit(m, ps.unit));
+      const auto r = cheapest(methods, tgt, timed, m, ps.unit);
       const auto answer = r.answer(methods);
       for (std::size_t k = 0; k < r.ranked.size(); ++k) {
         const auto& p = r.ranked[k];
@@ -138,7 +138,7 @@ void write_equal_error(H5::Group& g, const problem_study& ps, bool timed) {
       }
     }
   }
-  columns.write(g, "equal_error", rows);
+  ranked_equal_error_columns().write(g, "equal_error", rows);
 }
 
 struct front_row {
@@ -146,18 +146,22 @@ struct front_row {
   double param = 0.0, cost = 0.0, err_pos_max = 0.0;
 };
 
-void write_front(H5::Group& g, const problem_study& ps, bool by_time, bool timed) {
+const column_map<front_row>& front_columns() {
   using R = front_row;
-  static const auto columns = column_map<R>("front")
+  static const auto columns = column_map<R>("front", "/problems/<p>/front_force_evals, /problems/<p>/front_time")
                                   .member("method", &R::method)
                                   .member("param", &R::param)
                                   .member("cost", &R::cost)
                                   .member("err_pos_max", &R::err_pos_max);
+  return columns;
+}
+
+void write_front(H5::Group& g, const problem_study& ps, bool by_time, bool timed) {
   const auto methods = work_precision_input(ps, "err_pos_max");
-  std::vector<R> rows;
+  std::vector<front_row> rows;
   for (const auto& p : pareto_front(methods, by_time, timed))
     rows.push_back({methods[p.method].name, methods[p.method].rows[p.row].param, p.cost, p.error});
-  columns.write(g, by_time ? "front_time" : "front_force_evals", rows);
+  front_columns().write(g, by_time ? "front_time" : "front_force_evals", rows);
 }
 
 void write_problem(H5::Group& parent, const problem_study& ps, const std::optional<timing_settings>& timing) {
@@ -355,7 +359,7 @@ void write_root_attributes(H5::H5File& file, const study& s, const std::string& 
 
 const column_map<param_value>& parameters_columns() {
   using R = param_value;
-  static const auto columns = column_map<R>("parameters")
+  static const auto columns = column_map<R>("parameters", "/problems/<p>/parameters, /energy/<p>/parameters")
                                   .member("name", &R::name)
                                   .member("value", &R::value)
                                   .member("unit", &R::unit)
@@ -372,7 +376,8 @@ const column_map<method_row>& runs_columns() {
   using W = work_counters;
   using M = run_metrics;
   using T = timing;
-  static const auto columns = column_map<R>("runs")
+  // One row per ladder entry (the substeps study's runs too).
+  static const auto columns = column_map<R>("runs", "/problems/<p>/methods/<m>/runs")
                                   .member("param", &R::param)
                                   .member("steps", &R::steps)
                                   .member("rejected_steps", &R::rejected_steps)
@@ -404,12 +409,18 @@ const column_map<method_row>& runs_columns() {
                                   .member("note", &R::metrics, &M::note)
                                   // Timing fields only in a timed study, so an untimed file does not carry columns
                                   // of NaN that a reader could mistake for measurements.
+                                  .timed_only()
                                   .member("time_ns", &R::time, &T::time_ns)
                                   .member("time_ns_min", &R::time, &T::time_ns_min)
                                   .member("time_ns_max", &R::time, &T::time_ns_max)
                                   .member("repetitions", &R::time, &T::repetitions)
                                   .member("cut", &R::time, &T::cut);
   return columns;
+}
+
+std::vector<schema::table> problems_tables() {
+  return {runs_columns().spec(), parameters_columns().spec(), ranked_equal_error_columns().spec(),
+          front_columns().spec()};
 }
 
 void check_writable(const std::string& path) {

@@ -54,5 +54,7 @@ void write_image(const std::vector<unsigned char>& image, const std::string& pat
 const column_map<param_value>& parameters_columns();
 // The `runs` table of a method's rows (docs/study-format.md); timing fields when timed.
 const column_map<method_row>& runs_columns();
+// The tables of /problems, in the schema's order (store/schema.cpp).
+std::vector<schema::table> problems_tables();
 
 }  // namespace stepbench

@@ -9,7 +9,7 @@ namespace stepbench {
 
 const column_map<substep_row>& substep_runs_columns() {
   using R = substep_row;
-  static const auto columns = column_map<R>("substeps_runs")
+  static const auto columns = column_map<R>("substeps_runs", "/substeps/<p>/<m>/runs")
                                   .fields(
                                       runs_columns(), [](auto& r) -> auto& { return r.row; })
                                   .member("substeps", &R::substeps)
@@ -19,7 +19,7 @@ const column_map<substep_row>& substep_runs_columns() {
 
 const column_map<substep_verdict>& substep_verdict_columns() {
   using R = substep_verdict;
-  static const auto columns = column_map<R>("substeps_verdict")
+  static const auto columns = column_map<R>("substeps_verdict", "/substeps/<p>/verdict")
                                   .member("implicit_method", &R::implicit_method)
                                   .member("explicit_method", &R::explicit_method)
                                   .member("cost_kind", &R::cost_kind)
@@ -34,6 +34,10 @@ const column_map<substep_verdict>& substep_verdict_columns() {
                                   .member("cost_to_match", &R::cost_to_match)
                                   .member("summary", &R::summary);
   return columns;
+}
+
+std::vector<schema::table> substeps_tables() {
+  return {substep_runs_columns().spec(), substep_verdict_columns().spec()};
 }
 
 void write_substeps(H5::Group& root, const std::vector<substep_study>& studies, bool timed) {

@@ -10,6 +10,7 @@ namespace stepbench {
 // row fields plus `substeps` and `extra_damping`); `verdict` (a table of substep_verdict).
 const column_map<substep_row>& substep_runs_columns();
 const column_map<substep_verdict>& substep_verdict_columns();
+std::vector<schema::table> substeps_tables();  // in the schema's order (store/schema.cpp)
 void write_substeps(H5::Group& root, const std::vector<substep_study>& studies, bool timed);
 // /substeps read back (the substeps part's read): each problem's frame and methods' runs,
 // each method's declaration the build's where it has the method.

@@ -53,7 +53,7 @@ const column_map<equal_error_verdict>& equal_error_columns() {
   using R = equal_error_verdict;
   using C = cost_at_error;
   static const auto columns =
-      column_map<R>("verdict_equal_error")
+      column_map<R>("verdict_equal_error", "/verdict/equal_error")
           .member("problem", &R::problem)
           .member("unit", &R::unit)
           .member("target", &R::target)
@@ -80,7 +80,7 @@ const column_map<equal_error_verdict>& equal_error_columns() {
 
 const column_map<frame_stability>& frame_rate_columns() {
   using R = frame_stability;
-  static const auto columns = column_map<R>("verdict_frame_rate")
+  static const auto columns = column_map<R>("verdict_frame_rate", "/verdict/frame_rate")
                                   .member("problem", &R::problem)
                                   .member("unit", &R::unit)
                                   .member("hz", &R::hz)
@@ -93,7 +93,7 @@ const column_map<frame_stability>& frame_rate_columns() {
 
 const column_map<frame_answer>& frame_answer_columns() {
   using R = frame_answer;
-  static const auto columns = column_map<R>("verdict_frame_answer")
+  static const auto columns = column_map<R>("verdict_frame_answer", "/verdict/frame_answer")
                                   .member("problem", &R::problem)
                                   .member("unit", &R::unit)
                                   .member("hz", &R::hz)
@@ -108,7 +108,7 @@ const column_map<frame_answer>& frame_answer_columns() {
 
 const column_map<frame_option>& frame_rate_run_columns() {
   using R = frame_option;
-  static const auto columns = column_map<R>("frame_rate_runs")
+  static const auto columns = column_map<R>("frame_rate_runs", "/frame_rates/<p>/runs")
                                   .member("hz", &R::hz)
                                   .member("method", &R::method)
                                   .member("substeps", &R::substeps)
@@ -124,6 +124,11 @@ const column_map<frame_option>& frame_rate_run_columns() {
 }
 
 }  // namespace
+
+std::vector<schema::table> verdict_file_tables() {
+  return {equal_error_columns().spec(), frame_rate_columns().spec(), frame_answer_columns().spec(),
+          frame_rate_run_columns().spec()};
+}
 
 void write_verdict(H5::Group& root, const study& s) {
   using h5::attr;

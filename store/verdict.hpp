@@ -25,4 +25,7 @@ void read_frame_rates(const H5::Group& root, study& s);
 // (/verdict's attribute `findings`): merge's judged_again for the verdict part.
 void judge_findings_again(H5::Group& root, const std::vector<std::string>& problems);
 
+// The tables of /verdict and /frame_rates, in the schema's order (store/schema.cpp).
+std::vector<schema::table> verdict_file_tables();
+
 }  // namespace stepbench

@@ -23,6 +23,20 @@ double norm(std::span<const double> a, int offset, int dim, std::span<const doub
   return std::sqrt(s);
 }
 
+}  // namespace
+
+agreement compare(std::span<const std::vector<double>> a, std::span<const std::vector<double>> b, int dim,
+                  double pos_scale, double vel_scale) {
+  agreement out;
+  for (size_t j = 0; j < a.size(); ++j) {
+    out.pos_rel = std::max(out.pos_rel, norm(a[j], 0, dim, b[j]) / pos_scale);
+    out.vel_rel = std::max(out.vel_rel, norm(a[j], dim, dim, b[j]) / vel_scale);
+  }
+  return out;
+}
+
+namespace {
+
 // Kinetic energy of [x; v] is E([x; v]) - E([x; 0]) for every problem here (the
 // potential depends on x only, the kinetic energy on v only), which needs no
 // kinetic-energy hook in the interface. Evaluated at x = 0 for both terms.
@@ -32,17 +46,15 @@ double kinetic(const problem_instance& p, std::span<const double> y) {
   return p.energy(moving) - p.energy(rest);
 }
 
-// The agreement of a and b on the observed positions (problem_instance::observed).
+// compare() on the observed positions (problem_instance::observed).
 agreement compare_observed(const problem_instance& p, std::span<const std::vector<double>> a,
                            std::span<const std::vector<double>> b, const truth_table& t) {
-  const int dim = p.observed_dim();
-  agreement out;
-  for (size_t j = 0; j < a.size(); ++j) {
-    const auto oa = p.observed(a[j]), ob = p.observed(b[j]);
-    out.pos_rel = std::max(out.pos_rel, norm(oa, 0, dim, ob) / t.pos_scale);
-    out.vel_rel = std::max(out.vel_rel, norm(oa, dim, dim, ob) / t.vel_scale);
-  }
-  return out;
+  const auto observed = [&](std::span<const std::vector<double>> ys) {
+    std::vector<std::vector<double>> out;
+    for (const auto& y : ys) out.push_back(p.observed(y));
+    return out;
+  };
+  return compare(observed(a), observed(b), p.observed_dim(), t.pos_scale, t.vel_scale);
 }
 
 void set_scales(const problem_instance& p, truth_table& t) {

@@ -81,6 +81,9 @@ double predicted_reference_work(const problem_instance& problem, double horizon)
 // the closed form itself is not finite (parameters out of range).
 truth_table build_truth(const problem_instance& problem, std::span<const double> times, const truth_options& opts);
 
+agreement compare(std::span<const std::vector<double>> a, std::span<const std::vector<double>> b, int dim,
+                  double pos_scale, double vel_scale);
+
 // A row of a study completed: it neither diverged, nor failed, nor was skipped. The one
 // statement of the rule; the study file stores the three flags, and every reader (C++
 // and the report, through the schema `stepbench schema` prints) applies this.

@@ -55,14 +55,8 @@ class band_matrix {
 
   void set_zero() { std::fill(ab_.begin(), ab_.end(), 0.0); }
 
-  double& operator()(Eigen::Index i, Eigen::Index j) {
-    assert(in_band(i, j));
-    return ab_[static_cast<std::size_t>(j * ld_ + kl_ + ku_ + i - j)];
-  }
-  double operator()(Eigen::Index i, Eigen::Index j) const {
-    assert(in_band(i, j));
-    return ab_[static_cast<std::size_t>(j * ld_ + kl_ + ku_ + i - j)];
-  }
+  double& operator()(Eigen::Index i, Eigen::Index j) { return ab_[at(i, j)]; }
+  double operator()(Eigen::Index i, Eigen::Index j) const { return ab_[at(i, j)]; }
 
   // A += s I.
   void add_identity(double s) {
@@ -106,6 +100,12 @@ class band_matrix {
   std::span<const double> storage() const { return ab_; }
 
  private:
+  friend class band_lu;  // factors in a copy of this layout
+  std::size_t at(Eigen::Index i, Eigen::Index j) const {
+    assert(in_band(i, j));
+    return static_cast<std::size_t>(j * ld_ + kl_ + ku_ + i - j);
+  }
+
   Eigen::Index n_ = 0;
   Eigen::Index kl_ = 0;
   Eigen::Index ku_ = 0;
@@ -131,11 +131,7 @@ class band_lu {
   // Allocates the factor storage and the pivots; factorize and solve_in_place allocate nothing.
   void resize(Eigen::Index n, Eigen::Index kl, Eigen::Index ku) {
     if (n < 0 || kl < 0 || ku < 0) throw std::invalid_argument("band_lu::resize: negative size or bandwidth");
-    n_ = n;
-    kl_ = kl;
-    ku_ = ku;
-    ld_ = 2 * kl + ku + 1;
-    ab_.assign(static_cast<std::size_t>(ld_ * n), 0.0);
+    lu_.resize(n, kl, ku);
     ipiv_.assign(static_cast<std::size_t>(n), 0);
     factored_ = false;
     zero_pivot_ = -1;
@@ -155,40 +151,35 @@ class band_lu {
   Eigen::Index zero_pivot() const { return zero_pivot_; }
   // Row interchanges: at step j, row j was swapped with row pivots()[j] (>= j).
   std::span<const Eigen::Index> pivots() const { return ipiv_; }
-  Eigen::Index rows() const { return n_; }
-  Eigen::Index kl() const { return kl_; }
-  Eigen::Index ku() const { return ku_; }
+  Eigen::Index rows() const { return lu_.rows(); }
+  Eigen::Index kl() const { return lu_.kl(); }
+  Eigen::Index ku() const { return lu_.ku(); }
 
  private:
-  Eigen::Index n_ = 0;
-  Eigen::Index kl_ = 0;
-  Eigen::Index ku_ = 0;
-  Eigen::Index ld_ = 1;
-  std::vector<double> ab_;
+  band_matrix lu_;  // the factors, in the layout of A
   std::vector<Eigen::Index> ipiv_;
   bool factored_ = false;
   Eigen::Index zero_pivot_ = -1;
 };
 
 inline bool band_lu::factorize(const band_matrix& a) {
-  if (a.rows() != n_ || a.kl() != kl_ || a.ku() != ku_)
-    throw std::invalid_argument("band_lu::factorize: matrix shape differs from resize()");
+  if (!a.same_shape(lu_)) throw std::invalid_argument("band_lu::factorize: matrix shape differs from resize()");
   // The copy brings zero fill-in rows with it (a band_matrix keeps them zero), which
   // the interchanges below rely on.
-  const std::span<const double> src = a.storage();
-  std::copy(src.begin(), src.end(), ab_.begin());
+  std::copy(a.ab_.begin(), a.ab_.end(), lu_.ab_.begin());
   factored_ = false;
   zero_pivot_ = -1;
 
-  const Eigen::Index kv = kl_ + ku_;  // row of the diagonal in each column
-  const Eigen::Index ld = ld_;
-  double* ab = ab_.data();
+  const Eigen::Index n = lu_.n_, kl = lu_.kl_, ku = lu_.ku_;
+  const Eigen::Index kv = kl + ku;  // row of the diagonal in each column
+  const Eigen::Index ld = lu_.ld_;
+  double* ab = lu_.ab_.data();
   // Last column reached by the rows interchanged so far: U's row j extends to column
   // j + ku + p after row j + p was swapped up, and the updates must cover it.
   Eigen::Index ju = 0;
-  for (Eigen::Index j = 0; j < n_; ++j) {
-    double* cj = ab + j * ld + kv;                      // cj[r] = A(j + r, j), r in [-kv, kl]
-    const Eigen::Index km = std::min(kl_, n_ - 1 - j);  // sub-diagonal entries left in column j
+  for (Eigen::Index j = 0; j < n; ++j) {
+    double* cj = ab + j * ld + kv;                    // cj[r] = A(j + r, j), r in [-kv, kl]
+    const Eigen::Index km = std::min(kl, n - 1 - j);  // sub-diagonal entries left in column j
 
     // Pivot: the largest magnitude on or below the diagonal (the first one on ties, as idamax).
     Eigen::Index p = 0;
@@ -205,7 +196,7 @@ inline bool band_lu::factorize(const band_matrix& a) {
       return false;
     }
 
-    ju = std::max(ju, std::min(j + ku_ + p, n_ - 1));
+    ju = std::max(ju, std::min(j + ku + p, n - 1));
     if (p != 0) {
       // Swap rows j and j + p in columns j..ju. A(i, c) is at ab[c * ld + kv + i - c].
       for (Eigen::Index c = j; c <= ju; ++c) std::swap(ab[c * ld + kv + j - c], ab[c * ld + kv + j + p - c]);
@@ -231,28 +222,29 @@ inline bool band_lu::factorize(const band_matrix& a) {
 
 inline void band_lu::solve_in_place(Eigen::Ref<Eigen::VectorXd> b) const {
   if (!factored_) throw std::logic_error("band_lu::solve_in_place: no successful factorisation");
-  if (b.size() != n_) throw std::invalid_argument("band_lu::solve_in_place: vector size differs from n");
-  const Eigen::Index kv = kl_ + ku_;
-  const Eigen::Index ld = ld_;
-  const double* ab = ab_.data();
+  const Eigen::Index n = lu_.n_, kl = lu_.kl_, ku = lu_.ku_;
+  if (b.size() != n) throw std::invalid_argument("band_lu::solve_in_place: vector size differs from n");
+  const Eigen::Index kv = kl + ku;
+  const Eigen::Index ld = lu_.ld_;
+  const double* ab = lu_.ab_.data();
   double* x = b.data();  // Ref<VectorXd> has unit inner stride
 
   // L y = P b: at step j, the interchange of step j, then the elimination with column j's
   // multipliers.
-  if (kl_ > 0) {
-    for (Eigen::Index j = 0; j + 1 < n_; ++j) {
+  if (kl > 0) {
+    for (Eigen::Index j = 0; j + 1 < n; ++j) {
       const Eigen::Index p = ipiv_[static_cast<std::size_t>(j)];
       if (p != j) std::swap(x[j], x[p]);
       const double xj = x[j];
       if (xj == 0.0) continue;
       const double* l = ab + j * ld + kv;  // l[r] = l(j + r, j)
-      const Eigen::Index lm = std::min(kl_, n_ - 1 - j);
+      const Eigen::Index lm = std::min(kl, n - 1 - j);
       for (Eigen::Index r = 1; r <= lm; ++r) x[j + r] -= l[r] * xj;
     }
   }
 
   // U x = y, column-oriented: U has kl + ku super-diagonals.
-  for (Eigen::Index j = n_ - 1; j >= 0; --j) {
+  for (Eigen::Index j = n - 1; j >= 0; --j) {
     const double* u = ab + j * ld + kv - j;  // u[i] = U(i, j), i in [j - kv, j]
     x[j] /= u[j];
     const double xj = x[j];

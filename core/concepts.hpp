@@ -39,6 +39,18 @@ struct phase {
   Vec v;
 };
 
+// [x; v] in one plain vector: a state as the registry, the references and the study file hold it.
+template <class Vec>
+std::vector<double> stacked(const Vec& x, const Vec& v) {
+  std::vector<double> y(x.data(), x.data() + x.size());
+  y.insert(y.end(), v.data(), v.data() + v.size());
+  return y;
+}
+template <class Vec>
+std::vector<double> stacked(const phase<Vec>& s) {
+  return stacked(s.x, s.v);
+}
+
 // A problem: the forces of one scene and nothing else (no general physics engine).
 // The integrators see F(t, x, v) and a scalar mass m, as in the lecture. `vec` is an
 // Eigen column vector, fixed-size (the step inlines to scalar code) or Eigen::VectorXd
@@ -219,16 +231,11 @@ inline void size_like(const Vec& like, Vec& first, More&... more) {
 // Odeint's steppers keep theirs, sized once by their resizer. A method without scratch
 // space has the step itself.
 template <class I, class Sys>
-concept has_stepper = requires {
-  typename I::template stepper<Sys>;
-};
-
-template <class I, class Sys>
 struct stepper_of {
   using type = I;
 };
 template <class I, class Sys>
-requires has_stepper<I, Sys>
+requires requires { typename I::template stepper<Sys>; }
 struct stepper_of<I, Sys> {
   using type = typename I::template stepper<Sys>;
 };
@@ -242,14 +249,20 @@ inline void prepare_stepper(S& stepper, const Sys& sys, const typename Sys::vec&
   if constexpr (requires { stepper.resize(sys, like); }) stepper.resize(sys, like);
 }
 
-// A fixed-step integrator (Odeint's "stepper"): a small value type with its name, its
-// order, its capabilities and one step of a given dt.
+// What every integrator declares: its name, its order, a description and its capabilities.
 template <class I>
-concept integrator = requires(const I& i, const detail::probe_system& sys, step_state<detail::probe_system::vec>& s) {
+concept described_method = requires {
   { I::name } -> std::convertible_to<std::string_view>;
   { I::order } -> std::convertible_to<int>;
   { I::description } -> std::convertible_to<std::string_view>;
   { I::traits } -> std::convertible_to<capabilities>;
+};
+
+// A fixed-step integrator (Odeint's "stepper"): a small value type with its name, its
+// order, its capabilities and one step of a given dt.
+template <class I>
+concept integrator = described_method<I> &&
+    requires(const I& i, const detail::probe_system& sys, step_state<detail::probe_system::vec>& s) {
   {stepper_t<I, detail::probe_system>(i).step(sys, 0.0, s, 0.1)};
 };
 
@@ -265,12 +278,8 @@ struct step_attempt {
 // proposes the next dt. On rejection the state is unchanged. `initial_dt` proposes the
 // first step of a run.
 template <class I>
-concept adaptive_integrator = requires(const I& i, const detail::probe_system& sys,
-                                       step_state<detail::probe_system::vec>& s) {
-  { I::name } -> std::convertible_to<std::string_view>;
-  { I::order } -> std::convertible_to<int>;
-  { I::description } -> std::convertible_to<std::string_view>;
-  { I::traits } -> std::convertible_to<capabilities>;
+concept adaptive_integrator = described_method<I> &&
+    requires(const I& i, const detail::probe_system& sys, step_state<detail::probe_system::vec>& s) {
   {I(1e-6)};
   { I::force_evals_per_step } -> std::convertible_to<int>;  // for the step budget
   { stepper_t<I, detail::probe_system>(i).initial_dt(sys, 0.0, s, 1.0) } -> std::convertible_to<double>;

@@ -23,6 +23,7 @@
 
 #include "core/concepts.hpp"
 #include "core/flatten.hpp"
+#include "core/method.hpp"
 #include "core/system.hpp"
 
 namespace stepbench {
@@ -63,16 +64,10 @@ std::vector<double> nearest_grid_times(double horizon, double dt, int count);
 // The fractions j T / count, j = 1..count (the last exactly T).
 std::vector<double> sample_times(double horizon, int count);
 
+// A run as the loop records it (core/method.hpp's run_record), with its states in the
+// loop's own form.
 template <class Vec>
-struct drive_result {
-  long steps = 0;           // accepted steps taken
-  long rejected_steps = 0;  // adaptive methods: attempts the error test rejected
-  work_counters work{};
-  bool non_finite = false;   // a NaN or Inf appeared: the run stopped there
-  std::string stop_reason;   // why the run stopped early (step size underflow, the step budget), else empty
-  bool over_budget = false;  // stopped by the step budget (with the reason in `stop_reason`): skipped, not failed
-  double constraint_violation = std::numeric_limits<double>::quiet_NaN();  // run_result's (core/method.hpp)
-  std::vector<double> sample_t;
+struct drive_result : run_record {
   Eigen::MatrixXd samples;  // column j: [x; v] at sample_t[j]
   double t_final = 0.0;
   phase<Vec> final_state;
@@ -80,11 +75,7 @@ struct drive_result {
   // Contacts (problems with contacts only; core/concepts.hpp's has_contacts).
   static constexpr std::size_t recorded_contacts = 64;  // the first ones are recorded with their time
   static constexpr int contact_position_dims = 4;       // ... and their position, up to this many coordinates
-  long contacts = 0;                                    // contacts resolved (responses applied)
-  long tunnelled = 0;                                   // contacts found deeper than the problem's tunnelling depth
-  double max_penetration = 0.0;                         // the deepest penetration found before a resolution
-  std::vector<double> contact_times;  // the first recorded_contacts: when resolved (end_of_step: the step's end)
-  Eigen::MatrixXd contact_x;          // column k: the position just after contact k (empty for larger states)
+  Eigen::MatrixXd contact_x;  // column k: the position just after contact k (empty for larger states)
 
   // Sizes everything a run records, once: no step allocates.
   void start(int dim, std::size_t count) {
@@ -129,6 +120,24 @@ inline std::string fmt_g(double v) {
 template <class Vec>
 inline bool all_finite(const Vec& x, const Vec& v) {
   return x.allFinite() && v.allFinite();
+}
+
+// The adaptive loops' stops (ours below, the peers' in core/step_adapter.hpp). A step of h
+// from t lost in the round-off of t stops the run with a recorded failure.
+template <class Vec>
+inline bool stop_on_underflow(drive_result<Vec>& out, double h, double t, double horizon) {
+  if (h > 4.0 * std::numeric_limits<double>::epsilon() * std::max(std::abs(t), horizon)) return false;
+  out.stop_reason = "step size underflow at t = " + std::to_string(t);
+  return true;
+}
+// A run that has taken its `max_steps` accepted steps short of the horizon is stopped as
+// over budget: skipped, not failed.
+template <class Vec>
+inline bool stop_at_step_budget(drive_result<Vec>& out, long max_steps, double t, double horizon) {
+  if (out.steps < max_steps || !(t < horizon)) return false;
+  out.skipped = true;
+  out.stop_reason = "over the step budget of " + std::to_string(max_steps) + " steps at t = " + std::to_string(t);
+  return true;
 }
 
 template <class P>
@@ -400,15 +409,12 @@ STEPBENCH_FLATTEN drive_result<typename P::vec> drive_adaptive(const P& problem,
     // step left over would cost a whole step): Hairer's codes stretch by up to 1 %.
     const bool lands = t + 1.01 * h >= target;
     const double h_try = lands ? target - t : h;
-    if (!(h_try > 4.0 * std::numeric_limits<double>::epsilon() * std::max(std::abs(t), horizon))) {
-      out.stop_reason = "step size underflow at t = " + std::to_string(t);
-      break;
-    }
+    if (stop_on_underflow(out, h_try, t, horizon)) break;
     // advance: attempts until one is accepted
     const step_attempt a = stepper.try_step(sys, t, s, h_try);
     h = a.dt_next;
     if ((horizon - t) / h > 10.0 * static_cast<double>(max_steps - out.steps)) {
-      out.over_budget = true;
+      out.skipped = true;
       out.stop_reason = "over the step budget of " + std::to_string(max_steps) + " steps: at t = " + std::to_string(t) +
                         " the step size " + fmt_g(h) + " would need about " + fmt_g((horizon - t) / h) + " more";
       break;
@@ -456,11 +462,7 @@ STEPBENCH_FLATTEN drive_result<typename P::vec> drive_adaptive(const P& problem,
         ++next;
       }
     }
-    if (out.steps >= max_steps && t < horizon) {
-      out.over_budget = true;
-      out.stop_reason = "over the step budget of " + std::to_string(max_steps) + " steps at t = " + std::to_string(t);
-      break;
-    }
+    if (stop_at_step_budget(out, max_steps, t, horizon)) break;
   }
   out.work = sys.work;
   out.t_final = t;

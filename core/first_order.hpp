@@ -88,8 +88,7 @@ ode_system make_ode_system(const P& p, int outputs = 32) {
   ode_system sys;
   sys.n = 2 * p.dim();
   const auto s0 = p.initial();
-  sys.y0.assign(s0.x.data(), s0.x.data() + s0.x.size());
-  sys.y0.insert(sys.y0.end(), s0.v.data(), s0.v.data() + s0.v.size());
+  sys.y0 = stacked(s0);
   sys.rhs = [f = first_order_form<P>(p)](double t, std::span<const double> y, std::span<double> dydt) {
     f(t, y.data(), dydt.data());
   };

@@ -130,40 +130,6 @@ inline std::string loop_config_error(const loop_config& c) {
   return {};
 }
 
-// The display clock: the wall-clock interval of each frame.
-class display_clock {
- public:
-  explicit display_clock(const loop_config& c)
-      : hz_(c.display_hz),
-        jitter_(c.jitter_seed ? c.jitter : 0.0),
-        rng_(c.jitter_seed.value_or(0)),
-        stall_at_(c.stall_at_s),
-        stall_s_(c.stall_s),
-        stall_pending_(c.stalls()),
-        jittered_(c.jitter_seed.has_value()) {}
-
-  struct interval {
-    double seconds = 0.0;
-    bool stall = false;
-  };
-  // The interval of the frame that begins at wall time `wall_now`.
-  interval next(double wall_now) {
-    if (stall_pending_ && wall_now >= stall_at_) {
-      stall_pending_ = false;
-      return {stall_s_, true};
-    }
-    if (!jittered_) return {1.0 / hz_, false};
-    const double u = static_cast<double>(rng_() >> 11) * 0x1.0p-53;  // [0, 1), 53 random bits
-    return {(1.0 + jitter_ * (2.0 * u - 1.0)) / hz_, false};
-  }
-
- private:
-  double hz_, jitter_;
-  std::mt19937_64 rng_;
-  double stall_at_, stall_s_;
-  bool stall_pending_, jittered_;
-};
-
 // One frame as the timer plans it.
 struct frame_plan {
   double display_interval = 0.0;  // the display clock's interval: the frame's budget
@@ -179,12 +145,13 @@ struct frame_plan {
   bool last = false;                                        // it lands on the horizon
 };
 
-// The loop's timing, without the physics: the clock, the clamp, the accumulator, the
-// end at the horizon. The physics loop below and the cost model (schedule_loop) both
+// The loop's timing, without the physics: the display clock, the clamp, the accumulator,
+// the end at the horizon. The physics loop below and the cost model (schedule_loop) both
 // run on it, so they take the same frames and the same steps.
 class loop_timer {
  public:
-  explicit loop_timer(const loop_config& c) : c_(c), clock_(c), dt_(c.dt()), k_(c.substeps()), horizon_(c.horizon) {}
+  explicit loop_timer(const loop_config& c)
+      : c_(c), rng_(c.jitter_seed.value_or(0)), stall_pending_(c.stalls()), dt_(c.dt()), k_(c.substeps()) {}
 
   bool done() const { return done_; }
   double dt() const { return dt_; }
@@ -195,19 +162,27 @@ class loop_timer {
   // time is the next frame time: the feedback behind the spiral of death).
   frame_plan next(double previous_work_s = 0.0) {
     frame_plan f;
-    const display_clock::interval iv = clock_.next(wall_);
-    f.stall = iv.stall;
-    f.display_interval = iv.seconds;
-    f.interval = std::max(iv.seconds, previous_work_s);
+    // The display clock's interval for the frame that begins at wall_: the stall's, once
+    // the wall clock reaches it, else 1 / display rate, jittered when seeded.
+    f.display_interval = 1.0 / c_.display_hz;
+    if (stall_pending_ && wall_ >= c_.stall_at_s) {
+      stall_pending_ = false;
+      f.stall = true;
+      f.display_interval = c_.stall_s;
+    } else if (c_.jitter_seed) {
+      const double u = static_cast<double>(rng_() >> 11) * 0x1.0p-53;  // [0, 1), 53 random bits
+      f.display_interval = (1.0 + c_.jitter * (2.0 * u - 1.0)) / c_.display_hz;
+    }
+    f.interval = std::max(f.display_interval, previous_work_s);
     wall_ += f.interval;
     f.wall_t = wall_;
     double ft = f.interval;
     if (c_.clamp_s > 0.0 && ft > c_.clamp_s) ft = c_.clamp_s, f.clamped = true;
-    if (game_ + ft >= horizon_ * (1.0 - 1e-12)) {
-      ft = horizon_ - game_;
+    if (game_ + ft >= c_.horizon * (1.0 - 1e-12)) {
+      ft = c_.horizon - game_;
       f.last = true;
       done_ = true;
-      game_ = horizon_;
+      game_ = c_.horizon;
     } else {
       game_ += ft;
     }
@@ -238,10 +213,10 @@ class loop_timer {
 
  private:
   loop_config c_;
-  display_clock clock_;
+  std::mt19937_64 rng_;
+  bool stall_pending_;
   double dt_;
   int k_;
-  double horizon_;
   double wall_ = 0.0, game_ = 0.0, accumulator_ = 0.0;
   bool done_ = false;
 };
@@ -251,7 +226,6 @@ class loop_timer {
 struct loop_result {
   int dim = 0;
   std::vector<double> display_t;   // the game clock at each frame
-  std::vector<double> wall_t;      // the wall clock at each frame
   std::vector<double> interval;    // the frame's wall duration
   std::vector<double> frame_time;  // the game time it consumed
   std::vector<double> shown_t;     // the simulated time of the state it showed (n dt; the blend's (n - 1 + alpha) dt)
@@ -270,7 +244,6 @@ struct loop_result {
   template <class X>
   void record(const frame_plan& f, double t_shown, const Eigen::MatrixBase<X>& x) {
     display_t.push_back(f.game_t);
-    wall_t.push_back(f.wall_t);
     interval.push_back(f.interval);
     frame_time.push_back(f.frame_time);
     shown_t.push_back(t_shown);
@@ -281,15 +254,6 @@ struct loop_result {
     shown.insert(shown.end(), x.derived().data(), x.derived().data() + x.size());
   }
 };
-
-namespace detail {
-template <class Vec>
-std::vector<double> joined(const Vec& x, const Vec& v) {
-  std::vector<double> y(x.data(), x.data() + x.size());
-  y.insert(y.end(), v.data(), v.data() + v.size());
-  return y;
-}
-}  // namespace detail
 
 // Runs `cfg` (checked with loop_config_error first) for one problem and integrator: one
 // instance per pair, the design a run-time choice. Not flattened as drive() is: the loop
@@ -365,8 +329,8 @@ loop_result simulate_loop(const P& problem, const I& method, const loop_config& 
   }
   out.physics_steps = n;
   out.physics_t = accumulator ? static_cast<double>(n) * dt : t_frame;
-  out.final_physics = detail::joined(s.x, s.v);
-  out.final_shown = design == loop_design::interpolated ? detail::joined(shown_x, shown_v) : out.final_physics;
+  out.final_physics = stacked(s.x, s.v);
+  out.final_shown = design == loop_design::interpolated ? stacked(shown_x, shown_v) : out.final_physics;
   out.work = sys.work;
   return out;
 }
@@ -389,7 +353,6 @@ inline std::string_view to_string(loop_outcome o) {
 }
 
 struct loop_schedule {
-  double step_cost_s = 0.0;
   double frame_budget_s = 0.0;  // 1 / display rate
   long frames = 0;              // frames to the horizon
   long late_frames = 0;         // frames whose physics work outlasted their display interval (their budget)
@@ -405,7 +368,6 @@ inline constexpr long settle_frames = 10000;
 
 inline loop_schedule schedule_loop(const loop_config& cfg, double step_cost_s) {
   loop_schedule out;
-  out.step_cost_s = step_cost_s;
   out.frame_budget_s = 1.0 / cfg.display_hz;
   loop_config endless = cfg;
   endless.horizon = std::numeric_limits<double>::infinity();

@@ -13,20 +13,29 @@
 namespace stepbench {
 namespace {
 
-double norm_diff(std::span<const double> a, std::span<const double> b, int offset, int dim) {
+// |a - b| over the `dim` entries from `offset` (|a| when b is empty).
+double norm(std::span<const double> a, int offset, int dim, std::span<const double> b = {}) {
   double s = 0.0;
   for (int i = 0; i < dim; ++i) {
-    const double d = a[offset + i] - b[offset + i];
+    const double d = a[offset + i] - (b.empty() ? 0.0 : b[offset + i]);
     s += d * d;
   }
   return std::sqrt(s);
 }
 
-double norm_part(std::span<const double> y, int offset, int dim) {
-  double s = 0.0;
-  for (int i = 0; i < dim; ++i) s += y[offset + i] * y[offset + i];
-  return std::sqrt(s);
+}  // namespace
+
+agreement compare(std::span<const std::vector<double>> a, std::span<const std::vector<double>> b, int dim,
+                  double pos_scale, double vel_scale) {
+  agreement out;
+  for (size_t j = 0; j < a.size(); ++j) {
+    out.pos_rel = std::max(out.pos_rel, norm(a[j], 0, dim, b[j]) / pos_scale);
+    out.vel_rel = std::max(out.vel_rel, norm(a[j], dim, dim, b[j]) / vel_scale);
+  }
+  return out;
 }
+
+namespace {
 
 // Kinetic energy of [x; v] is E([x; v]) - E([x; 0]) for every problem here (the
 // potential depends on x only, the kinetic energy on v only), which needs no
@@ -37,60 +46,44 @@ double kinetic(const problem_instance& p, std::span<const double> y) {
   return p.energy(moving) - p.energy(rest);
 }
 
-// States mapped to the positions errors are measured on (problem_instance::observed).
-std::vector<std::vector<double>> observed_all(const problem_instance& p, std::span<const std::vector<double>> ys) {
-  std::vector<std::vector<double>> out;
-  out.reserve(ys.size());
-  for (const auto& y : ys) out.push_back(p.observed(y));
-  return out;
-}
-
-// compare() on the observed positions.
+// compare() on the observed positions (problem_instance::observed).
 agreement compare_observed(const problem_instance& p, std::span<const std::vector<double>> a,
                            std::span<const std::vector<double>> b, const truth_table& t) {
-  return compare(observed_all(p, a), observed_all(p, b), p.observed_dim(), t.pos_scale, t.vel_scale);
+  const auto observed = [&](std::span<const std::vector<double>> ys) {
+    std::vector<std::vector<double>> out;
+    for (const auto& y : ys) out.push_back(p.observed(y));
+    return out;
+  };
+  return compare(observed(a), observed(b), p.observed_dim(), t.pos_scale, t.vel_scale);
 }
 
 void set_scales(const problem_instance& p, truth_table& t) {
   const int dim = p.observed_dim();
   const auto y0 = p.initial();
   const auto o0 = p.observed(y0);
-  double xs = norm_part(o0, 0, dim), vs = norm_part(o0, dim, dim);
+  double xs = norm(o0, 0, dim), vs = norm(o0, dim, dim);
   double es = p.has_energy() ? std::max(std::abs(p.energy(y0)), kinetic(p, y0)) : 1.0;
+  double ls = p.has_angular_momentum() ? std::abs(p.angular_momentum(y0)) : 0.0;
   for (const auto& y : t.y) {
     const auto o = p.observed(y);
-    xs = std::max(xs, norm_part(o, 0, dim));
-    vs = std::max(vs, norm_part(o, dim, dim));
+    xs = std::max(xs, norm(o, 0, dim));
+    vs = std::max(vs, norm(o, dim, dim));
     if (p.has_energy()) es = std::max({es, std::abs(p.energy(y)), kinetic(p, y)});
+    if (p.has_angular_momentum()) ls = std::max(ls, std::abs(p.angular_momentum(y)));
   }
-  if (p.has_angular_momentum()) {
-    double ls = std::abs(p.angular_momentum(y0));
-    for (const auto& y : t.y) ls = std::max(ls, std::abs(p.angular_momentum(y)));
-    t.angmom_scale = ls > 0.0 ? ls : 1.0;
-  }
+  if (p.has_angular_momentum()) t.angmom_scale = ls > 0.0 ? ls : 1.0;
   t.pos_scale = xs > 0.0 ? xs : 1.0;
   t.vel_scale = vs > 0.0 ? vs : 1.0;
   t.energy_scale = es > 0.0 ? es : 1.0;
 }
 
-std::string disagreement(const agreement& a, double limit) {
-  return fmt::format("relative error {:.3e} (position) {:.3e} (velocity) exceeds the agreement limit {:.1e}", a.pos_rel,
-                     a.vel_rel, limit);
+// No trusted truth: every error is NaN, and the note says why.
+void distrust(truth_table& t, std::string note, int dim) {
+  t.trusted = false;
+  t.source = "none";
+  t.note = std::move(note);
+  t.y.assign(t.times.size(), std::vector<double>(2 * dim, nan));
 }
-
-}  // namespace
-
-agreement compare(std::span<const std::vector<double>> a, std::span<const std::vector<double>> b, int dim,
-                  double pos_scale, double vel_scale) {
-  agreement out;
-  for (size_t j = 0; j < a.size(); ++j) {
-    out.pos_rel = std::max(out.pos_rel, norm_diff(a[j], b[j], 0, dim) / pos_scale);
-    out.vel_rel = std::max(out.vel_rel, norm_diff(a[j], b[j], dim, dim) / vel_scale);
-  }
-  return out;
-}
-
-namespace {
 
 // Every reference source on the problem: solved, failed with its reason, or unsupported.
 std::vector<reference_check> run_references(const problem_instance& problem, std::span<const double> times,
@@ -103,23 +96,28 @@ std::vector<reference_check> run_references(const problem_instance& problem, std
     if (sys.has_contacts() && !reference_handles_contacts(source)) {
       rc.status = "unsupported";
       rc.reason = "the problem has contacts, and this reference has no root finding to stop at them";
-      out.push_back(std::move(rc));
-      continue;
-    }
-    try {
-      rc.solution = solve_reference(source, sys, times, opts.tol);
-    } catch (const std::runtime_error& e) {
-      rc.status = "failed";
-      rc.reason = e.what();
+    } else {
+      try {
+        rc.solution = solve_reference(source, sys, times, opts.tol);
+      } catch (const std::runtime_error& e) {
+        rc.status = "failed";
+        rc.reason = e.what();
+      }
     }
     out.push_back(std::move(rc));
   }
   return out;
 }
 
-// Marks a reference that strays from what it was compared with beyond the limit.
-void judge_agreement(reference_check& r, const truth_table& t) {
-  if (!(r.vs.worst() <= t.agreement_limit)) r.status = "disagrees", r.reason = disagreement(r.vs, t.agreement_limit);
+// Compares a reference with `source`'s solution `y`, and marks it when it strays beyond the limit.
+void check_reference(const problem_instance& p, reference_check& r, const std::string& source,
+                     std::span<const std::vector<double>> y, const truth_table& t) {
+  r.compared_with = source;
+  r.vs = compare_observed(p, r.solution.y, y, t);
+  if (r.vs.worst() <= t.agreement_limit) return;
+  r.status = "disagrees";
+  r.reason = fmt::format("relative error {:.3e} (position) {:.3e} (velocity) exceeds the agreement limit {:.1e}",
+                         r.vs.pos_rel, r.vs.vel_rel, t.agreement_limit);
 }
 
 // The truth from the closed form; each completed reference is checked against it.
@@ -133,17 +131,12 @@ void truth_from_closed_form(const problem_instance& problem, truth_table& t, con
             fmt::format("the closed form of problem {} is not finite at t = {:g}: are the parameters in range?",
                         problem.name(), t.times[j]));
   set_scales(problem, t);
-  for (auto* r : ok) {
-    r->compared_with = t.source;
-    r->vs = compare_observed(problem, r->solution.y, t.y, t);
-    judge_agreement(*r, t);
-  }
+  for (auto* r : ok) check_reference(problem, *r, t.source, t.y, t);
 }
 
 // The truth from the best-agreeing pair of completed references (on scales from the
 // first of them), trusted when they agree within the limit; else no trusted truth.
 void truth_from_references(const problem_instance& problem, truth_table& t, const std::vector<reference_check*>& ok) {
-  const int dim = problem.dim();
   if (!ok.empty()) {
     t.y = ok.front()->solution.y;
     set_scales(problem, t);
@@ -156,13 +149,12 @@ void truth_from_references(const problem_instance& problem, truth_table& t, cons
       if (w < best) best = w, best_i = i, best_k = k;
     }
   if (ok.size() < 2 || !(best <= t.agreement_limit)) {
-    t.trusted = false;
-    t.source = "none";
-    t.note = ok.size() < 2 ? fmt::format("only {} of {} references completed, and no closed form to check them",
+    distrust(t,
+             ok.size() < 2 ? fmt::format("only {} of {} references completed, and no closed form to check them",
                                          ok.size(), t.references.size())
                            : fmt::format("no two references agree within {:.1e} (best pair {} and {}: {:.3e})",
-                                         t.agreement_limit, ok[best_i]->source, ok[best_k]->source, best);
-    t.y.assign(t.times.size(), std::vector<double>(2 * dim, nan));
+                                         t.agreement_limit, ok[best_i]->source, ok[best_k]->source, best),
+             problem.dim());
     for (auto* r : ok) r->status = "disagrees", r->reason = t.note;
     return;
   }
@@ -173,9 +165,7 @@ void truth_from_references(const problem_instance& problem, truth_table& t, cons
   for (auto* r : ok) {
     // The truth itself is reported against its partner, so its own row is not a 0.
     const auto& other = r == &truth ? *ok[best_k] : truth;
-    r->compared_with = other.source;
-    r->vs = compare_observed(problem, r->solution.y, other.solution.y, t);
-    judge_agreement(*r, t);
+    check_reference(problem, *r, other.source, other.solution.y, t);
   }
 }
 
@@ -199,13 +189,12 @@ truth_table build_truth(const problem_instance& problem, std::span<const double>
     const double predicted = predicted_reference_work(problem, times.back());
     if (predicted > opts.reference_budget) {
       // Not run: nothing to compare, so no truth; the runs are judged on stability alone.
-      t.trusted = false;
-      t.source = "none";
-      t.note = fmt::format(
-          "references not run: their predicted work, {:.3g} ({} coordinates x w_max T = {:.3g} rad), is over the "
-          "reference budget of {:.3g}",
-          predicted, 2 * problem.dim(), problem.fastest_frequency() * times.back(), opts.reference_budget);
-      t.y.assign(t.times.size(), std::vector<double>(2 * problem.dim(), std::numeric_limits<double>::quiet_NaN()));
+      distrust(
+          t,
+          fmt::format("references not run: their predicted work, {:.3g} ({} coordinates x w_max T = {:.3g} "
+                      "rad), is over the reference budget of {:.3g}",
+                      predicted, 2 * problem.dim(), problem.fastest_frequency() * times.back(), opts.reference_budget),
+          problem.dim());
       return t;
     }
   }
@@ -241,19 +230,12 @@ run_metrics measure(const problem_instance& problem, const run_result& run, cons
   m.contacts = run.contacts;
   m.tunnelled = run.tunnelled;
   m.max_penetration = run.max_penetration;
-  if (run.skipped) {
-    m.skipped = true;
-    m.note = run.stop_reason;
-    return all_nan();
-  }
-  if (!run.stop_reason.empty()) {
-    m.failed = true;
-    m.note = run.stop_reason;
-    return all_nan();
-  }
-  if (run.non_finite) {
-    m.diverged = true;
-    m.note = "non-finite state";
+  // A run that stopped short is measured no further: skipped (over the budget), else
+  // failed (the solver's reason), else diverged (a non-finite state).
+  const bool stopped = run.skipped || !run.stop_reason.empty();
+  if (stopped || run.non_finite) {
+    (run.skipped ? m.skipped : stopped ? m.failed : m.diverged) = true;
+    m.note = stopped ? run.stop_reason : "non-finite state";
     return all_nan();
   }
   if (!truth.trusted) {
@@ -261,9 +243,9 @@ run_metrics measure(const problem_instance& problem, const run_result& run, cons
     // (blowup_factor + 1) times the initial state's extent are the run's own growth (the
     // truth-based test below, |x - x_true| > blowup_factor x amplitude, on a motion that
     // stays within its initial extent; a problem starting at the origin is not judged).
-    const double extent = norm_part(problem.observed(problem.initial()), 0, observed_dim);
+    const double extent = norm(problem.observed(problem.initial()), 0, observed_dim);
     double reach = 0.0;
-    for (const auto& y : run.sample_y) reach = std::max(reach, norm_part(problem.observed(y), 0, observed_dim));
+    for (const auto& y : run.sample_y) reach = std::max(reach, norm(problem.observed(y), 0, observed_dim));
     all_nan();
     if (extent > 0.0 && !(reach <= (blowup_factor + 1.0) * extent)) {
       m.diverged = true;
@@ -277,18 +259,13 @@ run_metrics measure(const problem_instance& problem, const run_result& run, cons
   }
   if (run.sample_t.size() != truth.times.size())
     throw std::logic_error("measure: the run's samples do not match the truth's times");
-  double sum_sq = 0.0, e_max = 0.0, l_max = 0.0;
+  double sum_sq = 0.0;
   for (size_t j = 0; j < truth.times.size(); ++j) {
     if (std::abs(run.sample_t[j] - truth.times[j]) > 1e-12 * std::max(1.0, truth.times[j]))
       throw std::logic_error("measure: a sample time differs from the truth's");
-    const double e = norm_diff(problem.observed(run.sample_y[j]), problem.observed(truth.y[j]), 0, observed_dim);
+    const double e = norm(problem.observed(run.sample_y[j]), 0, observed_dim, problem.observed(truth.y[j]));
     m.err_pos_max = std::max(m.err_pos_max, e);
     sum_sq += e * e;
-    if (problem.has_energy())
-      e_max = std::max(e_max, std::abs(problem.energy(run.sample_y[j]) - problem.energy(truth.y[j])));
-    if (problem.has_angular_momentum())
-      l_max =
-          std::max(l_max, std::abs(problem.angular_momentum(run.sample_y[j]) - problem.angular_momentum(truth.y[j])));
   }
   m.err_pos_rms = std::sqrt(sum_sq / static_cast<double>(truth.times.size()));
   m.constraint_violation_max = run.constraint_violation;
@@ -300,20 +277,25 @@ run_metrics measure(const problem_instance& problem, const run_result& run, cons
   const auto& y_final = run.final_y;
   const auto& y_true = truth.y.back();
   const auto o_final = problem.observed(y_final), o_true = problem.observed(y_true);
-  m.err_pos_final = norm_diff(o_final, o_true, 0, observed_dim);
-  m.err_vel_final = norm_diff(o_final, o_true, observed_dim, observed_dim);
-  if (problem.has_energy()) {
-    m.energy_drift = (problem.energy(y_final) - problem.energy(y_true)) / truth.energy_scale;
-    m.energy_err_max = e_max / truth.energy_scale;
-  } else {
-    m.energy_drift = m.energy_err_max = nan;
-  }
-  if (problem.has_angular_momentum()) {
-    m.angmom_drift = (problem.angular_momentum(y_final) - problem.angular_momentum(y_true)) / truth.angmom_scale;
-    m.angmom_err_max = l_max / truth.angmom_scale;
-  } else {
-    m.angmom_drift = m.angmom_err_max = nan;
-  }
+  m.err_pos_final = norm(o_final, 0, observed_dim, o_true);
+  m.err_vel_final = norm(o_final, observed_dim, observed_dim, o_true);
+  // A conserved quantity q (energy, angular momentum): its signed error at the end and its
+  // largest error over the samples, over the truth's scale of it; NaN where there is none.
+  const auto conserved = [&](bool has, auto q, double scale, double& drift, double& err_max) {
+    drift = err_max = nan;
+    if (!has) return;
+    double worst = 0.0;
+    for (size_t j = 0; j < truth.times.size(); ++j)
+      worst = std::max(worst, std::abs(q(run.sample_y[j]) - q(truth.y[j])));
+    drift = (q(y_final) - q(y_true)) / scale;
+    err_max = worst / scale;
+  };
+  conserved(
+      problem.has_energy(), [&](const auto& y) { return problem.energy(y); }, truth.energy_scale, m.energy_drift,
+      m.energy_err_max);
+  conserved(
+      problem.has_angular_momentum(), [&](const auto& y) { return problem.angular_momentum(y); }, truth.angmom_scale,
+      m.angmom_drift, m.angmom_err_max);
   // Contacts, matched in order: the k-th of the run against the k-th exact one. NaN where
   // there is nothing to compare (no exact contacts, or none matched).
   const bool exact_contacts = truth.contact_count >= 0;
@@ -325,8 +307,7 @@ run_metrics measure(const problem_instance& problem, const run_result& run, cons
   for (std::size_t k = 0; k < matched; ++k)
     m.contact_time_err = std::max(m.contact_time_err, std::abs(run.contact_times[k] - truth.contact_times[k]));
   for (std::size_t k = 0; k < matched_x; ++k)
-    m.contact_pos_err =
-        std::max(m.contact_pos_err, norm_diff(run.contact_positions[k], truth.contact_positions[k], 0, dim));
+    m.contact_pos_err = std::max(m.contact_pos_err, norm(run.contact_positions[k], 0, dim, truth.contact_positions[k]));
   if (!(m.err_pos_max <= blowup_factor * truth.pos_scale)) {
     m.diverged = true;
     m.note = fmt::format("position error {:.3g} exceeds {:g} times the amplitude", m.err_pos_max, blowup_factor);

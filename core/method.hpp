@@ -64,11 +64,10 @@ struct method_info {
   std::string library;  // "stepbench", "GSL", "SUNDIALS CVODE", "Boost.Odeint"
 };
 
-// One run of one method at one parameter, to the horizon, with the state recorded at
-// the requested times.
-struct run_result {
-  double param = 0.0;  // dt [s] or relative tolerance
-  double horizon = 0.0;
+// What a run did, as every loop records it and every run is reported: its work, why it
+// stopped, its sample times and its contacts (core/drive.hpp's drive_result and the plain
+// run_result below both hold it).
+struct run_record {
   long steps = 0;           // accepted steps
   long rejected_steps = 0;  // attempts rejected by an error test or a failed solve
   work_counters work{};     // force (right-hand-side) evaluations and an implicit method's work
@@ -76,19 +75,26 @@ struct run_result {
   // Why the run stopped before the horizon: a solver error, or the work budget
   // (`skipped`); empty when it reached the horizon.
   std::string stop_reason;
+  bool skipped = false;  // not run to the end because it would exceed the work budget (reason in `stop_reason`)
   // A method that steps its own particles (xpbd): the largest max_j |C_j| / L_j of them
   // over the recorded samples; NaN for a method that steps the problem's state.
   double constraint_violation = std::numeric_limits<double>::quiet_NaN();
-  bool skipped = false;  // not run to the end because it would exceed the work budget (reason in `stop_reason`)
   std::vector<double> sample_t;
-  std::vector<std::vector<double>> sample_y;  // [x; v] at sample_t
-  std::vector<double> final_y;                // [x; v] where the run stopped
   // Contacts (a problem with contacts, run by a loop that resolves them: core/drive.hpp).
-  long contacts = 0;                                   // contacts resolved
-  long tunnelled = 0;                                  // contacts deeper than the problem's tunnelling depth
-  double max_penetration = 0.0;                        // the deepest penetration met before a resolution
-  std::vector<double> contact_times;                   // the first 64
-  std::vector<std::vector<double>> contact_positions;  // position just after each of those (small states only)
+  long contacts = 0;                  // contacts resolved (responses applied)
+  long tunnelled = 0;                 // contacts found deeper than the problem's tunnelling depth
+  double max_penetration = 0.0;       // the deepest penetration found before a resolution
+  std::vector<double> contact_times;  // the first 64: when resolved (end_of_step: the step's end)
+};
+
+// One run of one method at one parameter, to the horizon, with the state recorded at
+// the requested times, in plain vectors.
+struct run_result : run_record {
+  double param = 0.0;  // dt [s] or relative tolerance
+  double horizon = 0.0;
+  std::vector<std::vector<double>> sample_y;           // [x; v] at sample_t
+  std::vector<double> final_y;                         // [x; v] where the run stopped
+  std::vector<std::vector<double>> contact_positions;  // position just after each contact time (small states only)
 };
 
 }  // namespace stepbench

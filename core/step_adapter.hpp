@@ -125,39 +125,30 @@ struct adaptive_peer : peer_entry<Peer, method_kind::adaptive> {
     drive_result<Vec> out;
     out.start(p.dim(), times.size());
     double t = 0.0, dt = 1e-6 * times.front();
-    for (double tout : times) {
-      while (t < tout) {
-        double h = std::min(dt, tout - t);
-        const bool lands = h == tout - t;
-        if (!(h > 4.0 * std::numeric_limits<double>::epsilon() * std::max(std::abs(t), horizon))) {
-          out.stop_reason = "step size underflow at t = " + std::to_string(t);
-          adapter_detail::finish(out, a, t, x, v);
-          return out;
-        }
-        double t_step = t;
-        if (a.try_step(t_step, h)) {
-          ++out.steps;
-          t = lands ? tout : t_step;
-          dt = std::max(dt, h);  // h now holds the proposed next step
-          if (out.steps >= max_steps && t < horizon) {
-            out.over_budget = true;
-            out.stop_reason =
-                "over the step budget of " + std::to_string(max_steps) + " steps at t = " + std::to_string(t);
-            adapter_detail::finish(out, a, t, x, v);
-            return out;
-          }
-        } else {
-          ++out.rejected_steps;
-          dt = h;
-          if (!std::isfinite(dt)) {
-            out.non_finite = true;
-            adapter_detail::finish(out, a, t, x, v);
-            return out;
+    [&] {  // steps and records until the run ends or stops
+      for (double tout : times) {
+        while (t < tout) {
+          double h = std::min(dt, tout - t);
+          const bool lands = h == tout - t;
+          if (stop_on_underflow(out, h, t, horizon)) return;
+          double t_step = t;
+          if (a.try_step(t_step, h)) {
+            ++out.steps;
+            t = lands ? tout : t_step;
+            dt = std::max(dt, h);  // h now holds the proposed next step
+            if (stop_at_step_budget(out, max_steps, t, horizon)) return;
+          } else {
+            ++out.rejected_steps;
+            dt = h;
+            if (!std::isfinite(dt)) {
+              out.non_finite = true;
+              return;
+            }
           }
         }
+        if (!adapter_detail::record_if_finite(out, a, t, x, v)) return;
       }
-      if (!adapter_detail::record_if_finite(out, a, t, x, v)) break;
-    }
+    }();
     adapter_detail::finish(out, a, t, x, v);
     return out;
   }

@@ -73,27 +73,23 @@ struct counted_system {
     } else {
       vec &f0 = fd_f0, &y = fd_y, &f1 = fd_f1;
       force(t, x, v, f0);
-      const double root_eps = std::sqrt(std::numeric_limits<double>::epsilon());
-      y = x;
-      for (int j = 0; j < dim(); ++j) {
-        const double h = root_eps * std::max(std::abs(x[j]), 1.0);
-        y[j] = x[j] + h;
-        force(t, y, v, f1);
-        dfdx.col(j) = (f1 - f0) / (y[j] - x[j]);  // the step as represented, not as intended
-        y[j] = x[j];
-      }
-      if constexpr (force_depends_on_velocity) {
-        y = v;
+      // dF/dz for z = x or v: `force_at(y)` evaluates F into f1 with y in z's place.
+      const auto differences = [&](const vec& z, jacobian_matrix& dfdz, auto&& force_at) {
+        const double root_eps = std::sqrt(std::numeric_limits<double>::epsilon());
+        y = z;
         for (int j = 0; j < dim(); ++j) {
-          const double h = root_eps * std::max(std::abs(v[j]), 1.0);
-          y[j] = v[j] + h;
-          force(t, x, y, f1);
-          dfdv.col(j) = (f1 - f0) / (y[j] - v[j]);
-          y[j] = v[j];
+          const double h = root_eps * std::max(std::abs(z[j]), 1.0);
+          y[j] = z[j] + h;
+          force_at(y);
+          dfdz.col(j) = (f1 - f0) / (y[j] - z[j]);  // the step as represented, not as intended
+          y[j] = z[j];
         }
-      } else {
+      };
+      differences(x, dfdx, [&](const vec& xj) { force(t, xj, v, f1); });
+      if constexpr (force_depends_on_velocity)
+        differences(v, dfdv, [&](const vec& vj) { force(t, x, vj, f1); });
+      else
         dfdv.setZero();
-      }
     }
   }
 

@@ -15,6 +15,33 @@ bool qualifies(const wp_row& r, double target, bool timed) {
 
 std::string what_param(method_kind kind) { return kind == method_kind::adaptive ? "tolerance" : "dt"; }
 
+double cost_of(const wp_row& r, bool by_time) { return by_time ? r.time_ns : r.force_evals; }
+
+// A row on a method's curve: completed, its error finite (an error of exactly 0, a method
+// exact for the problem, meets every target and bounds the cost like any row that does),
+// its cost measured and, in a timed study, its timing not cut.
+bool on_curve(const wp_row& r, bool by_time, bool timed) {
+  const double c = cost_of(r, by_time);
+  return r.completed && std::isfinite(r.error) && r.error >= 0.0 && std::isfinite(c) && c > 0.0 && !(timed && r.cut);
+}
+
+// The pick at measured row i. The spread of its cost: the fastest and slowest repetition
+// when timed and recorded, else the cost itself.
+wp_pick at_row(const wp_method& m, std::size_t i, bool by_time) {
+  const wp_row& r = m.rows[i];
+  const auto spread = [&](double t) { return by_time && std::isfinite(t) && t > 0.0 ? t : cost_of(r, by_time); };
+  wp_pick p;
+  p.row = i;
+  p.cost = cost_of(r, by_time);
+  p.cost_lo = spread(r.time_lo);
+  p.cost_hi = spread(r.time_hi);
+  p.param = r.param;
+  p.error = r.error;
+  p.time_ns = r.time_ns;
+  p.force_evals = r.force_evals;
+  return p;
+}
+
 }  // namespace
 
 bool is_error_metric(std::string_view name) {
@@ -42,38 +69,10 @@ std::optional<wp_pick> cheapest_result::answer(const std::vector<wp_method>& met
 }
 
 std::optional<wp_pick> at_equal_error(const wp_method& m, double target, bool by_time, bool timed) {
-  const auto cost_of = [&](const wp_row& r) { return by_time ? r.time_ns : r.force_evals; };
   // The curve: the usable rows in ladder order (coarse to fine, as the study stores them).
   std::vector<std::size_t> curve;
-  for (std::size_t i = 0; i < m.rows.size(); ++i) {
-    const auto& r = m.rows[i];
-    const double c = cost_of(r);
-    // An error of exactly 0 (a method exact for the problem) is on the curve: it meets
-    // every target, and bounds the cost like any row that does.
-    if (r.completed && std::isfinite(r.error) && r.error >= 0.0 && std::isfinite(c) && c > 0.0 && !(timed && r.cut))
-      curve.push_back(i);
-  }
-  // The spread of a row's cost: its fastest and slowest repetition when timed and
-  // recorded, else the cost itself.
-  const auto lo_of = [&](const wp_row& r) {
-    return by_time && std::isfinite(r.time_lo) && r.time_lo > 0.0 ? r.time_lo : cost_of(r);
-  };
-  const auto hi_of = [&](const wp_row& r) {
-    return by_time && std::isfinite(r.time_hi) && r.time_hi > 0.0 ? r.time_hi : cost_of(r);
-  };
-  const auto at_row = [&](std::size_t i) {
-    const auto& r = m.rows[i];
-    wp_pick p;
-    p.row = i;
-    p.cost = cost_of(r);
-    p.cost_lo = lo_of(r);
-    p.cost_hi = hi_of(r);
-    p.param = r.param;
-    p.error = r.error;
-    p.time_ns = r.time_ns;
-    p.force_evals = r.force_evals;
-    return p;
-  };
+  for (std::size_t i = 0; i < m.rows.size(); ++i)
+    if (on_curve(m.rows[i], by_time, timed)) curve.push_back(i);
   std::optional<wp_pick> best;
   const auto consider = [&](const wp_pick& p) {
     if (!best || p.cost < best->cost) best = p;
@@ -82,7 +81,7 @@ std::optional<wp_pick> at_equal_error(const wp_method& m, double target, bool by
   // extrapolated beyond the coarsest, and on a curve whose cost does not rise steadily,
   // an adaptive method's or a noisy timing's, a measured row may undercut a crossing).
   for (const std::size_t i : curve)
-    if (m.rows[i].error <= target) consider(at_row(i));
+    if (m.rows[i].error <= target) consider(at_row(m, i, by_time));
   // Log-log interpolation between neighbours that bracket the target (both errors
   // positive: a row of error 0 is a bound above, not a point of a log-log line).
   const double lt = std::log(target);
@@ -96,15 +95,12 @@ std::optional<wp_pick> at_equal_error(const wp_method& m, double target, bool by
         return std::numeric_limits<double>::quiet_NaN();
       return std::exp(std::log(va) + s * (std::log(vb) - std::log(va)));
     };
-    wp_pick p;
-    p.row = a.error <= b.error ? curve[k] : curve[k + 1];  // the more accurate of the two
-    p.cost = lerp(cost_of(a), cost_of(b));
-    p.cost_lo = lerp(lo_of(a), lo_of(b));
-    p.cost_hi = lerp(hi_of(a), hi_of(b));
-    p.param = lerp(a.param, b.param);
+    const wp_pick pa = at_row(m, curve[k], by_time), pb = at_row(m, curve[k + 1], by_time);
+    wp_pick p = a.error <= b.error ? pa : pb;  // the row: the more accurate of the two
+    for (double wp_pick::*f : {&wp_pick::cost, &wp_pick::cost_lo, &wp_pick::cost_hi, &wp_pick::param, &wp_pick::time_ns,
+                               &wp_pick::force_evals})
+      p.*f = lerp(pa.*f, pb.*f);
     p.error = target;
-    p.time_ns = lerp(a.time_ns, b.time_ns);
-    p.force_evals = lerp(a.force_evals, b.force_evals);
     p.interpolated = true;
     consider(p);
   }
@@ -167,14 +163,8 @@ cheapest_result cheapest(const std::vector<wp_method>& methods, double target, b
     }
     if (lowest && m.origin != method_origin::baseline &&
         (!best_achieved || m.rows[*lowest].error < methods[best_achieved->method].rows[best_achieved->row].error)) {
-      wp_pick p;
-      p.row = *lowest;
-      p.cost = all_timed ? m.rows[*lowest].time_ns : m.rows[*lowest].force_evals;
+      wp_pick p = at_row(m, *lowest, all_timed);
       p.cost_lo = p.cost_hi = p.cost;
-      p.param = m.rows[*lowest].param;
-      p.error = m.rows[*lowest].error;
-      p.time_ns = m.rows[*lowest].time_ns;
-      p.force_evals = m.rows[*lowest].force_evals;
       best_achieved = with_margin(p);
     }
     if (const auto p = at_equal_error(m, target, all_timed, timed)) {
@@ -183,8 +173,7 @@ cheapest_result cheapest(const std::vector<wp_method>& methods, double target, b
     }
     std::string reason;
     if (!lowest) {
-      bool any_diverged = false;
-      for (const auto& d : m.rows) any_diverged = any_diverged || d.diverged;
+      const bool any_diverged = std::any_of(m.rows.begin(), m.rows.end(), [](const wp_row& d) { return d.diverged; });
       reason = m.rows.empty() ? "no rows in the study"
                : any_diverged ? fmt::format("diverged or failed at every {}", what_param(m.kind))
                               : fmt::format("failed at every {}", what_param(m.kind));
@@ -212,9 +201,7 @@ std::vector<front_point> pareto_front(const std::vector<wp_method>& methods, boo
     if (methods[mi].origin == method_origin::baseline) continue;
     for (std::size_t ri = 0; ri < methods[mi].rows.size(); ++ri) {
       const auto& r = methods[mi].rows[ri];
-      const double cost = by_time ? r.time_ns : r.force_evals;
-      if (!r.completed || !std::isfinite(r.error) || !(std::isfinite(cost) && cost > 0.0) || (timed && r.cut)) continue;
-      pts.push_back({mi, ri, cost, r.error});
+      if (on_curve(r, by_time, timed)) pts.push_back({mi, ri, cost_of(r, by_time), r.error});
     }
   }
   // By cost, then error; a point joins when it beats every cheaper point's error.

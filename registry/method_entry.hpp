@@ -38,6 +38,7 @@ method_info ours_info(method_kind kind) {
 template <integrator I>
 struct ours_fixed {
   using integrator_type = I;
+  static constexpr bool resolves_contacts = true;  // our loops do (runs_on, below)
   static method_info info() { return ours_info<I>(method_kind::fixed_step); }
   template <problem P>
   static auto prepare(const P& p, double dt, double horizon, std::span<const double> times, const run_limits&) {
@@ -47,6 +48,7 @@ struct ours_fixed {
 
 template <adaptive_integrator I>
 struct ours_adaptive {
+  static constexpr bool resolves_contacts = true;
   static method_info info() { return ours_info<I>(method_kind::adaptive); }
   template <problem P>
   static auto prepare(const P& p, double tol, double horizon, std::span<const double> times, const run_limits& limits) {
@@ -64,13 +66,11 @@ template <class M>
 struct entry_for {
   using type = M;
 };
-template <class I>
-requires integrator<I>
+template <integrator I>
 struct entry_for<I> {
   using type = ours_fixed<I>;
 };
-template <class I>
-requires adaptive_integrator<I>
+template <adaptive_integrator I>
 struct entry_for<I> {
   using type = ours_adaptive<I>;
 };
@@ -80,14 +80,8 @@ using entry_t = typename entry_for<M>::type;
 // Our loops resolve contacts (core/drive.hpp); the peers' and the baseline's do not, so
 // on a problem with contacts only our methods run (a library stepping through a ground
 // plane would be measured falling through it).
-template <class M>
-inline constexpr bool is_ours = false;
-template <class I>
-inline constexpr bool is_ours<ours_fixed<I>> = true;
-template <class I>
-inline constexpr bool is_ours<ours_adaptive<I>> = true;
 template <class M, class P>
-inline constexpr bool runs_on = method_applies<M, P>() && (!has_contacts<P> || is_ours<M>);
+inline constexpr bool runs_on = method_applies<M, P>() && (!has_contacts<P> || requires { M::resolves_contacts; });
 
 // One info object per entry for the whole program (an inline function's static).
 template <class M>

@@ -32,34 +32,16 @@ template <class P>
 using method_table = std::vector<method_slot<P>>;
 
 template <class Vec>
-std::vector<double> flatten(const Vec& x, const Vec& v) {
-  std::vector<double> y(x.data(), x.data() + x.size());
-  y.insert(y.end(), v.data(), v.data() + v.size());
-  return y;
-}
-
-template <class Vec>
 run_result to_run_result(const drive_result<Vec>& r, double param, double horizon) {
   run_result out;
+  static_cast<run_record&>(out) = r;
   out.param = param;
   out.horizon = horizon;
-  out.steps = r.steps;
-  out.rejected_steps = r.rejected_steps;
-  out.work = r.work;
-  out.non_finite = r.non_finite;
-  out.stop_reason = r.stop_reason;
-  out.skipped = r.over_budget;
-  out.constraint_violation = r.constraint_violation;
-  out.sample_t = r.sample_t;
   for (std::size_t j = 0; j < r.sample_t.size(); ++j) {
     const auto col = r.samples.col(static_cast<Eigen::Index>(j));
     out.sample_y.emplace_back(col.data(), col.data() + col.size());
   }
-  out.final_y = flatten(r.final_state.x, r.final_state.v);
-  out.contacts = r.contacts;
-  out.tunnelled = r.tunnelled;
-  out.max_penetration = r.max_penetration;
-  out.contact_times = r.contact_times;
+  out.final_y = stacked(r.final_state);
   for (std::size_t k = 0; k < r.contact_times.size() && r.contact_x.size() > 0; ++k) {
     const auto col = r.contact_x.col(static_cast<Eigen::Index>(k));
     out.contact_positions.emplace_back(col.data(), col.data() + col.size());
@@ -91,18 +73,14 @@ std::function<double()> timed_method(const P& p, double param, double horizon, s
   return [run_once = M::prepare(p, param, horizon, times, limits)] { return run_once().final_state.x[0]; };
 }
 
-template <integrator I, problem P>
-loop_result loop_of(const P& p, const loop_config& config) {
-  return simulate_loop(p, I{}, config);
-}
-
 // Appends a slot for each method of the group that runs on P, in the group's order.
 template <problem P, class... Ms>
 void append_group(type_list<Ms...>, method_table<P>& table) {
   for_each_type(type_list<entry_t<Ms>...>{}, [&]<class M>() {
     if constexpr (runs_on<M, P>) {
       method_slot<P> slot{.info = &info_of<M>(), .run = &run_method<M, P>, .timed_run = &timed_method<M, P>};
-      if constexpr (requires { typename M::integrator_type; }) slot.loop = &loop_of<typename M::integrator_type, P>;
+      if constexpr (requires { typename M::integrator_type; })
+        slot.loop = [](const P& p, const loop_config& c) { return simulate_loop(p, typename M::integrator_type{}, c); };
       table.push_back(slot);
     }
   });

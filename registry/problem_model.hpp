@@ -6,7 +6,6 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
-#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string_view>
@@ -14,6 +13,7 @@
 #include "core/constraints.hpp"
 #include "core/first_order.hpp"
 #include "core/game_loop.hpp"
+#include "core/number.hpp"
 #include "registry/method_table.hpp"
 #include "registry/registry.hpp"
 
@@ -72,38 +72,29 @@ class problem_model final : public problem_instance {
   bool has_jacobian() const override { return stepbench::has_jacobian<P>; }
 
   std::vector<double> exact(double t) const override {
-    if constexpr (stepbench::has_closed_form<P>) {
-      const auto s = p_.exact(t);
-      return flatten(s.x, s.v);
-    } else {
-      throw std::logic_error(fmt::format("problem {} has no closed form", P::name));
-    }
+    if constexpr (stepbench::has_closed_form<P>) return stacked(p_.exact(t));
+    throw std::logic_error(fmt::format("problem {} has no closed form", P::name));
   }
   double energy(std::span<const double> y) const override {
-    if constexpr (stepbench::has_energy<P>)
-      return p_.energy(unflatten(y, 0), unflatten(y, p_.dim()));
-    else
-      return std::numeric_limits<double>::quiet_NaN();
+    if constexpr (stepbench::has_energy<P>) return p_.energy(unflatten(y, 0), unflatten(y, p_.dim()));
+    return nan;
   }
   bool has_angular_momentum() const override { return stepbench::has_angular_momentum<P>; }
   double angular_momentum(std::span<const double> y) const override {
     if constexpr (stepbench::has_angular_momentum<P>)
       return p_.angular_momentum(unflatten(y, 0), unflatten(y, p_.dim()));
-    else
-      return std::numeric_limits<double>::quiet_NaN();
+    return nan;
   }
   int observed_dim() const override {
-    if constexpr (stepbench::has_observed_positions<P>)
-      return p_.observed_dim();
-    else
-      return p_.dim();
+    if constexpr (stepbench::has_observed_positions<P>) return p_.observed_dim();
+    return p_.dim();
   }
   std::vector<double> observed(std::span<const double> y) const override {
     if constexpr (stepbench::has_observed_positions<P>) {
       const int n = p_.observed_dim();
       Eigen::VectorXd pos(n), vel(n);
       p_.observe(unflatten(y, 0), unflatten(y, p_.dim()), pos, vel);
-      return flatten(pos, vel);
+      return stacked(pos, vel);
     } else {
       return {y.begin(), y.end()};
     }
@@ -111,32 +102,22 @@ class problem_model final : public problem_instance {
   double constraint_violation(std::span<const double> y) const override {
     if constexpr (stepbench::has_constraint_view<P>)
       return stepbench::constraint_violation(p_.particles(unflatten(y, 0), unflatten(y, p_.dim())));
-    else
-      return std::numeric_limits<double>::quiet_NaN();
+    return nan;
   }
   double period() const override {
-    if constexpr (stepbench::has_period<P>)
-      return p_.period();
-    else
-      return std::numeric_limits<double>::quiet_NaN();
+    if constexpr (stepbench::has_period<P>) return p_.period();
+    return nan;
   }
   std::string_view contact_mode() const override {
-    if constexpr (stepbench::has_contacts<P>)
-      return p_.locate_contacts() ? "locate" : "end_of_step";
-    else
-      return "none";
+    if constexpr (stepbench::has_contacts<P>) return p_.locate_contacts() ? "locate" : "end_of_step";
+    return "none";
   }
   bool has_exact_contacts() const override { return stepbench::has_exact_contacts<P>; }
   exact_contact_list exact_contacts(double t_end) const override {
-    if constexpr (stepbench::has_exact_contacts<P>)
-      return p_.exact_contacts(t_end);
-    else
-      throw std::logic_error(fmt::format("problem {} has no exact contacts", P::name));
+    if constexpr (stepbench::has_exact_contacts<P>) return p_.exact_contacts(t_end);
+    throw std::logic_error(fmt::format("problem {} has no exact contacts", P::name));
   }
-  std::vector<double> initial() const override {
-    const auto s = p_.initial();
-    return flatten(s.x, s.v);
-  }
+  std::vector<double> initial() const override { return stacked(p_.initial()); }
   double fastest_frequency() const override { return stepbench::fastest_frequency(p_); }
   ode_system ode() const override {
     ode_system sys = make_ode_system(p_);
@@ -144,22 +125,24 @@ class problem_model final : public problem_instance {
       // The gap and the response for CVODE's root finding, on the problem's own functions.
       struct workspace {
         P p;
-        typename P::vec x, v;
+        vec x, v;
+        Eigen::Index load(std::span<const double> y) {  // returns the dimension
+          const auto d = static_cast<Eigen::Index>(y.size() / 2);
+          x = Eigen::Map<const vec>(y.data(), d);
+          v = Eigen::Map<const vec>(y.data() + d, d);
+          return d;
+        }
       };
       auto w = std::make_shared<workspace>(workspace{p_, p_.initial().x, p_.initial().v});
       sys.contact_gap = [w](double t, std::span<const double> y) {
-        const auto d = static_cast<Eigen::Index>(y.size() / 2);
-        w->x = Eigen::Map<const typename P::vec>(y.data(), d);
-        w->v = Eigen::Map<const typename P::vec>(y.data() + d, d);
+        w->load(y);
         return w->p.contact_gap(t, w->x, w->v);
       };
       sys.resolve_contacts = [w](double t, std::span<double> y) {
-        const auto d = static_cast<Eigen::Index>(y.size() / 2);
-        w->x = Eigen::Map<const typename P::vec>(y.data(), d);
-        w->v = Eigen::Map<const typename P::vec>(y.data() + d, d);
+        const Eigen::Index d = w->load(y);
         const contact_outcome c = w->p.resolve_contacts(t, w->x, w->v);
-        Eigen::Map<typename P::vec>(y.data(), d) = w->x;
-        Eigen::Map<typename P::vec>(y.data() + d, d) = w->v;
+        Eigen::Map<vec>(y.data(), d) = w->x;
+        Eigen::Map<vec>(y.data() + d, d) = w->v;
         return c.resolved;
       };
     }

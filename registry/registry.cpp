@@ -37,13 +37,6 @@ const std::vector<method_info>& all_methods() {
   return all;
 }
 
-std::vector<method_info> integrators() {
-  std::vector<method_info> out;
-  for (const auto& m : all_methods())
-    if (m.origin == method_origin::ours) out.push_back(m);
-  return out;
-}
-
 const method_info* registered_method(std::string_view name) {
   for (const auto& m : all_methods())
     if (m.name == name) return &m;

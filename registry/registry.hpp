@@ -18,8 +18,6 @@ std::unique_ptr<problem_instance> make_problem(std::string_view name);
 
 // Every method in registry order: our integrators, then the peers and the baseline.
 const std::vector<method_info>& all_methods();
-// Our integrators only.
-std::vector<method_info> integrators();
 // Throws std::invalid_argument naming the unknown method and the known ones.
 const method_info& find_method(std::string_view name);
 // The method of that name, or nullptr (a study file may hold a method this build lacks).

@@ -54,7 +54,7 @@ struct study_part {
   merge_rule merge = merge_rule::per_problem;  // how the shards of a study hold it (store/merge.hpp)
   // judged_again: what spans problems, judged again on the merged file.
   void (*judge_again)(H5::Group& root, const std::vector<std::string>& problems) = nullptr;
-  // The tables it writes that store/schema.cpp does not declare: a part's own, declared in
+  // The tables it writes that no column map of store/ declares: a part's own, declared in
   // its file (`stepbench schema` lists them; merge joins a judged_again part's by them).
   std::span<const schema::table> tables = {};
   std::string (*describe)(const sweep_options&) = nullptr;

@@ -17,7 +17,7 @@
 // test always passes, so its step is rk45's Dormand-Prince step and adaptive_euler's two
 // half steps of explicit Euler.
 //
-// Computed by the sweep into every study (study/sweep.hpp), written to the study file as
+// Computed by the stability part (parts/stability.cpp, run/stability.cpp), written to the study file as
 // /stability (docs/study-format.md), and printed by `stepbench stability`.
 #include <string>
 #include <string_view>

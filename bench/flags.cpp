@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "cli/args.hpp"
+#include "core/text.hpp"
 
 namespace stepbench::bench {
 
@@ -56,11 +57,9 @@ options take_own_flags(int& argc, char** argv, std::vector<std::string>& extra) 
       o.problems.push_back(a.substr(10));  // checked by run_sweep's validate()
       if (o.problems.back().empty()) throw std::invalid_argument("--problem needs a problem name");
     } else if (a.rfind("--parts=", 0) == 0) {
-      for (std::size_t start = 8; start <= a.size();) {
-        const std::size_t comma = std::min(a.find(',', start), a.size());
-        o.parts.push_back(a.substr(start, comma - start));  // checked by run_sweep's validate()
-        if (o.parts.back().empty()) throw std::invalid_argument("--parts needs part names: --parts=A,B");
-        start = comma + 1;
+      for (const auto name : split(std::string_view(a).substr(8), ',')) {
+        o.parts.emplace_back(name);  // checked by run_sweep's validate()
+        if (name.empty()) throw std::invalid_argument("--parts needs part names: --parts=A,B");
       }
     } else if (a.rfind("--shard=", 0) == 0) {
       parse_shard(a.substr(8), o.shard_index, o.shard_count);

@@ -13,6 +13,7 @@
 
 #include "cli/args.hpp"
 #include "cli/commands.hpp"
+#include "core/text.hpp"
 #include "parts/study.hpp"
 #include "render/scan.hpp"
 #include "run/scan.hpp"
@@ -58,11 +59,7 @@ struct scan_args {
 
 std::vector<double> number_list(const std::string& text, std::string_view what) {
   std::vector<double> out;
-  for (std::size_t start = 0; start <= text.size();) {
-    const auto comma = std::min(text.find(',', start), text.size());
-    out.push_back(parse_number(std::string_view(text).substr(start, comma - start), what));
-    start = comma + 1;
-  }
+  for (const auto piece : split(text, ',')) out.push_back(parse_number(piece, what));
   return out;
 }
 

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "core/measure.hpp"
+#include "core/text.hpp"
 #include "registry/registry.hpp"
 #include "run/balanced_share.hpp"
 #include "run/frame_rates.hpp"
@@ -24,16 +25,6 @@ double number(std::string_view text, std::string_view what, std::string_view axi
   if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(v))
     throw std::invalid_argument(fmt::format("--param {}: {} '{}' is not a finite number", axis, what, text));
   return v;
-}
-
-std::vector<std::string_view> split(std::string_view text, char sep) {
-  std::vector<std::string_view> out;
-  for (std::size_t start = 0;;) {
-    const auto at = text.find(sep, start);
-    out.push_back(text.substr(start, at == std::string_view::npos ? std::string_view::npos : at - start));
-    if (at == std::string_view::npos) return out;
-    start = at + 1;
-  }
 }
 
 // The grid points of this run's shard (validate checked it exists), in grid order: each

@@ -487,15 +487,4 @@ std::map<std::string, double> number_attrs(const H5::H5Object& obj, bool floats_
   return scan_attrs<double>(obj, wanted, attr_kind::number, read_double);
 }
 
-std::vector<std::string> split(const std::string& text, char sep) {
-  std::vector<std::string> out;
-  if (text.empty()) return out;
-  for (std::size_t a = 0;;) {
-    const auto b = text.find(sep, a);
-    out.push_back(text.substr(a, b == std::string::npos ? std::string::npos : b - a));
-    if (b == std::string::npos) return out;
-    a = b + 1;
-  }
-}
-
 }  // namespace stepbench::h5

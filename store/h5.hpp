@@ -97,7 +97,5 @@ std::vector<double> double_array_attr(const H5::H5Object& obj, const std::string
 // too), by name; attributes of other kinds are skipped, damaged ones refused.
 std::map<std::string, std::string> string_attrs(const H5::H5Object& obj);
 std::map<std::string, double> number_attrs(const H5::H5Object& obj, bool floats_only);
-// The items of a list attribute's text, separated by `sep` (none for ""; the items hold no `sep`).
-std::vector<std::string> split(const std::string& text, char sep);
 
 }  // namespace stepbench::h5

@@ -9,6 +9,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "core/text.hpp"
 #include "run/machine.hpp"
 #include "store/columns.hpp"
 #include "store/h5.hpp"
@@ -136,7 +137,7 @@ shard_file read_shard(const std::string& path) {
 
 // The first line where two `sweep_options` texts differ, from each.
 std::pair<std::string, std::string> first_difference(const std::string& a, const std::string& b) {
-  const auto la = h5::split(a, '\n'), lb = h5::split(b, '\n');
+  const auto la = stored_list(a, '\n'), lb = stored_list(b, '\n');
   for (std::size_t i = 0; i < std::max(la.size(), lb.size()); ++i) {
     const std::string x = i < la.size() ? la[i] : "(none)", y = i < lb.size() ? lb[i] : "(none)";
     if (x != y) return {x, y};
@@ -261,7 +262,7 @@ study_merge_result merge_studies(const std::vector<std::string>& paths, const st
       }
   }
   // Every selected problem once.
-  const auto selection = h5::split(first.selection, ',');
+  const auto selection = stored_list(first.selection, ',');
   std::map<long, const shard_file*> by_index;
   std::map<std::string, const shard_file*> owner;
   for (const auto& s : shards) {

@@ -4,6 +4,7 @@
 #include <fmt/ranges.h>
 
 #include "core/number.hpp"
+#include "core/text.hpp"
 #include "store/columns.hpp"
 #include "store/study_reader.hpp"
 
@@ -80,7 +81,7 @@ scan_result read_scan_group(const H5::Group& all, const std::string& which) {
   o.tol = h5::double_attr(g, "tol");
   const auto lo = h5::double_array_attr(g, "axis_lo"), hi = h5::double_array_attr(g, "axis_hi");
   const auto count = h5::int_array_attr(g, "axis_count"), log = h5::int_array_attr(g, "axis_log");
-  const std::vector<std::string> axis_names = h5::split(h5::string_attr(g, "axes"), ',');
+  const std::vector<std::string> axis_names = stored_list(h5::string_attr(g, "axes"), ',');
   if (axis_names.size() != lo.size() || lo.size() != hi.size() || hi.size() != count.size() ||
       count.size() != log.size())
     throw std::runtime_error(fmt::format("scan '{}': its axis attributes differ in length", which));
@@ -89,8 +90,8 @@ scan_result read_scan_group(const H5::Group& all, const std::string& which) {
   o.hz = h5::double_array_attr(g, "hz");
   o.substeps.clear();  // the file's counts replace the defaults, not extend them
   for (long n : h5::int_array_attr(g, "substeps")) o.substeps.push_back(static_cast<int>(n));
-  o.methods = h5::split(h5::string_attr(g, "methods"), ',');
-  const auto fixed_names = h5::split(h5::string_attr(g, "fixed_params"), ',');
+  o.methods = stored_list(h5::string_attr(g, "methods"), ',');
+  const auto fixed_names = stored_list(h5::string_attr(g, "fixed_params"), ',');
   const auto fixed_values = h5::double_array_attr(g, "fixed_values");
   if (fixed_names.size() != fixed_values.size())
     throw std::runtime_error(

@@ -30,7 +30,6 @@ void attr(H5::H5Object& obj, const std::string& name, const std::string& value) 
   const H5::StrType type = vlen_string();
   obj.createAttribute(name, type, H5::DataSpace(H5S_SCALAR)).write(type, value);
 }
-void attr(H5::H5Object& obj, const std::string& name, const char* value) { attr(obj, name, std::string(value)); }
 void attr(H5::H5Object& obj, const std::string& name, double value) {
   obj.createAttribute(name, H5::PredType::NATIVE_DOUBLE, H5::DataSpace(H5S_SCALAR))
       .write(H5::PredType::NATIVE_DOUBLE, &value);
@@ -290,11 +289,6 @@ bool table_data::has(const std::string& field) const {
   return std::any_of(fields_.begin(), fields_.end(), [&](const auto& f) { return f.first == field; });
 }
 
-std::vector<double> table_data::doubles(const std::string& field) const {
-  if (const auto it = reals_.find(field); it != reals_.end()) return it->second;
-  if (const auto it = integers_.find(field); it != integers_.end()) return {it->second.begin(), it->second.end()};
-  throw std::runtime_error(fmt::format("missing numeric field '{}' in {}", field, name_));
-}
 template <class T>
 static const std::vector<T>& column_named(const std::map<std::string, std::vector<T>>& columns,
                                           const std::string& field, const char* kind, const std::string& table) {

@@ -16,7 +16,6 @@
 namespace stepbench::h5 {
 
 void attr(H5::H5Object& obj, const std::string& name, const std::string& value);
-void attr(H5::H5Object& obj, const std::string& name, const char* value);
 void attr(H5::H5Object& obj, const std::string& name, double value);
 void attr(H5::H5Object& obj, const std::string& name, long value);
 void attr(H5::H5Object& obj, const std::string& name, int value);
@@ -65,10 +64,8 @@ class table_data {
  public:
   enum class kind { real, integer, text };  // double; int8 or int64; variable-length string
   std::size_t rows() const { return rows_; }
-  const std::vector<std::pair<std::string, kind>>& fields() const { return fields_; }
   bool has(const std::string& field) const;
   // A missing field (or one of another kind) is an error naming it and the table.
-  std::vector<double> doubles(const std::string& field) const;  // a real or integer field
   const std::vector<double>& reals(const std::string& field) const;
   const std::vector<std::int64_t>& ints(const std::string& field) const;
   const std::vector<std::string>& strings(const std::string& field) const;

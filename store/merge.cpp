@@ -171,22 +171,13 @@ void join_table(const std::vector<shard_file>& shards, H5::Group& dst, const std
     if (group.timed_only && !parts.front().has(std::string(group.fields.front().name))) continue;
     for (const auto& f : group.fields) {
       const std::string field(f.name);
-      // The field's values in the merged order, from each part's column (read once a part).
+      // The field's values in the merged order, from each part's column.
+      std::vector<columns_detail::read_column> columns;
+      for (const auto& p : parts) columns.push_back(columns_detail::column_of(p, field, f.type));
       h5::column joined = columns_detail::empty_column(f.type);
       std::visit(
           [&]<class T>(std::vector<T>& v) {
-            const auto column_of = [&](const h5::table_data& p) {
-              if constexpr (std::is_same_v<T, double>)
-                return p.doubles(field);
-              else if constexpr (std::is_same_v<T, std::string>)
-                return p.strings(field);
-              else
-                return p.ints(field);
-            };
-            std::vector<decltype(column_of(parts.front()))> columns;
-            for (const auto& p : parts) columns.push_back(column_of(p));
-            v.reserve(rows.size());
-            for (const auto& [r, k, i] : rows) v.push_back(static_cast<T>(columns[k][i]));
+            for (const auto& [r, k, i] : rows) v.push_back(columns_detail::value_at<T>(columns[k], i));
           },
           joined);
       t.add(field, std::move(joined));
@@ -195,16 +186,12 @@ void join_table(const std::vector<shard_file>& shards, H5::Group& dst, const std
   t.write(dst, name, spec);
 }
 
-// A group whose children are problems: each copied from the shard that ran it, in the
-// study's order; the group's own attributes from the first shard that has it, its
-// wall_seconds summed.
-void merge_per_problem(const std::vector<const shard_file*>& having, H5::H5File& dst, const std::string& top,
-                       const std::vector<std::string>& problems,
+// A group whose children are problems (`g`, its own attributes the first shard's): each
+// copied from the shard that ran it, in the study's order; the group's wall_seconds summed.
+void merge_per_problem(const std::vector<const shard_file*>& having, H5::H5File& dst, H5::Group& g,
+                       const std::string& top, const std::vector<std::string>& problems,
                        const std::map<std::string, const shard_file*>& owner) {
-  H5::Group g = dst.createGroup(top);
-  const H5::Group src = having.front()->file.openGroup(top);
-  copy_attrs(src, g);
-  if (has_attr(src, "wall_seconds")) {
+  if (has_attr(g, "wall_seconds")) {
     double sum = 0.0;
     for (const auto* s : having) sum += h5::double_attr(s->file.openGroup(top), "wall_seconds");
     replace_attr(g, "wall_seconds", sum);
@@ -332,16 +319,20 @@ study_merge_result merge_studies(const std::vector<std::string>& paths, const st
       for (const auto& s : shards)
         if (h5::is_group(s.file, top)) having.push_back(&s);
       if (having.empty()) continue;
+      if (part.rule == merge_rule::same_in_every_shard) {  // identical in every shard of one build: the first's
+        copy_object(having.front()->file, dst, top);
+        continue;
+      }
+      // The group's own attributes from the first shard that has it.
+      H5::Group g = dst.createGroup(top);
+      copy_attrs(having.front()->file.openGroup(top), g);
       switch (part.rule) {
-        case merge_rule::same_in_every_shard:  // identical in every shard of one build: the first's
-          copy_object(having.front()->file, dst, top);
+        case merge_rule::same_in_every_shard:  // copied whole above
           break;
         case merge_rule::per_problem:
-          merge_per_problem(having, dst, top, result.problems, owner);
+          merge_per_problem(having, dst, g, top, result.problems, owner);
           break;
-        case merge_rule::in_one_shard: {
-          H5::Group g = dst.createGroup(top);
-          copy_attrs(having.front()->file.openGroup(top), g);
+        case merge_rule::in_one_shard:
           for (const auto* s : having)
             for (const auto& name : h5::children(s->file.openGroup(top))) {
               if (h5::has_link(g, name))
@@ -350,10 +341,7 @@ study_merge_result merge_studies(const std::vector<std::string>& paths, const st
               copy_object(s->file, dst, top + "/" + name);
             }
           break;
-        }
         case merge_rule::judged_again: {
-          H5::Group g = dst.createGroup(top);
-          copy_attrs(having.front()->file.openGroup(top), g);
           std::vector<const schema::table*> tables;
           for (const auto& t : schema::tables()) tables.push_back(&t);
           for (const auto& t : part.tables) tables.push_back(&t);

@@ -32,12 +32,6 @@ std::span<const table> tables() {
   return all;
 }
 
-const table& find(std::string_view name) {
-  for (const auto& t : tables())
-    if (t.name == name) return t;
-  throw std::logic_error("the study schema has no table named " + std::string(name));
-}
-
 std::string to_json(std::span<const table* const> own) {
   nlohmann::ordered_json out;
   out["format_version"] = format_version;

@@ -38,8 +38,6 @@ struct table {
 
 // Every table of the study file, the loop, energy and substeps studies included.
 std::span<const table> tables();
-// The table named `name`; throws std::logic_error for an unknown name (a bug, not input).
-const table& find(std::string_view name);
 
 // The "row completed" rule as data: a row completed when every one of these flags is 0
 // (core/measure.hpp's row_completed is the same rule in C++).

@@ -295,21 +295,21 @@ std::string temp_path_for(const std::string& path) { return fmt::format("{}.tmp.
 int write_whole(const std::string& path, const std::vector<unsigned char>& bytes) {
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
   if (fd < 0) return errno;
-  std::size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const int error = n < 0 ? errno : EIO;
-      ::close(fd);
-      return error;
-    }
-    done += static_cast<std::size_t>(n);
-  }
-  return ::close(fd) == 0 ? 0 : errno;
+  const int error = write_bytes(fd, bytes.data(), bytes.size());
+  return ::close(fd) == 0 || error ? error : errno;
 }
 
 }  // namespace
+
+int write_bytes(int fd, const void* data, std::size_t size) {
+  for (std::size_t done = 0; done < size;) {
+    const ssize_t n = ::write(fd, static_cast<const char*>(data) + done, size - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return n < 0 ? errno : EIO;
+    done += static_cast<std::size_t>(n);
+  }
+  return 0;
+}
 
 void write_root_attributes(H5::H5File& file, const study& s, const std::string& described_options) {
   attr(file, "format_version", study_format_version);
@@ -320,8 +320,7 @@ void write_root_attributes(H5::H5File& file, const study& s, const std::string& 
   attr(file, "dependencies", build_info::dependencies);
   attr(file, "build_flags", build_info::build_flags);
   attr(file, "created_utc", utc_now_iso8601());
-  attr(file, "cpu", cpu_model());
-  attr(file, "cores", core_count());
+  write_machine(file, s.timed);
   if (s.swept) {
     // Which problems the study selected and which share of them this file holds
     // (sweep --shard K/N, stepbench_bench --shard=K/N); stepbench merge reads these.
@@ -351,9 +350,6 @@ void write_root_attributes(H5::H5File& file, const study& s, const std::string& 
     attr(file, "benchmark_repetitions", t.repetitions);
     attr(file, "benchmark_case_budget_s", t.case_budget_s);
     attr(file, "benchmark_wall_seconds", t.wall_seconds);
-    attr(file, "cpu_scaling_enabled", t.cpu_scaling_enabled);
-    attr(file, "num_cpus", t.num_cpus);
-    attr(file, "mhz_per_cpu", t.mhz_per_cpu);
   }
 }
 

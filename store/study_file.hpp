@@ -41,6 +41,10 @@ void read_problems(const H5::Group& root, study& s);
 // and with timings num_cpus, mhz_per_cpu, cpu_scaling_enabled (Google Benchmark's context).
 void write_machine(H5::H5Object& obj, const std::optional<timing_settings>& timing);
 
+// Writes `size` bytes from `data` to the descriptor whole, again when interrupted: 0, or
+// the errno of the write that failed (EIO for one that wrote nothing).
+int write_bytes(int fd, const void* data, std::size_t size);
+
 // A file built in memory (HDF5's core driver, no backing store) and named after a
 // temporary path beside `path`; its image; and the image written to a temporary file
 // beside `path`, renamed into place when whole (as write_study writes).

@@ -76,15 +76,6 @@ struct reading_child {
   int fd = -1;
 };
 
-void write_all(int fd, const std::string& bytes) {
-  for (std::size_t done = 0; done < bytes.size();) {
-    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return;  // the parent is gone: nothing to tell
-    done += static_cast<std::size_t>(n);
-  }
-}
-
 std::runtime_error cannot_read(const std::string& path, const std::string& what) {
   return std::runtime_error(fmt::format("cannot read study file '{}': {}", path, what));
 }
@@ -156,7 +147,7 @@ reading_child start_reading(const std::string& path, const study_parts_reader& r
     } catch (const std::exception& e) {
       answer = std::string("R") + e.what();
     }
-    write_all(fds[1], answer);
+    write_bytes(fds[1], answer.data(), answer.size());  // failing when the parent is gone: nothing to tell
     std::_Exit(0);
   }
   ::close(fds[1]);

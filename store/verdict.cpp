@@ -4,6 +4,7 @@
 #include <fmt/ranges.h>
 
 #include "core/number.hpp"
+#include "core/text.hpp"
 #include "judge/verdict.hpp"
 #include "store/columns.hpp"
 #include "store/study_file.hpp"
@@ -198,12 +199,7 @@ verdict_tables read_verdict(const H5::Group& root) {
   const H5::Group g = root.openGroup("verdict");
   verdict_tables v;
   v.cost_kind = h5::string_attr(g, "cost_kind");
-  const std::string findings = h5::string_attr(g, "findings");
-  for (std::size_t a = 0; a < findings.size();) {
-    const auto b = std::min(findings.find('\n', a), findings.size());
-    v.findings.push_back(findings.substr(a, b - a));
-    a = b + 1;
-  }
+  v.findings = stored_list(h5::string_attr(g, "findings"), '\n');  // a finding is one sentence, never empty
   v.equal_error = equal_error_columns().read(g, "equal_error");
   v.frame_rate = frame_rate_columns().read(g, "frame_rate");
   v.frame_answers = frame_answer_columns().read(g, "frame_answer");

@@ -203,8 +203,8 @@ TEST(stability, written_to_the_study_file) {
   const h5::table_data limits = h5::read_table(g.openDataSet("limits"));
   const auto& names = limits.strings("integrator");
   const auto& tests = limits.strings("test");
-  const auto theory = limits.doubles("theory");
-  const auto measured = limits.doubles("measured");
+  const auto& theory = limits.reals("theory");
+  const auto& measured = limits.reals("measured");
   const auto& uncond = limits.ints("unconditionally_stable");
   ASSERT_EQ(names.size(), data().limits.size());
   for (std::size_t k = 0; k < names.size(); ++k) {

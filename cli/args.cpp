@@ -24,9 +24,8 @@ double parse_positive(std::string_view text, std::string_view what) {
   return value;
 }
 
-std::string count_of(long long n, std::string_view singular, std::string_view plural) {
-  if (n == 1) return fmt::format("1 {}", singular);
-  return plural.empty() ? fmt::format("{} {}s", n, singular) : fmt::format("{} {}", n, plural);
+std::string count_of(long long n, std::string_view singular) {
+  return fmt::format("{} {}{}", n, singular, n == 1 ? "" : "s");
 }
 
 void add_override(parameter_overrides& out, std::string_view text, std::span<const std::string> selected) {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ranges>
 #include <stdexcept>
 #include <vector>
 
@@ -52,12 +53,10 @@ void add_override(parameter_overrides& out, std::string_view text, std::span<con
     throw std::invalid_argument(fmt::format("--set {}: problem {} is not selected", text, problem));
   const auto params = instance->params();
   const auto it = std::find_if(params.begin(), params.end(), [&](const param_value& q) { return q.name == name; });
-  if (it == params.end()) {
-    std::vector<std::string_view> known;
-    for (const auto& q : params) known.push_back(q.name);
+  if (it == params.end())
     throw std::invalid_argument(fmt::format("--set {}: unknown parameter '{}' for problem {} (known: {})", text, name,
-                                            problem, fmt::join(known, ", ")));
-  }
+                                            problem,
+                                            fmt::join(params | std::views::transform(&param_value::name), ", ")));
   const std::string qualified = problem + "." + name;
   const double value = it->parse(value_text, qualified);
   if (auto why = it->check(value); !why.empty())

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ranges>
 #include <stdexcept>
 #include <vector>
 
@@ -24,9 +25,8 @@ double parse_positive(std::string_view text, std::string_view what) {
   return value;
 }
 
-std::string count_of(long long n, std::string_view singular, std::string_view plural) {
-  if (n == 1) return fmt::format("1 {}", singular);
-  return plural.empty() ? fmt::format("{} {}s", n, singular) : fmt::format("{} {}", n, plural);
+std::string count_of(long long n, std::string_view singular) {
+  return fmt::format("{} {}{}", n, singular, n == 1 ? "" : "s");
 }
 
 void add_override(parameter_overrides& out, std::string_view text, std::span<const std::string> selected) {
@@ -53,12 +53,10 @@ void add_override(parameter_overrides& out, std::string_view text, std::span<con
     throw std::invalid_argument(fmt::format("--set {}: problem {} is not selected", text, problem));
   const auto params = instance->params();
   const auto it = std::find_if(params.begin(), params.end(), [&](const param_value& q) { return q.name == name; });
-  if (it == params.end()) {
-    std::vector<std::string_view> known;
-    for (const auto& q : params) known.push_back(q.name);
+  if (it == params.end())
     throw std::invalid_argument(fmt::format("--set {}: unknown parameter '{}' for problem {} (known: {})", text, name,
-                                            problem, fmt::join(known, ", ")));
-  }
+                                            problem,
+                                            fmt::join(params | std::views::transform(&param_value::name), ", ")));
   const std::string qualified = problem + "." + name;
   const double value = it->parse(value_text, qualified);
   if (auto why = it->check(value); !why.empty())

@@ -29,8 +29,7 @@ void add_override(parameter_overrides& out, std::string_view text, std::span<con
 // Throws std::invalid_argument("--shard <text>: ...") on anything else.
 void parse_shard(std::string_view text, int& index, int& count);
 
-// A count and its noun, the plural when the count is not one: "1 step", "2 steps",
-// "1 repetition"; `plural` for the irregular ones.
-std::string count_of(long long n, std::string_view singular, std::string_view plural = {});
+// A count and its noun, the plural (an s) when the count is not one: "1 step", "2 steps".
+std::string count_of(long long n, std::string_view singular);
 
 }  // namespace stepbench

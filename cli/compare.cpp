@@ -61,12 +61,12 @@ json presence_json(const std::vector<presence>& items) {
   return out;
 }
 
-json side_json(const timing_side& s) {
-  return {{"time_ns", s.median},
-          {"time_ns_min", s.min},
-          {"time_ns_max", s.max},
+json side_json(const timing& s) {
+  return {{"time_ns", s.time_ns},
+          {"time_ns_min", s.time_ns_min},
+          {"time_ns_max", s.time_ns_max},
           {"repetitions", s.repetitions},
-          {"spread", s.spread()}};
+          {"spread", spread(s)}};
 }
 
 json comparison_json(const comparison& c) {

@@ -194,13 +194,11 @@ void print_one_loop(const loop_args& a, const problem_instance& problem, const l
 
 int run_one(const loop_args& a) {
   if (!a.out.empty()) throw std::invalid_argument("--out writes the whole loop study: leave out --design");
-  auto problem = make_problem(a.problem);
+  make_problem(a.problem);  // an unknown problem is named before an unknown method
   loop_method_info(a.method);
-  parameter_overrides overrides;
-  for (const auto& s : a.sets) add_override(overrides, s, std::vector{a.problem});
-  for (const auto& [name, value] : overrides[a.problem]) problem->set(name, value);
-  if (auto err = problem->validate(); !err.empty())
-    throw std::invalid_argument(fmt::format("problem {}: {}", a.problem, err));
+  sweep_options so;
+  for (const auto& s : a.sets) add_override(so.overrides, s, std::vector{a.problem});
+  const auto problem = configured_problem(a.problem, so);
   const loop_options opts;
   const loop_config c = one_loop_config(a, *problem, opts);
   // The stated cost of one physics step for the cost model [ns].

@@ -52,11 +52,11 @@ int run_study_merge(const merge_args& a) {
                "timings are compared only within a problem\n",
                r.machines.size(), fmt::join(parts, "; "));
   }
-  fmt::print(stderr, "merge: {} of {} from {}\n", count_of(static_cast<long long>(r.problems.size()), "problem"),
-             r.problems.size() + r.missing.size(), count_of(static_cast<long long>(r.shards), "shard"));
+  fmt::print(stderr, "merge: {} of {} from {}\n", count_of(r.problems.size(), "problem"),
+             r.problems.size() + r.missing.size(), count_of(r.shards, "shard"));
   if (!a.bench.empty())
-    fmt::print(stderr, "merge: {} of {} into {}\n", count_of(static_cast<long long>(joined.benchmarks), "benchmark"),
-               count_of(static_cast<long long>(joined.shards), "shard"), a.bench_out);
+    fmt::print(stderr, "merge: {} of {} into {}\n", count_of(joined.benchmarks, "benchmark"),
+               count_of(joined.shards, "shard"), a.bench_out);
   fmt::print(stderr, "wrote {}{}\n", a.out, a.bench.empty() ? "" : " and " + a.bench_out);
   return 0;
 }
@@ -124,7 +124,7 @@ int run_merge(const merge_args& a) {
   write_study(merged, a.out);
   for (const auto& s : scans)
     fmt::print(stderr, "merge: /scan/{}: {} of {} points from {}\n", s.options.name, s.points.size(), s.grid_points,
-               count_of(static_cast<long long>(by_name[s.options.name].size()), "shard"));
+               count_of(by_name[s.options.name].size(), "shard"));
   fmt::print(stderr, "wrote {}\n", a.out);
   return 0;
 }

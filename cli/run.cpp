@@ -13,6 +13,7 @@
 #include "core/drive.hpp"
 #include "core/measure.hpp"
 #include "registry/registry.hpp"
+#include "run/sweep.hpp"
 
 namespace stepbench {
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(work_counters, force_evals, jacobian_evals, newton_iterations, linear_solves)
@@ -66,13 +67,11 @@ std::string with_truth(const std::vector<double>& y, const std::vector<double>& 
 int run_run(const run_args& a) {
   // What `run` was asked, checked: the problem with its --set overrides, the method, its
   // dt or tolerance, and the horizon. Throws std::invalid_argument naming the problem.
-  const auto instance = make_problem(a.problem);
+  make_problem(a.problem);  // an unknown problem is named before an unknown method
   const method_info& m = find_method(a.method);
-  parameter_overrides overrides;
-  for (const auto& s : a.sets) add_override(overrides, s, std::vector{a.problem});
-  for (const auto& [name, value] : overrides[a.problem]) instance->set(name, value);
-  if (auto err = instance->validate(); !err.empty())
-    throw std::invalid_argument(fmt::format("problem {}: {}", a.problem, err));
+  sweep_options so;
+  for (const auto& s : a.sets) add_override(so.overrides, s, std::vector{a.problem});
+  const auto instance = configured_problem(a.problem, so);
   const problem_instance& problem = *instance;
   const bool fixed = m.kind == method_kind::fixed_step;
   const char *kind = fixed ? "is a fixed-step method" : "is adaptive", *given = fixed ? "--dt" : "--tol";

@@ -59,8 +59,7 @@ int run_sweep_command(sweep_args a) {
                    r.vs.pos_rel, r.vs.vel_rel, r.solution.stats.steps, r.solution.stats.rhs_evals_counted);
   }
   std::fflush(stdout);
-  fmt::print(stderr, "wrote {} ({}{}, {}) in {:.2f} s\n", a.out,
-             count_of(static_cast<long long>(s.problems.size()), "problem"),
+  fmt::print(stderr, "wrote {} ({}{}, {}) in {:.2f} s\n", a.out, count_of(s.problems.size(), "problem"),
              a.opts.shard_count > 1 ? fmt::format(": shard {} of {}", a.opts.shard_index + 1, a.opts.shard_count) : "",
              count_of(a.opts.levels, "level"), s.wall_seconds);
   return report_study_outcome(s, "stepbench", a.strict);

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <ranges>
 #include <set>
 #include <stdexcept>
 
@@ -18,13 +19,11 @@ advice advise(const study& study, const std::string& problem, const std::string&
     throw std::invalid_argument(fmt::format("unknown metric '{}' (known: {})", metric, fmt::join(error_metrics, ", ")));
   if (!(tol > 0.0) || !std::isfinite(tol)) throw std::invalid_argument(fmt::format("--tol must be > 0, got {}", tol));
   const problem_study* p = study.find(problem);
-  if (!p) {
-    std::vector<std::string> names;
-    for (const auto& q : study.problems) names.push_back(q.name);
+  const auto names = study.problems | std::views::transform(&problem_study::name);
+  if (!p)
     throw std::invalid_argument(fmt::format("problem '{}' is not in the study file '{}' (it has: {})", problem,
                                             study.record ? study.record->path : "",
                                             names.empty() ? "none" : fmt::format("{}", fmt::join(names, ", "))));
-  }
   advice a;
   a.problem = problem;
   a.metric = metric;
@@ -48,12 +47,10 @@ frame_advice advise_frame(const study& s, const std::string& problem, double hz,
         "again)",
         path));
   const auto fs = std::find_if(studies.begin(), studies.end(), [&](const auto& f) { return f.problem == problem; });
-  if (fs == studies.end()) {
-    std::vector<std::string> names;
-    for (const auto& f : studies) names.push_back(f.problem);
+  if (fs == studies.end())
     throw std::invalid_argument(
-        fmt::format("problem '{}' has no frame-rate runs in '{}' (it has: {})", problem, path, fmt::join(names, ", ")));
-  }
+        fmt::format("problem '{}' has no frame-rate runs in '{}' (it has: {})", problem, path,
+                    fmt::join(studies | std::views::transform(&frame_rate_study::problem), ", ")));
   frame_advice f;
   f.problem = problem;
   f.hz = hz;

@@ -38,24 +38,19 @@ struct method_pair {
   std::vector<std::pair<std::size_t, std::size_t>> rows;  // (base row, new row) with equal param
 };
 
-change problem_change(change_kind k, const problem_study& p, std::string what, compare_value old_value,
-                      compare_value new_value, double ratio = nan, std::string note = {}) {
-  return {k, p.name, "", "", nan, std::move(what), std::move(old_value), std::move(new_value), ratio, std::move(note)};
+// A finding not about one row (`method` empty for the problem itself).
+change finding(change_kind k, std::string problem, std::string method, std::string what, compare_value old_value,
+               compare_value new_value, double ratio = nan, std::string note = {}) {
+  return {k, std::move(problem), std::move(method), "", nan, std::move(what), old_value, new_value, ratio, note};
 }
 
+// A finding about a row of NEW (`new_row`, its index).
 change row_change(change_kind k, const method_pair& mp, std::size_t new_row, std::string what, double old_value,
-                  double new_value) {
-  const method_row& r = mp.next.rows[new_row];
-  return {k,
-          mp.next_problem.name,
-          mp.next.info.name,
-          std::string(param_name(mp.next.info.kind)),
-          r.param,
-          std::move(what),
-          old_value,
-          new_value,
-          new_value / old_value,
-          r.metrics.note};
+                  double new_value, double ratio, std::string note) {
+  change c = finding(k, mp.next_problem.name, mp.next.info.name, std::move(what), old_value, new_value, ratio, note);
+  c.param_name = param_name(mp.next.info.kind);
+  c.param = mp.next.rows[new_row].param;
+  return c;
 }
 
 // Pairs the items of two lists by key: `both(b, n)` for each item of BASE that NEW has
@@ -79,10 +74,10 @@ void pair_up(const std::vector<T>& base, const std::vector<T>& next, Key key, Bo
 void check_truth(const problem_pair& pp, comparison& out) {
   const truth_table &base = pp.base.truth, &next = pp.next.truth;
   if (base.source != next.source)
-    out.changes.push_back(problem_change(change_kind::regression, pp.next, "truth_source", base.source, next.source));
+    out.changes.push_back(finding(change_kind::regression, pp.next.name, "", "truth_source", base.source, next.source));
   if (base.trusted != next.trusted)
-    out.changes.push_back(problem_change(next.trusted ? change_kind::improvement : change_kind::regression, pp.next,
-                                         "truth_trusted", base.trusted ? 1.0 : 0.0, next.trusted ? 1.0 : 0.0));
+    out.changes.push_back(finding(next.trusted ? change_kind::improvement : change_kind::regression, pp.next.name, "",
+                                  "truth_trusted", base.trusted ? 1.0 : 0.0, next.trusted ? 1.0 : 0.0));
 }
 
 // The references: status (ok, failed, disagrees) and agreement with what they are compared with.
@@ -90,15 +85,14 @@ void check_references(const problem_pair& pp, comparison& out) {
   const auto both = [&](const reference_check& r, const reference_check& n) {
     const bool was_ok = r.status == "ok", is_ok = n.status == "ok";
     if (was_ok != is_ok)
-      out.changes.push_back(problem_change(is_ok ? change_kind::improvement : change_kind::regression, pp.next,
-                                           fmt::format("reference {} status", r.source), r.status, n.status, nan,
-                                           n.reason));
+      out.changes.push_back(finding(is_ok ? change_kind::improvement : change_kind::regression, pp.next.name, "",
+                                    fmt::format("reference {} status", r.source), r.status, n.status, nan, n.reason));
     if (r.compared_with != n.compared_with) return;  // agreements with different things do not compare
     for (const auto& [field, old_rel, new_rel] :
          {std::tuple{"err_pos_rel", r.vs.pos_rel, n.vs.pos_rel}, std::tuple{"err_vel_rel", r.vs.vel_rel, n.vs.vel_rel}})
       if (const auto k = judge_agreement(old_rel, new_rel, pp.opts.error_factor))
-        out.changes.push_back(problem_change(*k, pp.next, fmt::format("reference {} {}", r.source, field), old_rel,
-                                             new_rel, new_rel / old_rel, fmt::format("vs {}", n.compared_with)));
+        out.changes.push_back(finding(*k, pp.next.name, "", fmt::format("reference {} {}", r.source, field), old_rel,
+                                      new_rel, new_rel / old_rel, fmt::format("vs {}", n.compared_with)));
   };
   pair_up(
       pp.base.truth.references, pp.next.truth.references, [](const reference_check& r) { return r.source; }, both,
@@ -159,8 +153,7 @@ void check_order(const method_pair& mp, comparison& out) {
   };
   const auto add = [&](change_kind k, std::string what, compare_value old_value, compare_value new_value,
                        double ratio) {
-    out.changes.push_back({k, mp.next_problem.name, mp.next.info.name, "", nan, std::move(what), std::move(old_value),
-                           std::move(new_value), ratio, ""});
+    out.changes.push_back(finding(k, mp.next_problem.name, mp.next.info.name, what, old_value, new_value, ratio));
   };
   if (was && is) {
     if (!same_ladder && fitted_params(mp.base) != fitted_params(mp.next)) return;
@@ -188,22 +181,16 @@ void check_rows(const method_pair& mp, comparison& out) {
     for (const auto& [flag, member] : row_flags) {
       const double old_flag = old_row.*member, new_flag = new_row.*member;
       completed = completed && old_flag == 0 && new_flag == 0;
-      if ((old_flag != 0) != (new_flag != 0)) {
-        auto c = row_change(new_flag != 0 ? change_kind::regression : change_kind::improvement, mp, j, flag, old_flag,
-                            new_flag);
-        c.ratio = nan;  // a flag: 0 -> 1 has no ratio
-        out.changes.push_back(std::move(c));
-      }
+      if ((old_flag != 0) != (new_flag != 0))  // a flag: 0 -> 1 has no ratio
+        out.changes.push_back(row_change(new_flag != 0 ? change_kind::regression : change_kind::improvement, mp, j,
+                                         flag, old_flag, new_flag, nan, new_row.note));
     }
     if (!completed) continue;  // errors of completed runs only
     for (const char* metric : error_metrics) {
       const double old_err = metric_value(old_row, metric), new_err = metric_value(new_row, metric);
       const double floor = std::string_view(metric) == "err_vel_final" ? vel_floor : pos_floor;
-      if (const auto k = judge_error(old_err, new_err, floor, mp.opts.error_factor)) {
-        auto c = row_change(*k, mp, j, metric, old_err, new_err);
-        c.note.clear();
-        out.changes.push_back(std::move(c));
-      }
+      if (const auto k = judge_error(old_err, new_err, floor, mp.opts.error_factor))
+        out.changes.push_back(row_change(*k, mp, j, metric, old_err, new_err, new_err / old_err, ""));
     }
   }
 }
@@ -213,13 +200,11 @@ void collect_timing(const method_pair& mp, comparison& out) {
   const auto timed = [](const timing& t) {
     return std::isfinite(t.time_ns) && t.time_ns > 0 && t.repetitions >= 1 && !t.cut;
   };
-  const auto side = [](const timing& t) { return timing_side{t.time_ns, t.time_ns_min, t.time_ns_max, t.repetitions}; };
   if (!out.timing_compared) return;
   for (const auto& [i, j] : mp.rows) {
-    const timing &old_time = mp.base.rows[i].time, &new_time = mp.next.rows[j].time;
-    if (!timed(old_time) || !timed(new_time)) continue;
-    const timing_side o = side(old_time), n = side(new_time);
-    const double ratio = n.median / o.median, threshold = timing_threshold(o, n);
+    const timing &o = mp.base.rows[i].time, &n = mp.next.rows[j].time;
+    if (!timed(o) || !timed(n)) continue;
+    const double ratio = n.time_ns / o.time_ns, threshold = timing_threshold(o, n);
     out.timing.push_back({mp.next_problem.name, mp.next.info.name, std::string(param_name(mp.next.info.kind)),
                           mp.next.rows[j].param, o, n, ratio, threshold, judge_timing(ratio, threshold)});
   }
@@ -324,7 +309,7 @@ void problem_differences(const problem_study& base, const problem_study& next, c
 
 // ---------------------------------------------------------------------------------------
 
-double timing_side::spread() const { return repetitions >= 2 ? (max - min) / median : nan; }
+double spread(const timing& t) { return t.repetitions >= 2 ? (t.time_ns_max - t.time_ns_min) / t.time_ns : nan; }
 
 std::optional<change_kind> judge_error(double old_err, double new_err, double floor, double factor) {
   if (std::isnan(old_err) && std::isnan(new_err)) return std::nullopt;
@@ -347,11 +332,11 @@ std::optional<change_kind> judge_order(double old_order, double new_order, doubl
   return std::nullopt;
 }
 
-double timing_threshold(const timing_side& old_time, const timing_side& new_time) {
+double timing_threshold(const timing& old_time, const timing& new_time) {
   const bool both_spread = old_time.repetitions >= 2 && new_time.repetitions >= 2;
   double t = both_spread ? timing_noise_floor : timing_single_run_floor;
   for (const auto& s : {old_time, new_time})
-    if (std::isfinite(s.spread())) t = std::max(t, timing_spread_multiple * s.spread());
+    if (std::isfinite(spread(s))) t = std::max(t, timing_spread_multiple * spread(s));
   return t;
 }
 
@@ -428,13 +413,13 @@ void check_stability(const study& base_study, const study& next_study, compariso
     if (it == next.end()) {
       if (!next.empty()) out.removed.push_back({"stability", b.integrator, "limit " + test, "in BASE only"});
     } else if (flags(b) != flags(*it)) {
-      out.changes.push_back({change_kind::regression, "stability", b.integrator, "", nan, test + " stability", flags(b),
-                             flags(*it), nan, ""});
+      out.changes.push_back(
+          finding(change_kind::regression, "stability", b.integrator, test + " stability", flags(b), flags(*it)));
     } else if (std::isfinite(b.theory) && std::isfinite(it->theory) &&
                std::abs(it->theory / b.theory - 1.0) > stability_tolerance) {
-      out.changes.push_back({change_kind::regression, "stability", b.integrator, "", nan,
-                             test + " stability limit (y = w dt or lambda dt)", b.theory, it->theory,
-                             it->theory / b.theory, ""});
+      out.changes.push_back(finding(change_kind::regression, "stability", b.integrator,
+                                    test + " stability limit (y = w dt or lambda dt)", b.theory, it->theory,
+                                    it->theory / b.theory));
     }
   }
 }

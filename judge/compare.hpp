@@ -85,19 +85,14 @@ struct difference {
   std::string old_value, new_value;
 };
 
+// A row's (time_ns_max - time_ns_min) / time_ns; NaN with fewer than two repetitions (no
+// spread to measure).
+double spread(const timing& t);
 // One row timed in both files.
-struct timing_side {
-  double median = std::numeric_limits<double>::quiet_NaN();
-  double min = std::numeric_limits<double>::quiet_NaN();
-  double max = std::numeric_limits<double>::quiet_NaN();
-  long repetitions = 0;
-  // (max - min) / median; NaN with fewer than two repetitions (no spread to measure).
-  double spread() const;
-};
 struct timing_row {
   std::string problem, method, param_name;
   double param = 0.0;
-  timing_side old_time, new_time;
+  timing old_time, new_time;
   double ratio = 0.0;      // new median / old median
   double threshold = 0.0;  // timing_threshold(old, new)
   int flag = 0;            // +1 slower beyond the threshold, -1 faster, 0 within the noise
@@ -144,7 +139,7 @@ std::optional<change_kind> judge_error(double old_err, double new_err, double fl
 std::optional<change_kind> judge_agreement(double old_rel, double new_rel, double factor);
 std::optional<change_kind> judge_order(double old_order, double new_order, double drop);
 // The noise threshold of a row timed in both files, and its flag (+1, -1, 0).
-double timing_threshold(const timing_side& old_time, const timing_side& new_time);
+double timing_threshold(const timing& old_time, const timing& new_time);
 int judge_timing(double ratio, double threshold);
 
 }  // namespace stepbench

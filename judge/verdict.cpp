@@ -196,11 +196,6 @@ bool is_first_order_pair(const substep_verdict& sv) {
          em->declared_order == 1.0 && em->traits.symplectic && !em->traits.needs_jacobian;
 }
 
-bool judges_ladder_as_substeps(std::string_view method) {
-  const method_info* m = registered_method(method);
-  return m && m->traits.small_steps;
-}
-
 finding_inputs finding_inputs_of(const study& s) {
   finding_inputs in;
   for (const auto& st : s.results.get<std::vector<substep_study>>())

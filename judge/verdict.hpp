@@ -2,7 +2,6 @@
 // The verdict (study/verdict.hpp says what it answers), judged from the study as it holds
 // it, and the findings generated from it and the other parts' results.
 #include <string>
-#include <string_view>
 #include <vector>
 
 #include "study/study.hpp"
@@ -19,8 +18,6 @@ finding_inputs finding_inputs_of(const study& s);
 // order, not symplectic) against symplectic Euler (explicit, first order), picked by
 // their registry entries' order and capabilities, not their names.
 bool is_first_order_pair(const substep_verdict& sv);
-// A method whose dt ladder the findings judge as substeps (capabilities::small_steps).
-bool judges_ladder_as_substeps(std::string_view method);
 std::vector<std::string> findings_of(const verdict_tables& v, const finding_inputs& in);
 
 // The cost of a frame of a frame-rate run: the benchmark's median ns per step of its

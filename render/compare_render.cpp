@@ -56,10 +56,10 @@ table differences_table(const comparison& c) {
   return t;
 }
 
-std::string side_text(const timing_side& s) {
-  return s.repetitions >= 2 ? fmt::format("{} ({}..{}, {} reps)", format_time_ns(s.median), format_time_ns(s.min),
-                                          format_time_ns(s.max), s.repetitions)
-                            : fmt::format("{} (1 rep)", format_time_ns(s.median));
+std::string side_text(const timing& s) {
+  return s.repetitions >= 2 ? fmt::format("{} ({}..{}, {} reps)", format_time_ns(s.time_ns),
+                                          format_time_ns(s.time_ns_min), format_time_ns(s.time_ns_max), s.repetitions)
+                            : fmt::format("{} (1 rep)", format_time_ns(s.time_ns));
 }
 
 table timing_flagged_table(const comparison& c) {

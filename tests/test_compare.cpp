@@ -140,12 +140,12 @@ TEST(compare_decisions, order_and_agreement) {
 }
 
 TEST(compare_decisions, timing_threshold_from_the_repetitions) {
-  const timing_side tight{1000, 990, 1010, 5}, loose{1000, 900, 1100, 5}, single{1000, 1000, 1000, 1};
+  const timing tight{1000, 990, 1010, 5}, loose{1000, 900, 1100, 5}, single{1000, 1000, 1000, 1};
   EXPECT_DOUBLE_EQ(timing_threshold(tight, tight), 0.15);    // the floor (3 x 2 % is below it)
   EXPECT_DOUBLE_EQ(timing_threshold(tight, loose), 0.6);     // 3 x the larger spread, 20 %
   EXPECT_DOUBLE_EQ(timing_threshold(single, single), 0.25);  // no spread: the fallback
   EXPECT_DOUBLE_EQ(timing_threshold(single, loose), 0.6);    // the other side's spread still counts
-  EXPECT_TRUE(std::isnan(single.spread()));
+  EXPECT_TRUE(std::isnan(spread(single)));
   EXPECT_DOUBLE_EQ(timing_threshold({1000, 900, 1080, 3}, tight), 0.54);  // spread 18 %
   EXPECT_EQ(judge_timing(2.0, 0.6), 1);
   EXPECT_EQ(judge_timing(1.5, 0.6), 0);

@@ -15,6 +15,7 @@
 #include "default_study.hpp"
 #include "judge/verdict.hpp"
 #include "parts/study.hpp"
+#include "registry/registry.hpp"
 #include "run/sweep.hpp"
 #include "study/verdict.hpp"
 
@@ -530,6 +531,11 @@ TEST(sweep, findings_pick_their_methods_by_capability) {
     sv.implicit_method = std::move(implicit);
     sv.explicit_method = std::move(explicit_);
     return is_first_order_pair(sv);
+  };
+  // A method whose dt ladder the findings judge as substeps (capabilities::small_steps).
+  const auto judges_ladder_as_substeps = [](std::string_view method) {
+    const method_info* m = registered_method(method);
+    return m && m->traits.small_steps;
   };
   EXPECT_TRUE(pair("implicit_euler", "semi_implicit_euler"));
   EXPECT_FALSE(pair("implicit_midpoint", "semi_implicit_euler"));  // second order

@@ -118,14 +118,7 @@ struct dop853 {
         k.template compute<13, 16, false>(*sys_last, t_last, x0, v0, h_last, h_im_last);
         dense_ready = true;
       }
-      const std::array<double, 16> w = dop853_dense_weights(theta);
-      x = x0;
-      v = v0;
-      for (int i = 0; i < 16; ++i) {
-        if (w[i] == 0.0) continue;
-        x += (h_last * w[i]) * k.V[i];
-        v += (h_im_last * w[i]) * k.F[i];
-      }
+      k.combine(dop853_dense_weights(theta), h_last, h_im_last, x0, v0, x, v);
     }
   };
 };

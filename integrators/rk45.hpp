@@ -5,11 +5,12 @@
 // error estimate; the PI step-size controller of dopri5.f (beta = 0.04; HNW I sec. IV.2,
 // integrators/step_control.hpp); and Shampine's quartic dense output, so that the
 // sample times are interpolated inside the steps instead of shortening them. The
-// coefficients are integrators/tableaus.hpp's, proved in tests/test_tableaus.cpp.
+// coefficients are integrators/tableaus.hpp's, proved in tests/test_tableaus.cpp; the
+// stages are integrators/unrolled_rk.hpp's in the velocity form, whatever the force.
 #include "core/concepts.hpp"
-#include "integrators/explicit_rk.hpp"
 #include "integrators/step_control.hpp"
 #include "integrators/tableaus.hpp"
+#include "integrators/unrolled_rk.hpp"
 
 namespace stepbench {
 
@@ -19,8 +20,12 @@ struct rk45 {
   static constexpr int order = 5;
   static constexpr capabilities traits{.reuses_last_force = true, .error_estimate = true, .dense_output = true};
   static constexpr int force_evals_per_step = 6;
-  static constexpr auto& tableau = dopri5_tableau;
-  static constexpr std::array<double, 7> error_weights = stepbench::error_weights(dopri5_tableau);
+  // b - b_hat: the weights of the embedded error estimate.
+  static constexpr std::array<double, 7> error_weights = [] {
+    std::array<double, 7> e{};
+    for (int i = 0; i < 7; ++i) e[i] = dopri5_tableau.b[i] - dopri5_tableau.b_hat[i];
+    return e;
+  }();
   double tol = 1e-6;
   explicit rk45(double tolerance) : tol(tolerance) {}
 
@@ -29,7 +34,7 @@ struct rk45 {
     using Vec = typename Sys::vec;
     double tol;
     step_controller control{.error_order = 4, .beta = 0.04};
-    rk_stages<7, Sys> k;
+    unrolled_rk<dopri5_tableau, Sys, false> k;
     Vec ex, ev, x0, v0;  // error estimate; start of the last accepted step (dense output)
     double h_last = 0.0, h_im_last = 0.0;
     explicit stepper(const rk45& m) : tol(m.tol) {}
@@ -44,9 +49,10 @@ struct rk45 {
 
     step_attempt try_step(const Sys& sys, double t, step_state<Vec>& s, double h) {
       const double h_im = h * inverse_mass(sys);
-      k.compute(tableau, sys, t, s.x, s.v, current_force(sys, t, s), h);
+      k.F[0] = current_force(sys, t, s);
+      k.template compute<1, 7>(sys, t, s.x, s.v, h, h_im);
       // The last stage is f(t + h, y1): y1 = (k.X, k.V[6]), its force k.F[6].
-      k.weighted(error_weights, h, h_im, ex, ev);
+      k.template difference<error_weights>(ex, ev, s.v, h, h_im);
       const double err = scaled_rms(ex, ev, s.x, s.v, k.X, k.V[6], tol);
       return control.attempt(h, err, [&] {
         x0 = s.x;

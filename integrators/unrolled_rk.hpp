@@ -1,8 +1,9 @@
 #pragma once
 // The stages of an explicit Runge-Kutta method with its Butcher tableau as compile-time
-// constants, for the high-order methods (rk8, dop853). Not a method itself. The same
-// stages as integrators/explicit_rk.hpp's generic engine (tests/test_high_order.cpp
-// checks that they agree to rounding), scheduled for latency as rk4 is:
+// constants, for the tableau methods (rk45, rk8, dop853). Not a method itself. The same
+// stages as the generic engine of the tests (tests/generic_rk.hpp, fed the tableau at run
+// time; tests/test_high_order.cpp checks that they agree to rounding), scheduled for
+// latency as rk4 is:
 //  - every sum is unrolled at compile time and zero coefficients drop out;
 //  - 1 / m is folded into the coefficients, V_i = v0 + sum_j (h a_ij / m) F_j;
 //  - each sum adds its newest term last, so one multiply-add follows the force (or
@@ -137,13 +138,13 @@ struct rk_weights {
   static constexpr double total = rk_detail::sum<S>(W);
 };
 
-template <const auto& T, class Sys>
+// Nystrom: the Nystrom form, no stage velocities (by default for a position-only force).
+template <const auto& T, class Sys, bool Nystrom = !Sys::force_depends_on_velocity>
 struct unrolled_rk {
   using Vec = typename Sys::vec;
   using tables = rk_tables<T>;
   static constexpr int S = tables::S;
-  // Position-only force: the Nystrom form, no stage velocities.
-  static constexpr bool nystrom = !Sys::force_depends_on_velocity;
+  static constexpr bool nystrom = Nystrom;
 
   std::array<Vec, S> V, F;  // stage velocities (not formed in the Nystrom form) and forces
   Vec X;                    // position of the stage being formed
@@ -156,26 +157,26 @@ struct unrolled_rk {
 
   // Stages First..Last-1 from (x0, v0) at t with step h (h_im = h / m). F[0] must be set;
   // from First = 1 the velocity form sets V[0] = v0, otherwise every stage before First
-  // must be complete. Nystrom selects the form (default: by the force).
-  template <int First, int Last, bool Nystrom = nystrom>
+  // must be complete. Form selects the form (default: the stepper's).
+  template <int First, int Last, bool Form = nystrom>
   [[gnu::always_inline]] inline void compute(const Sys& sys, double t, const Vec& x0, const Vec& v0, double h,
                                              double h_im) {
     const double hh_im = h * h_im;
-    if constexpr (!Nystrom && First == 1) V[0] = v0;
-    stages<First, Nystrom>(sys, t, x0, v0, h, h_im, hh_im, std::make_integer_sequence<int, Last - First>{});
+    if constexpr (!Form && First == 1) V[0] = v0;
+    stages<First, Form>(sys, t, x0, v0, h, h_im, hh_im, std::make_integer_sequence<int, Last - First>{});
   }
 
-  template <int First, bool Nystrom, int... I>
+  template <int First, bool Form, int... I>
   [[gnu::always_inline]] inline void stages(const Sys& sys, double t, const Vec& x0, const Vec& v0, double h,
                                             double h_im, double hh_im, std::integer_sequence<int, I...>) {
-    (stage<First + I, Nystrom>(sys, t, x0, v0, h, h_im, hh_im), ...);
+    (stage<First + I, Form>(sys, t, x0, v0, h, h_im, hh_im), ...);
   }
 
-  template <int I, bool Nystrom>
+  template <int I, bool Form>
   [[gnu::always_inline]] inline void stage(const Sys& sys, double t, const Vec& x0, const Vec& v0, double h,
                                            double h_im, double hh_im) {
     using R = tables;
-    if constexpr (Nystrom) {
+    if constexpr (Form) {
       rk_detail::assign_sum<R::template a2_row<I>>(X, x0 + (R::template row_sum<I> * h) * v0, hh_im, F);
       sys.force(t + T.c[I] * h, X, v0, F[I]);  // v is not read by a position-only force
     } else {
@@ -195,6 +196,19 @@ struct unrolled_rk {
     else
       rk_detail::assign_sum<w::row>(x, x0, h, V);
     rk_detail::assign_sum<w::row>(v, v0, h_im, F);
+  }
+
+  // The same for weights known at run time (dense output), every stage velocity formed:
+  // x = x0 + h sum_i w_i V_i, v = v0 + (h/m) sum_i w_i F_i.
+  void combine(const std::array<double, S>& w, double h, double h_im, const Vec& x0, const Vec& v0, Vec& x,
+               Vec& v) const {
+    x = x0;
+    v = v0;
+    for (int i = 0; i < S; ++i) {
+      if (w[i] == 0.0) continue;
+      x += (h * w[i]) * V[i];
+      v += (h_im * w[i]) * F[i];
+    }
   }
 
   // The same sums without the starting state, for weights that sum to zero (an error

@@ -10,8 +10,8 @@
 #include <limits>
 
 #include "core/drive.hpp"
+#include "generic_rk.hpp"
 #include "integrators/all.hpp"
-#include "integrators/explicit_rk.hpp"
 #include "integrators/tableaus.hpp"
 #include "parts/study.hpp"
 #include "problems/damped_spring.hpp"
@@ -26,7 +26,7 @@ namespace {
 
 constexpr double eps = std::numeric_limits<double>::epsilon();
 
-// The generic stages (integrators/explicit_rk.hpp) of DOP853 from a state: the
+// The generic stages (tests/generic_rk.hpp) of DOP853 from a state: the
 // reference the unrolled ones are checked against.
 template <class P>
 struct generic_step {

@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "core/drive.hpp"
+#include "generic_rk.hpp"
 #include "integrators/all.hpp"
-#include "integrators/explicit_rk.hpp"
 #include "integrators/tableaus.hpp"
 #include "problems/constant_acceleration.hpp"
 #include "problems/damped_spring.hpp"
@@ -124,7 +124,7 @@ TEST(drive, non_finite_state_stops_the_run) {
 
 // The hand-scheduled steps of midpoint and rk4 (written for latency: 1/m folded into the
 // coefficients, partial sums formed early) are the methods their Butcher tableaux define:
-// one step of each equals the generic tableau step (integrators/explicit_rk.hpp on
+// one step of each equals the generic tableau step (tests/generic_rk.hpp on
 // integrators/tableaus.hpp) to rounding, on a nonlinear and a damped problem.
 TEST(integrators, hand_scheduled_steps_equal_their_tableaux) {
   auto check = [](const auto& problem, auto method, const auto& tableau, const char* name) {

@@ -5,26 +5,26 @@
 // velocity V_i and the stage force F_i, with 1 / m folded into the coefficients.
 //   X_i = x0 + h sum_{j<i} a_ij V_j,  V_i = v0 + (h/m) sum_{j<i} a_ij F_j,
 //   F_i = F(t + c_i h, X_i, V_i).
-// Not a method itself: rk45 uses it, and tests check that the hand-scheduled steps of
-// midpoint and rk4 equal the generic step on their tableaux to rounding.
+// The tests' reference: the hand-scheduled steps of midpoint and rk4 and the unrolled
+// stages of integrators/unrolled_rk.hpp (rk45, rk8, dop853) equal it to rounding.
 #include <array>
 
 #include "core/concepts.hpp"
 #include "integrators/tableau.hpp"
+#include "integrators/unrolled_rk.hpp"
 
 namespace stepbench {
 
-template <int S, class Sys>
-struct rk_stages {
-  using Vec = typename Sys::vec;
-  std::array<Vec, S> V, F;  // stage velocities and forces
-  Vec X;                    // position of the stage being formed
+// A tableau of S stages to lend unrolled_rk's storage (V, F, X, resize) and its combine
+// with weights given at run time; its own stages are not used.
+template <int S>
+inline constexpr explicit_tableau<S> no_tableau{};
 
-  void resize(const Vec& like) {
-    for (auto& v : V) size_like(like, v);
-    for (auto& f : F) size_like(like, f);
-    size_like(like, X);
-  }
+template <int S, class Sys>
+struct rk_stages : unrolled_rk<no_tableau<S>, Sys, false> {
+  using Vec = typename Sys::vec;
+  using base = unrolled_rk<no_tableau<S>, Sys, false>;
+  using base::V, base::F, base::X;
 
   // Stage 0 from (v0, f0), then stages 1..S-1. After the call X and V[S-1] hold the
   // last stage's state (for a first-same-as-last method, the new state).
@@ -44,32 +44,6 @@ struct rk_stages {
       sys.force(t + tab.c[i] * h, X, V[i], F[i]);
     }
   }
-
-  // x = x0 + h sum_i w_i V_i,  v = v0 + (h/m) sum_i w_i F_i.
-  void combine(const std::array<double, S>& w, double h, double h_im, const Vec& x0, const Vec& v0, Vec& x,
-               Vec& v) const {
-    x = x0;
-    v = v0;
-    for (int i = 0; i < S; ++i) {
-      if (w[i] == 0.0) continue;
-      x += (h * w[i]) * V[i];
-      v += (h_im * w[i]) * F[i];
-    }
-  }
-  // The same sums without the starting state: h sum_i w_i k_i (an error estimate).
-  void weighted(const std::array<double, S>& w, double h, double h_im, Vec& x, Vec& v) const {
-    x.setZero();
-    v.setZero();
-    combine(w, h, h_im, x, v, x, v);
-  }
 };
-
-// b - b_hat: the weights of the embedded error estimate.
-template <int S>
-constexpr std::array<double, S> error_weights(const explicit_tableau<S>& t) {
-  std::array<double, S> e{};
-  for (int i = 0; i < S; ++i) e[i] = t.b[i] - t.b_hat[i];
-  return e;
-}
 
 }  // namespace stepbench

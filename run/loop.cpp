@@ -6,19 +6,15 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <span>
 #include <stdexcept>
 
 #include "core/contains.hpp"
+#include "core/measure.hpp"
 #include "core/number.hpp"
 
 namespace stepbench {
 namespace {
-
-double distance(const double* a, const double* b, int dim) {
-  double s = 0.0;
-  for (int i = 0; i < dim; ++i) s += (a[i] - b[i]) * (a[i] - b[i]);
-  return std::sqrt(s);
-}
 
 // The study's clocks for a run of `horizon`: constant at each display rate, jittered,
 // and the stall with the clamp and without it. The clamp is on everywhere else (it
@@ -152,8 +148,8 @@ loop_row measure_loop(const loop_config& config, std::string clock, const loop_r
   // Frame-rate independence: the state at the horizon against the reference clock's.
   row.clock_dependence = row.physics_clock_dependence = nan;
   if (reference && !run.non_finite && !reference->non_finite) {
-    row.clock_dependence = distance(run.final_shown.data(), reference->final_shown.data(), dim);
-    row.physics_clock_dependence = distance(run.final_physics.data(), reference->final_physics.data(), dim);
+    row.clock_dependence = norm(run.final_shown, 0, dim, reference->final_shown);
+    row.physics_clock_dependence = norm(run.final_physics, 0, dim, reference->final_physics);
   }
 
   auto no_errors = [&](std::string note) {
@@ -172,9 +168,9 @@ loop_row measure_loop(const loop_config& config, std::string clock, const loop_r
   // Shown error, and the lag that best explains it: shown(t) = exact(t - tau).
   double sum_sq = 0.0, lag_num = 0.0, lag_den = 0.0;
   for (std::size_t j = 0; j < counted; ++j) {
-    const double* shown = run.shown.data() + j * dim;
-    const double* exact = truth.y[j].data();
-    const double e = distance(shown, exact, dim);
+    const auto shown = std::span(run.shown).subspan(j * dim);
+    const auto& exact = truth.y[j];
+    const double e = norm(shown, 0, dim, exact);
     row.shown_err_max = std::max(row.shown_err_max, e);
     sum_sq += e * e;
     for (int i = 0; i < dim; ++i) {
@@ -183,7 +179,7 @@ loop_row measure_loop(const loop_config& config, std::string clock, const loop_r
     }
   }
   row.shown_err_rms = counted ? std::sqrt(sum_sq / static_cast<double>(counted)) : nan;
-  row.final_shown_err = frames ? distance(run.shown.data() + (frames - 1) * dim, truth.y.back().data(), dim) : nan;
+  row.final_shown_err = frames ? norm(std::span(run.shown).subspan((frames - 1) * dim), 0, dim, truth.y.back()) : nan;
   row.lag_s = lag_den > 0.0 ? -lag_num / lag_den : nan;
 
   row.judder = judder(run, truth, counted);

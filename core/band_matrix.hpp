@@ -46,7 +46,6 @@ class band_matrix {
   Eigen::Index cols() const { return n_; }
   Eigen::Index kl() const { return kl_; }  // sub-diagonals
   Eigen::Index ku() const { return ku_; }  // super-diagonals
-  Eigen::Index leading_dimension() const { return ld_; }
   bool same_shape(const band_matrix& o) const { return n_ == o.n_ && kl_ == o.kl_ && ku_ == o.ku_; }
 
   bool in_band(Eigen::Index i, Eigen::Index j) const {
@@ -57,11 +56,6 @@ class band_matrix {
 
   double& operator()(Eigen::Index i, Eigen::Index j) { return ab_[at(i, j)]; }
   double operator()(Eigen::Index i, Eigen::Index j) const { return ab_[at(i, j)]; }
-
-  // A += s I.
-  void add_identity(double s) {
-    for (Eigen::Index j = 0; j < n_; ++j) ab_[static_cast<std::size_t>(j * ld_ + kl_ + ku_)] += s;
-  }
 
   // A = c0 I + c1 B1 + c2 B2, all three of one shape (B1 or B2 may be *this): the
   // Newton matrix M - h dF/dv - h^2 dF/dx of an implicit step with scalar mass M.
@@ -77,22 +71,6 @@ class band_matrix {
       const double* p2 = b2.ab_.data() + first;
       for (Eigen::Index r = 0; r < band_rows; ++r) a[r] = c1 * p1[r] + c2 * p2[r];
       a[ku_] += c0;  // the diagonal: row kl + ku of the column
-    }
-  }
-
-  // y = A x. Column by column, so each column's band is read contiguously.
-  void multiply(Eigen::Ref<const Eigen::VectorXd> x, Eigen::Ref<Eigen::VectorXd> y) const {
-    if (x.size() != n_ || y.size() != n_)
-      throw std::invalid_argument("band_matrix::multiply: vector size differs from n");
-    if (n_ > 0 && x.data() < y.data() + n_ && y.data() < x.data() + n_)
-      throw std::invalid_argument("band_matrix::multiply: x and y overlap");
-    y.setZero();
-    const Eigen::Index kv = kl_ + ku_;
-    for (Eigen::Index j = 0; j < n_; ++j) {
-      const double* col = ab_.data() + j * ld_ + kv - j;  // col[i] = A(i, j) for i in the band
-      const double xj = x[j];
-      const Eigen::Index i_end = std::min(n_, j + kl_ + 1);
-      for (Eigen::Index i = std::max<Eigen::Index>(0, j - ku_); i < i_end; ++i) y[i] += col[i] * xj;
     }
   }
 
@@ -151,9 +129,6 @@ class band_lu {
   Eigen::Index zero_pivot() const { return zero_pivot_; }
   // Row interchanges: at step j, row j was swapped with row pivots()[j] (>= j).
   std::span<const Eigen::Index> pivots() const { return ipiv_; }
-  Eigen::Index rows() const { return lu_.rows(); }
-  Eigen::Index kl() const { return lu_.kl(); }
-  Eigen::Index ku() const { return lu_.ku(); }
 
  private:
   band_matrix lu_;  // the factors, in the layout of A

@@ -33,10 +33,10 @@ fit_result fit_order(const fit_input& in) {
   // under it too. Such errors fall as dt does and stand clearly above typical round-off
   // noise; an exact method's errors are noise (they may fall too, from 1e-17 relative
   // upwards, as the rounding of O(dt) terms shrinks).
+  auto slope = [&](int k) { return std::log(in.error[k] / in.error[k + 1]) / std::log(in.dt[k] / in.dt[k + 1]); };
   std::vector<double> local;
   for (int k = 0; k + 1 < n; ++k)
-    if (in.error[k] > 0.0 && in.error[k + 1] > 0.0)
-      local.push_back(std::log(in.error[k] / in.error[k + 1]) / std::log(in.dt[k] / in.dt[k + 1]));
+    if (in.error[k] > 0.0 && in.error[k + 1] > 0.0) local.push_back(slope(k));
   const bool converging =
       !local.empty() && median(local) > 0.5 && in.error[0] > 100.0 * roundoff_noise(in.steps[0], in.scale);
   if (all_roundoff && !converging) {
@@ -49,7 +49,6 @@ fit_result fit_order(const fit_input& in) {
     return !in.incomplete[k] && std::isfinite(in.error[k]) &&
            in.error[k] > 100.0 * roundoff_noise(in.steps[k], in.scale) && in.error[k] < 0.1 * in.scale;
   };
-  auto slope = [&](int k) { return std::log(in.error[k] / in.error[k + 1]) / std::log(in.dt[k] / in.dt[k + 1]); };
   // The window grown coarser from the pair (end - 1, end) while each local slope stays
   // within 0.1 of the median so far. It starts at the finest usable pair; when that pair
   // is the odd one out (the first touch of round-off) and leaves fewer than three levels,

@@ -7,8 +7,8 @@
 //   advance     the integrator's step (or an adaptive attempt, repeated until accepted);
 //               in `locate` contact mode it also finds a contact inside the step, steps
 //               to it, resolves it and finishes the step
-//   after_step  the problem's hook: in `end_of_step` contact mode the contacts are
-//               resolved here; a changed state clears the cached force
+//   after_step  in `end_of_step` contact mode the contacts are resolved here; a changed
+//               state clears the cached force
 //   record      the state at a requested time: reached by the step (fixed grid), by
 //               shortening a step to land on it, or from the method's dense output
 // No integrator knows about contacts.
@@ -140,18 +140,10 @@ inline bool stop_at_step_budget(drive_result<Vec>& out, long max_steps, double t
   return true;
 }
 
-template <class P>
-concept has_after_step = requires(const P& p, double t, typename P::vec& x) {
-  { p.after_step(t, x, x) } -> std::convertible_to<bool>;
-};
-
-// Stage after_step: the problem's hook, and in end_of_step mode its contacts. A state
-// it changes invalidates the cached force. Returns what the contact resolution did.
+// Stage after_step: in end_of_step mode the problem's contacts. A state they change
+// invalidates the cached force. Returns what the contact resolution did.
 template <problem P, class Vec>
 inline contact_outcome after_step(const P& problem, double t, step_state<Vec>& s) {
-  if constexpr (has_after_step<P>) {
-    if (problem.after_step(t, s.x, s.v)) s.f_current = false;
-  }
   if constexpr (has_contacts<P>) {
     if (!problem.locate_contacts()) {
       const contact_outcome c = problem.resolve_contacts(t, s.x, s.v);

@@ -11,10 +11,8 @@
 #include "core/number.hpp"
 
 namespace stepbench {
-namespace {
 
-// |a - b| over the `dim` entries from `offset` (|a| when b is empty).
-double norm(std::span<const double> a, int offset, int dim, std::span<const double> b = {}) {
+double norm(std::span<const double> a, int offset, int dim, std::span<const double> b) {
   double s = 0.0;
   for (int i = 0; i < dim; ++i) {
     const double d = a[offset + i] - (b.empty() ? 0.0 : b[offset + i]);
@@ -22,8 +20,6 @@ double norm(std::span<const double> a, int offset, int dim, std::span<const doub
   }
   return std::sqrt(s);
 }
-
-}  // namespace
 
 agreement compare(std::span<const std::vector<double>> a, std::span<const std::vector<double>> b, int dim,
                   double pos_scale, double vel_scale) {

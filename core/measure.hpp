@@ -81,6 +81,9 @@ double predicted_reference_work(const problem_instance& problem, double horizon)
 // the closed form itself is not finite (parameters out of range).
 truth_table build_truth(const problem_instance& problem, std::span<const double> times, const truth_options& opts);
 
+// |a - b| over the `dim` entries from `offset` (|a| when b is empty).
+double norm(std::span<const double> a, int offset, int dim, std::span<const double> b = {});
+
 agreement compare(std::span<const std::vector<double>> a, std::span<const std::vector<double>> b, int dim,
                   double pos_scale, double vel_scale);
 

@@ -1,6 +1,5 @@
 #pragma once
 // A compile-time list of types, walked with for_each_type to build the registries.
-#include <cstddef>
 
 namespace stepbench {
 
@@ -10,11 +9,6 @@ struct type_list {};
 template <class... Ts, class F>
 constexpr void for_each_type(type_list<Ts...>, F&& f) {
   (f.template operator()<Ts>(), ...);
-}
-
-template <class... Ts>
-constexpr std::size_t type_list_size(type_list<Ts...>) {
-  return sizeof...(Ts);
 }
 
 // The types of several lists, in order: type_list_cat_t<type_list<A, B>, type_list<C>>

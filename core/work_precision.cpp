@@ -13,8 +13,6 @@ bool qualifies(const wp_row& r, double target, bool timed) {
   return r.completed && std::isfinite(r.error) && r.error <= target && !(timed && r.cut);
 }
 
-std::string what_param(method_kind kind) { return kind == method_kind::adaptive ? "tolerance" : "dt"; }
-
 double cost_of(const wp_row& r, bool by_time) { return by_time ? r.time_ns : r.force_evals; }
 
 // A row on a method's curve: completed, its error finite (an error of exactly 0, a method
@@ -175,8 +173,8 @@ cheapest_result cheapest(const std::vector<wp_method>& methods, double target, b
     if (!lowest) {
       const bool any_diverged = std::any_of(m.rows.begin(), m.rows.end(), [](const wp_row& d) { return d.diverged; });
       reason = m.rows.empty() ? "no rows in the study"
-               : any_diverged ? fmt::format("diverged or failed at every {}", what_param(m.kind))
-                              : fmt::format("failed at every {}", what_param(m.kind));
+               : any_diverged ? fmt::format("diverged or failed at every {}", param_name(m.kind))
+                              : fmt::format("failed at every {}", param_name(m.kind));
     } else if (m.rows[*lowest].error <= target) {  // accurate enough, but every such row was cut
       reason = fmt::format("too slow: cut by the time budget (would reach {} {:.3g} {} at {})", metric,
                            m.rows[*lowest].error, unit, format_param(m.kind, m.rows[*lowest].param));

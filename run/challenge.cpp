@@ -114,12 +114,6 @@ std::vector<double> observed_positions(const P& p, const typename P::vec& x) {
   }
 }
 
-double distance(const std::vector<double>& a, const std::vector<double>& b) {
-  double s = 0.0;
-  for (std::size_t i = 0; i < a.size(); ++i) s += (a[i] - b[i]) * (a[i] - b[i]);
-  return std::sqrt(s);
-}
-
 // The Small Steps rows of one problem: every design at every n, at t = time.
 template <class P>
 void small_steps_of(const P& p, const challenge_options& o, std::vector<small_steps_row>& rows) {
@@ -138,7 +132,7 @@ void small_steps_of(const P& p, const challenge_options& o, std::vector<small_st
   // stretch), or the view of a force-based method's state.
   auto finish = [&](small_steps_row r, const typename P::vec& x, const typename P::vec& v,
                     const particle_system* own = nullptr) {
-    r.err_pos = all_finite(x, v) ? distance(observed_positions(p, x), true_pos) : nan;
+    r.err_pos = all_finite(x, v) ? norm(observed_positions(p, x), 0, static_cast<int>(true_pos.size()), true_pos) : nan;
     r.diverged = !(r.err_pos <= blowup_factor * truth.pos_scale);
     r.link_err = r.diverged ? nan : link_error(own ? *own : p.particles(x, v), true_particles);
     rows.push_back(std::move(r));

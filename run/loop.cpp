@@ -6,19 +6,15 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <span>
 #include <stdexcept>
 
 #include "core/contains.hpp"
+#include "core/measure.hpp"
 #include "core/number.hpp"
 
 namespace stepbench {
 namespace {
-
-double distance(const double* a, const double* b, int dim) {
-  double s = 0.0;
-  for (int i = 0; i < dim; ++i) s += (a[i] - b[i]) * (a[i] - b[i]);
-  return std::sqrt(s);
-}
 
 // The study's clocks for a run of `horizon`: constant at each display rate, jittered,
 // and the stall with the clamp and without it. The clamp is on everywhere else (it
@@ -74,14 +70,15 @@ void count_steps(loop_row& row, const loop_config& config, const loop_result& ru
   row.alpha_min = row.alpha_max = nan;
   double lag_clock = 0.0;
   for (std::size_t j = 0; j < counted; ++j) {
-    steps += run.steps[j];
-    row.steps_per_frame_max = std::max<long>(row.steps_per_frame_max, run.steps[j]);
-    if (run.stall[j]) row.stall_burst_steps = run.steps[j];
-    row.clamp_hits += run.clamped[j];
+    const frame_plan& f = run.plan[j];
+    steps += f.steps;
+    row.steps_per_frame_max = std::max<long>(row.steps_per_frame_max, f.steps);
+    if (f.stall) row.stall_burst_steps = f.steps;
+    row.clamp_hits += f.clamped;
     lag_clock += run.display_t[j] - run.shown_t[j];
     if (uses_accumulator(config.design)) {
-      row.alpha_min = j == 0 ? run.alpha[j] : std::min(row.alpha_min, run.alpha[j]);
-      row.alpha_max = j == 0 ? run.alpha[j] : std::max(row.alpha_max, run.alpha[j]);
+      row.alpha_min = j == 0 ? f.alpha : std::min(row.alpha_min, f.alpha);
+      row.alpha_max = j == 0 ? f.alpha : std::max(row.alpha_max, f.alpha);
     }
   }
   row.steps_per_frame_mean = counted ? static_cast<double>(steps) / static_cast<double>(counted) : nan;
@@ -140,8 +137,9 @@ loop_row measure_loop(const loop_config& config, std::string clock, const loop_r
   // what final_shown_err and the frame-rate independence compare).
   std::size_t counted = frames;
   if (frames > 0) {
-    const double full = config.clamp_s > 0.0 ? std::min(run.interval.back(), config.clamp_s) : run.interval.back();
-    if (run.frame_time.back() < full * (1.0 - 1e-9)) counted = frames - 1;
+    const frame_plan& last = run.plan.back();
+    const double full = config.clamp_s > 0.0 ? std::min(last.interval, config.clamp_s) : last.interval;
+    if (last.frame_time < full * (1.0 - 1e-9)) counted = frames - 1;
   }
   row.frames = static_cast<long>(counted);
 
@@ -150,8 +148,8 @@ loop_row measure_loop(const loop_config& config, std::string clock, const loop_r
   // Frame-rate independence: the state at the horizon against the reference clock's.
   row.clock_dependence = row.physics_clock_dependence = nan;
   if (reference && !run.non_finite && !reference->non_finite) {
-    row.clock_dependence = distance(run.final_shown.data(), reference->final_shown.data(), dim);
-    row.physics_clock_dependence = distance(run.final_physics.data(), reference->final_physics.data(), dim);
+    row.clock_dependence = norm(run.final_shown, 0, dim, reference->final_shown);
+    row.physics_clock_dependence = norm(run.final_physics, 0, dim, reference->final_physics);
   }
 
   auto no_errors = [&](std::string note) {
@@ -170,9 +168,9 @@ loop_row measure_loop(const loop_config& config, std::string clock, const loop_r
   // Shown error, and the lag that best explains it: shown(t) = exact(t - tau).
   double sum_sq = 0.0, lag_num = 0.0, lag_den = 0.0;
   for (std::size_t j = 0; j < counted; ++j) {
-    const double* shown = run.shown.data() + j * dim;
-    const double* exact = truth.y[j].data();
-    const double e = distance(shown, exact, dim);
+    const auto shown = std::span(run.shown).subspan(j * dim);
+    const auto& exact = truth.y[j];
+    const double e = norm(shown, 0, dim, exact);
     row.shown_err_max = std::max(row.shown_err_max, e);
     sum_sq += e * e;
     for (int i = 0; i < dim; ++i) {
@@ -181,7 +179,7 @@ loop_row measure_loop(const loop_config& config, std::string clock, const loop_r
     }
   }
   row.shown_err_rms = counted ? std::sqrt(sum_sq / static_cast<double>(counted)) : nan;
-  row.final_shown_err = frames ? distance(run.shown.data() + (frames - 1) * dim, truth.y.back().data(), dim) : nan;
+  row.final_shown_err = frames ? norm(std::span(run.shown).subspan((frames - 1) * dim), 0, dim, truth.y.back()) : nan;
   row.lag_s = lag_den > 0.0 ? -lag_num / lag_den : nan;
 
   row.judder = judder(run, truth, counted);

@@ -3,12 +3,12 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
 
 #include "core/measure.hpp"
+#include "core/number.hpp"
 #include "core/text.hpp"
 #include "registry/registry.hpp"
 #include "run/balanced_share.hpp"
@@ -20,11 +20,8 @@ namespace stepbench {
 namespace {
 
 double number(std::string_view text, std::string_view what, std::string_view axis) {
-  double v = 0.0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-  if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(v))
-    throw std::invalid_argument(fmt::format("--param {}: {} '{}' is not a finite number", axis, what, text));
-  return v;
+  if (const auto v = finite_number(text)) return *v;
+  throw std::invalid_argument(fmt::format("--param {}: {} '{}' is not a finite number", axis, what, text));
 }
 
 // The grid points of this run's shard (validate checked it exists), in grid order: each

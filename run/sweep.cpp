@@ -69,7 +69,7 @@ void validate(const sweep_options& opts) {
     if (!opts.problems.empty() && !contains(opts.problems, name))
       throw std::invalid_argument(fmt::format("--set names problem {}, which is not in the sweep", name));
   }
-  const auto names = opts.problems.empty() ? problem_names() : opts.problems;
+  const auto names = selected_problems(opts);
   for (const auto& name : names) configured_problem(name, opts);
   for (const auto& sc : opts.scans.value_or(default_scans())) validate(sc);
   // A method named explicitly must run on at least one selected problem.

@@ -20,6 +20,11 @@ using namespace stepbench;
 
 namespace {
 
+template <class... Ts>
+constexpr std::size_t type_list_size(type_list<Ts...>) {
+  return sizeof...(Ts);
+}
+
 // Computed once for the whole file (about 0.1 s).
 const stability_data& data() {
   static const stability_data d = compute_stability();

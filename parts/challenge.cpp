@@ -40,10 +40,7 @@ extern const study_part challenge_part{
             ctx.say(fmt::format("challenge n_pendulum in {:.2f} s",
                                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
         },
-    .write =
-        [](H5::Group& root, const study& s) {
-          if (const auto* c = s.results.find<challenge_result>()) write_challenge(root, *c);
-        },
+    .write = write_result<challenge_result, write_challenge>,
 };
 
 }  // namespace stepbench

@@ -41,10 +41,7 @@ extern const study_part energy_part{
           if (energy.methods.empty()) energy.methods = s.options.methods;
           if (!energy.scenes.empty()) s.results.put(run_energy_study(energy, s.options.overrides));
         },
-    .write =
-        [](H5::Group& root, const study& s) {
-          if (const auto* e = s.results.find<energy_study>()) write_energy(root, *e);
-        },
+    .write = write_result<energy_study, write_energy>,
 };
 
 }  // namespace stepbench

@@ -28,15 +28,13 @@
 
 #include "store/merge.hpp"
 #include "store/schema.hpp"
+#include "study/study.hpp"
 
 namespace H5 {
 class Group;
 }
 
 namespace stepbench {
-
-struct study;
-struct sweep_options;
 
 // What a part's run gets besides the study: the problems of this run (the selection, or
 // its shard's share), and where its progress and warnings go.
@@ -64,6 +62,13 @@ struct study_part {
   // Called only when the file has its group; nullptr: no command reads it back.
   void (*read)(const H5::Group& root, study&) = nullptr;
 };
+
+// A part's write of its result `T` (when the study holds one) by `write(root, result)`:
+// `.write = write_result<energy_study, write_energy>`.
+template <class T, auto write>
+void write_result(H5::Group& root, const study& s) {
+  if (const T* r = s.results.find<T>()) write(root, *r);
+}
 
 // A list of names as a describe line shows it: "a,b,c", or "all" when empty.
 std::string list_or_all(const std::vector<std::string>& names);

@@ -11,6 +11,7 @@
 #include <string>
 #include <string_view>
 #include <typeindex>
+#include <utility>
 #include <vector>
 
 #include "core/convergence_fit.hpp"
@@ -165,8 +166,7 @@ class part_results {
   }
   template <class T>
   T* find() {
-    const auto it = items_.find(std::type_index(typeid(T)));
-    return it == items_.end() ? nullptr : static_cast<T*>(it->second.get());
+    return const_cast<T*>(std::as_const(*this).find<T>());
   }
   template <class T>
   const T& get() const {
@@ -176,10 +176,8 @@ class part_results {
   }
   template <class T>
   T& put(T value) {
-    auto item = std::make_shared<T>(std::move(value));
-    T& out = *item;
-    items_[std::type_index(typeid(T))] = std::move(item);
-    return out;
+    auto& item = items_[std::type_index(typeid(T))] = std::make_shared<T>(std::move(value));
+    return *static_cast<T*>(item.get());
   }
 
  private:

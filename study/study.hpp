@@ -53,13 +53,6 @@ struct substep_options {
   int frames = 32;  // the frame is horizon / frames; the truth's sample times are its ends
 };
 
-// The frame-rate study (study/verdict.hpp): our fixed-step methods at whole frames of
-// each rate, with n substeps a frame.
-struct frame_rate_options {
-  std::vector<double> hz{30, 60, 120, 240};  // each divides the largest, so one truth serves all
-  std::vector<int> substeps{1, 2, 4, 8, 16, 32, 64};
-};
-
 struct sweep_options {
   // The parts of the study to run (parts/part.hpp), by name, in any order; empty: every
   // part. The sweep's rows are the part every other reads: a selection without it runs

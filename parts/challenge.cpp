@@ -17,7 +17,6 @@ namespace stepbench {
 extern const study_part challenge_part{
     .name = "challenge",
     .summary = "Mueller's pendulum challenge: xpbd at 50 substeps against our methods at its time a frame",
-    .group = "challenge",
     .merge = merge_rule::in_one_shard,
     .describe =
         [](const sweep_options& o) {

@@ -15,7 +15,6 @@ namespace stepbench {
 extern const study_part energy_part{
     .name = "energy",
     .summary = "energy over 10^4 periods: which methods keep it bounded and which drift",
-    .group = "energy",
     .describe =
         [](const sweep_options& o) {
           std::vector<std::string> scenes;

@@ -48,7 +48,7 @@ struct part_context {
 struct study_part {
   std::string_view name;
   std::string_view summary;                    // what it answers, one line (`stepbench list --parts`)
-  std::string_view group;                      // its group under the file's root ("problems", "scan", ...)
+  std::string_view group = {};                 // its group under the file's root when not its name ("problems")
   merge_rule merge = merge_rule::per_problem;  // how the shards of a study hold it (store/merge.hpp)
   // judged_again: what spans problems, judged again on the merged file.
   void (*judge_again)(H5::Group& root, const std::vector<std::string>& problems) = nullptr;
@@ -61,6 +61,7 @@ struct study_part {
   void (*write)(H5::Group& root, const study&) = nullptr;
   // Called only when the file has its group; nullptr: no command reads it back.
   void (*read)(const H5::Group& root, study&) = nullptr;
+  std::string_view group_name() const { return group.empty() ? name : group; }
 };
 
 // A part's write of its result `T` (when the study holds one) by `write(root, result)`:

@@ -11,7 +11,6 @@ namespace stepbench {
 extern const study_part stability_part{
     .name = "stability",
     .summary = "each integrator's stability limit on the oscillator and decay test equations, and its region",
-    .group = "stability",
     .merge = merge_rule::same_in_every_shard,
     .describe = [](const sweep_options&) { return std::string("stability: the default settings"); },
     .run = [](study& s, const part_context&) { s.results.put(compute_stability()); },

@@ -83,7 +83,6 @@ void write(H5::Group& root, const work_per_step& w) {
 extern const study_part work_per_step_part{
     .name = "work_per_step",
     .summary = "each fixed-step method's counted force evaluations a step against the number it declares",
-    .group = "work_per_step",
     .merge = merge_rule::judged_again,  // a row a problem: the shards' rows joined in the study's order
     .tables = {&work_per_step_detail::columns().spec(), 1},
     .describe = [](const sweep_options&) { return std::string("work per step: the sweep's rows"); },

@@ -67,13 +67,11 @@ void case_book::register_all(study& s) {
   auto* substeps = s.results.find<std::vector<substep_study>>();
   if (!substeps) return;
   for (auto& st : *substeps)
-    for (const auto& ps : s.problems) {
-      if (ps.problem->name() != st.problem) continue;
+    if (const problem_study* ps = s.find(st.problem))
       for (auto& m : st.methods)
         for (auto& r : m.rows)
-          add(ps, m.info, r.row, fmt::format("substeps/{}/{}/n:{}", st.problem, m.info.name, r.substeps),
+          add(*ps, m.info, r.row, fmt::format("substeps/{}/{}/n:{}", st.problem, m.info.name, r.substeps),
               "substeps/" + st.problem + "/" + m.info.name);
-    }
 }
 
 timed_case* case_book::find(const std::string& registered_name) {

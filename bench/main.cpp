@@ -159,16 +159,12 @@ int main(int argc, char** argv) {
       throw std::runtime_error("no case was timed (does --benchmark_filter match any?); " + opts.study_out +
                                " was not written");
     book.merge_into_rows();
-    timing_settings ts;
+    timing_settings& ts = s.timed.emplace(reporter.machine);
     ts.mode = mode;
     ts.min_time_s = opts.min_time_s;
     ts.repetitions = opts.repetitions;
     ts.case_budget_s = opts.case_budget_s;
-    ts.num_cpus = reporter.num_cpus;
-    ts.mhz_per_cpu = reporter.mhz;
-    ts.cpu_scaling_enabled = reporter.cpu_scaling;
     ts.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    s.timed = ts;
     judge_study(s);  // the verdict again, on the measured times
     if (opts.study_out.empty()) return report_study_outcome(s, "stepbench_bench", opts.strict);
     // The study first, then bench.json: a signal between the two leaves the new study

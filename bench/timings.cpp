@@ -22,11 +22,11 @@ std::string shown_context(const std::string& header, bool warnings_only, bool ve
 }  // namespace
 
 bool collecting_reporter::ReportContext(const Context& context) {
-  cpu_scaling = context.cpu_info.scaling == benchmark::CPUInfo::ENABLED    ? 1
-                : context.cpu_info.scaling == benchmark::CPUInfo::DISABLED ? 0
-                                                                           : -1;
-  num_cpus = context.cpu_info.num_cpus;
-  mhz = context.cpu_info.cycles_per_second / 1e6;
+  machine.cpu_scaling_enabled = context.cpu_info.scaling == benchmark::CPUInfo::ENABLED    ? 1
+                                : context.cpu_info.scaling == benchmark::CPUInfo::DISABLED ? 0
+                                                                                           : -1;
+  machine.num_cpus = context.cpu_info.num_cpus;
+  machine.mhz_per_cpu = context.cpu_info.cycles_per_second / 1e6;
   bool ok = !file_ || file_->ReportContext(context);
   progress_.around([&] {
     // The console and CSV reporters print the header to their error stream (the JSON one

@@ -26,9 +26,7 @@ class collecting_reporter : public benchmark::BenchmarkReporter {
   void ReportRuns(const std::vector<Run>& runs) override;
   void Finalize() override;
 
-  int cpu_scaling = -1;  // 1 on, 0 off, -1 unknown
-  int num_cpus = 0;
-  double mhz = 0.0;
+  timing_settings machine;  // the context's: num_cpus, mhz_per_cpu, cpu_scaling_enabled
 
  private:
   benchmark::BenchmarkReporter* display_;

@@ -17,7 +17,6 @@ namespace stepbench {
 extern const study_part challenge_part{
     .name = "challenge",
     .summary = "Mueller's pendulum challenge: xpbd at 50 substeps against our methods at its time a frame",
-    .group = "challenge",
     .merge = merge_rule::in_one_shard,
     .describe =
         [](const sweep_options& o) {
@@ -40,10 +39,7 @@ extern const study_part challenge_part{
             ctx.say(fmt::format("challenge n_pendulum in {:.2f} s",
                                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
         },
-    .write =
-        [](H5::Group& root, const study& s) {
-          if (const auto* c = s.results.find<challenge_result>()) write_challenge(root, *c);
-        },
+    .write = write_result<challenge_result, write_challenge>,
 };
 
 }  // namespace stepbench

@@ -15,7 +15,6 @@ namespace stepbench {
 extern const study_part energy_part{
     .name = "energy",
     .summary = "energy over 10^4 periods: which methods keep it bounded and which drift",
-    .group = "energy",
     .describe =
         [](const sweep_options& o) {
           std::vector<std::string> scenes;
@@ -41,10 +40,7 @@ extern const study_part energy_part{
           if (energy.methods.empty()) energy.methods = s.options.methods;
           if (!energy.scenes.empty()) s.results.put(run_energy_study(energy, s.options.overrides));
         },
-    .write =
-        [](H5::Group& root, const study& s) {
-          if (const auto* e = s.results.find<energy_study>()) write_energy(root, *e);
-        },
+    .write = write_result<energy_study, write_energy>,
 };
 
 }  // namespace stepbench

@@ -13,7 +13,6 @@ namespace stepbench {
 extern const study_part frame_rates_part{
     .name = "frame_rates",
     .summary = "which of our methods is stable and cheapest at 30, 60, 120 and 240 Hz with n substeps a frame",
-    .group = "frame_rates",
     .describe =
         [](const sweep_options& o) {
           return fmt::format("frame rates: {} Hz; substeps {}", fmt::join(o.frame_rates.hz, ","),

@@ -13,7 +13,6 @@ namespace stepbench {
 extern const study_part loop_part{
     .name = "loop",
     .summary = "the game loop's designs and clocks: the error the player sees, judder, lag and the spiral of death",
-    .group = "loop",
     .describe =
         [](const sweep_options& o) {
           const auto& lp = o.loop;

@@ -28,15 +28,13 @@
 
 #include "store/merge.hpp"
 #include "store/schema.hpp"
+#include "study/study.hpp"
 
 namespace H5 {
 class Group;
 }
 
 namespace stepbench {
-
-struct study;
-struct sweep_options;
 
 // What a part's run gets besides the study: the problems of this run (the selection, or
 // its shard's share), and where its progress and warnings go.
@@ -50,7 +48,7 @@ struct part_context {
 struct study_part {
   std::string_view name;
   std::string_view summary;                    // what it answers, one line (`stepbench list --parts`)
-  std::string_view group;                      // its group under the file's root ("problems", "scan", ...)
+  std::string_view group = {};                 // its group under the file's root when not its name ("problems")
   merge_rule merge = merge_rule::per_problem;  // how the shards of a study hold it (store/merge.hpp)
   // judged_again: what spans problems, judged again on the merged file.
   void (*judge_again)(H5::Group& root, const std::vector<std::string>& problems) = nullptr;
@@ -63,7 +61,15 @@ struct study_part {
   void (*write)(H5::Group& root, const study&) = nullptr;
   // Called only when the file has its group; nullptr: no command reads it back.
   void (*read)(const H5::Group& root, study&) = nullptr;
+  std::string_view group_name() const { return group.empty() ? name : group; }
 };
+
+// A part's write of its result `T` (when the study holds one) by `write(root, result)`:
+// `.write = write_result<energy_study, write_energy>`.
+template <class T, auto write>
+void write_result(H5::Group& root, const study& s) {
+  if (const T* r = s.results.find<T>()) write(root, *r);
+}
 
 // A list of names as a describe line shows it: "a,b,c", or "all" when empty.
 std::string list_or_all(const std::vector<std::string>& names);

@@ -37,7 +37,7 @@ const std::vector<study_part>& study_parts() {
 
 std::vector<merged_group> merged_groups() {
   std::vector<merged_group> out;
-  for (const auto& p : study_parts()) out.push_back({p.group, p.merge, p.judge_again, p.tables});
+  for (const auto& p : study_parts()) out.push_back({p.group_name(), p.merge, p.judge_again, p.tables});
   return out;
 }
 

@@ -76,7 +76,7 @@ extern const study_part scans_part{
           if (auto* scans = s.results.find<std::vector<scan_result>>())
             for (auto& sc : *scans) sc.range_answer = format_scan_answer(answer_scan(sc, sc.options.tol));
         },
-    .write = [](H5::Group& root, const study& s) { write_scans(root, s.results.get<std::vector<scan_result>>()); },
+    .write = write_result<std::vector<scan_result>, write_scans>,
 };
 
 }  // namespace stepbench

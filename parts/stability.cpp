@@ -11,14 +11,10 @@ namespace stepbench {
 extern const study_part stability_part{
     .name = "stability",
     .summary = "each integrator's stability limit on the oscillator and decay test equations, and its region",
-    .group = "stability",
     .merge = merge_rule::same_in_every_shard,
     .describe = [](const sweep_options&) { return std::string("stability: the default settings"); },
     .run = [](study& s, const part_context&) { s.results.put(compute_stability()); },
-    .write =
-        [](H5::Group& root, const study& s) {
-          if (const auto* d = s.results.find<stability_data>()) write_stability(root, *d);
-        },
+    .write = write_result<stability_data, write_stability>,
     .read =
         [](const H5::Group& root, study& s) {
           s.results.put(stability_data{}).limits =

@@ -75,7 +75,7 @@ void judge_study(study& s) {
 std::vector<study> read_studies(const std::vector<std::string>& paths) {
   return read_studies(paths, [](const H5::Group& root, study& s) {
     for (const auto& p : study_parts())
-      if (p.read && h5::is_group(root, std::string(p.group))) p.read(root, s);
+      if (p.read && h5::is_group(root, std::string(p.group_name()))) p.read(root, s);
   });
 }
 

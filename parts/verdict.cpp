@@ -11,7 +11,6 @@ namespace stepbench {
 extern const study_part verdict_part{
     .name = "verdict",
     .summary = "the fastest of ours against the fastest peer at equal error, the frame-rate answers, the findings",
-    .group = "verdict",
     .merge = merge_rule::judged_again,
     .judge_again = judge_findings_again,
     .describe = [](const sweep_options&) { return std::string("verdict: targets 1e-2 .. 1e-12"); },

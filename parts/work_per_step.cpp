@@ -56,15 +56,11 @@ work_per_step count(const study& s) {
   return out;
 }
 
-using enum schema::field_type;
-constexpr schema::field fields[] = {{"problem", str},      {"method", str},       {"declared", f64},  {"runs", i64},
-                                    {"measured_min", f64}, {"measured_max", f64}, {"extra_max", i64}, {"agrees", i8}};
-constexpr schema::field_group groups[] = {{fields}};
-constexpr schema::table tables[] = {{"work_per_step", "/work_per_step/rows", groups}};
-
+// Its table, /work_per_step/rows: declared by this one mapping of its fields to work_row's
+// members, which the writer uses and a reader would (`stepbench schema` lists it).
 const column_map<work_row>& columns() {
   using R = work_row;
-  static const auto columns = column_map<R>(tables[0])
+  static const auto columns = column_map<R>("work_per_step", "/work_per_step/rows")
                                   .member("problem", &R::problem)
                                   .member("method", &R::method)
                                   .member("declared", &R::declared)
@@ -76,12 +72,10 @@ const column_map<work_row>& columns() {
   return columns;
 }
 
-void write(H5::Group& root, const study& s) {
-  const auto* w = s.results.find<work_per_step>();
-  if (!w) return;
+void write(H5::Group& root, const work_per_step& w) {
   // Only the rows: an attribute summing them would be a second figure for merge to join.
   H5::Group g = root.createGroup("work_per_step");
-  columns().write(g, "rows", w->rows);
+  columns().write(g, "rows", w.rows);
 }
 
 }  // namespace work_per_step_detail
@@ -89,12 +83,11 @@ void write(H5::Group& root, const study& s) {
 extern const study_part work_per_step_part{
     .name = "work_per_step",
     .summary = "each fixed-step method's counted force evaluations a step against the number it declares",
-    .group = "work_per_step",
     .merge = merge_rule::judged_again,  // a row a problem: the shards' rows joined in the study's order
-    .tables = work_per_step_detail::tables,
+    .tables = {&work_per_step_detail::columns().spec(), 1},
     .describe = [](const sweep_options&) { return std::string("work per step: the sweep's rows"); },
     .run = [](study& s, const part_context&) { s.results.put(work_per_step_detail::count(s)); },
-    .write = work_per_step_detail::write,
+    .write = write_result<work_per_step_detail::work_per_step, work_per_step_detail::write>,
 };
 
 }  // namespace stepbench

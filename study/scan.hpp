@@ -31,12 +31,17 @@ struct scan_axis {
   std::vector<double> values() const;  // lo .. hi, count points, evenly (in log when `log`)
 };
 
-struct scan_options {
+// The frame-rate study (study/verdict.hpp): our fixed-step methods at whole frames of
+// each rate, with n substeps a frame; a scan runs it at each grid point.
+struct frame_rate_options {
+  std::vector<double> hz{30, 60, 120, 240};  // each divides the largest, so one truth serves all
+  std::vector<int> substeps{1, 2, 4, 8, 16, 32, 64};
+};
+
+struct scan_options : frame_rate_options {  // its rates and substeps (`scan --dt X` is hz 1/X)
   std::string problem;
   std::string name;  // the group under /scan ("" : the problem's name)
   std::vector<scan_axis> axes;
-  std::vector<double> hz{30, 60, 120, 240};  // each divides the fastest (--dt X is hz 1/X)
-  std::vector<int> substeps{1, 2, 4, 8, 16, 32, 64};
   // Empty: our fixed-step methods on the problem. A scan's result holds those it ran.
   std::vector<std::string> methods;
   double tol = 1e-3;                    // in the problem's position unit

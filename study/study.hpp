@@ -11,6 +11,7 @@
 #include <string>
 #include <string_view>
 #include <typeindex>
+#include <utility>
 #include <vector>
 
 #include "core/convergence_fit.hpp"
@@ -50,13 +51,6 @@ struct substep_options {
   std::vector<std::string> implicit_methods{"implicit_euler", "implicit_midpoint"};
   std::vector<int> counts{1, 2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 64};
   int frames = 32;  // the frame is horizon / frames; the truth's sample times are its ends
-};
-
-// The frame-rate study (study/verdict.hpp): our fixed-step methods at whole frames of
-// each rate, with n substeps a frame.
-struct frame_rate_options {
-  std::vector<double> hz{30, 60, 120, 240};  // each divides the largest, so one truth serves all
-  std::vector<int> substeps{1, 2, 4, 8, 16, 32, 64};
 };
 
 struct sweep_options {
@@ -165,8 +159,7 @@ class part_results {
   }
   template <class T>
   T* find() {
-    const auto it = items_.find(std::type_index(typeid(T)));
-    return it == items_.end() ? nullptr : static_cast<T*>(it->second.get());
+    return const_cast<T*>(std::as_const(*this).find<T>());
   }
   template <class T>
   const T& get() const {
@@ -176,10 +169,8 @@ class part_results {
   }
   template <class T>
   T& put(T value) {
-    auto item = std::make_shared<T>(std::move(value));
-    T& out = *item;
-    items_[std::type_index(typeid(T))] = std::move(item);
-    return out;
+    auto& item = items_[std::type_index(typeid(T))] = std::make_shared<T>(std::move(value));
+    return *static_cast<T*>(item.get());
   }
 
  private:

@@ -20,7 +20,7 @@
 // half stencil: every pair once). The grid's arrays are members sized once per scene
 // (when the problem is made or its ball count changes), so no step allocates.
 //
-// Scene: the event-driven truth's default_ball_scene (problems/exact/event_driven_balls.hpp)
+// Scene: the event-driven truth's default_ball_scene (tests/default_ball_scene.hpp)
 // with the box scaled to keep its density: W = 2 s, H = s metres, s = sqrt(max(N, 16) / 16),
 // balls of r = 0.05 m on a jittered grid with velocities uniform in [-2, 2) m/s from
 // std::mt19937_64(seed); for N = 16 (the default) exactly default_ball_scene(16, seed).
@@ -102,7 +102,7 @@ struct bouncing_balls {
   double width() const { return 2.0 * scale(); }
   double height() const { return scale(); }
 
-  // default_ball_scene's construction, in the scaled box (see above).
+  // place_on_grid's construction, in the scaled box (see above).
   phase<vec> initial() const {
     ensure_workspace();
     const auto s = scene();

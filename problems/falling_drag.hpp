@@ -41,7 +41,6 @@ struct falling_drag {
   }
 
   exact::falling_drag motion() const { return exact::falling_drag::from_mass_and_drag(gravity, mass_kg, drag); }
-  double terminal_speed() const { return motion().terminal_speed; }
 
   double mass() const { return mass_kg; }
   double horizon() const { return duration; }

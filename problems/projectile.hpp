@@ -50,25 +50,8 @@ struct projectile {
     return 0.5 * mass_kg * v.squaredNorm() + mass_kg * gravity * x.z();
   }
 
-  // The lecture's projectile formulas, launch and landing at the same height.
+  // The lecture's flight time, launch and landing at the same height.
   double flight_time() const { return 2.0 * launch_velocity().z() / gravity; }
-  double apex_time() const { return launch_velocity().z() / gravity; }
-  double apex_height() const {
-    const double vz = launch_velocity().z();
-    return vz * vz / (2.0 * gravity);
-  }
-  double range() const { return speed * speed * std::sin(2.0 * angle_rad()) / gravity; }
 };
-
-// Launch angle (radians) that reaches apex height h above the launch point at speed s:
-// a = asin( sqrt(2 g h) / s ). Returns NaN when h is out of reach.
-inline double launch_angle_for_height(double h, double s, double g) { return std::asin(std::sqrt(2.0 * g * h) / s); }
-
-// The two launch angles (radians) that land at range r: a = asin(r g / s^2) / 2 and
-// pi/2 - a. NaN when r is beyond the maximum range s^2 / g.
-inline std::array<double, 2> launch_angles_for_range(double r, double s, double g) {
-  const double low = 0.5 * std::asin(r * g / (s * s));
-  return {low, std::numbers::pi / 2.0 - low};
-}
 
 }  // namespace stepbench

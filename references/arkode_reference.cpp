@@ -14,7 +14,6 @@
 #include <sundials/sundials_context.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <exception>
 #include <stdexcept>
@@ -73,66 +72,58 @@ reference_solution solve_arkode_erk(const ode_system& sys, std::span<const doubl
   const std::string source = "arkode_erk" + std::to_string(order);
   if (fixed_step < 0.0 || !std::isfinite(fixed_step))
     throw std::invalid_argument(source + ": the fixed step must be finite and >= 0 (0: adaptive)");
-  detail::validate_reference_input(source, sys, times, tol);
-  const auto start = std::chrono::steady_clock::now();
-  detail::callback_state st;
-  st.sys = &sys;
-  arkode_handles h;
-  const auto fail = [&](const std::string& call, int flag) {
-    throw std::runtime_error(
-        st.failure(source, call, flag, detail::sundials_flag_name(ERKStepGetReturnFlagName(flag))));
-  };
-  const auto check = [&](const char* call, int flag) {
-    if (flag != 0) fail(call, flag);
-  };
-  check("SUNContext_Create", SUNContext_Create(nullptr, &h.ctx));
-  h.y = N_VNew_Serial(sys.n, h.ctx);
-  if (!h.y) throw std::runtime_error(source + ": N_VNew_Serial returned null");
-  std::copy(sys.y0.begin(), sys.y0.end(), N_VGetArrayPointer(h.y));
-  h.mem = ERKStepCreate(&arkode_rhs, 0.0, h.y, h.ctx);
-  if (!h.mem) throw std::runtime_error(source + ": ERKStepCreate returned null");
-  check("ERKStepSetErrHandlerFn",
-        ERKStepSetErrHandlerFn(h.mem, &detail::keep_sundials_message<detail::callback_state, ARK_WARNING>, &st));
-  check("ERKStepSetUserData", ERKStepSetUserData(h.mem, &st));
-  check("ERKStepSetOrder", ERKStepSetOrder(h.mem, order));
-  check("ERKStepSStolerances", ERKStepSStolerances(h.mem, tol.rtol, tol.atol));
-  if (fixed_step > 0.0) check("ERKStepSetFixedStep", ERKStepSetFixedStep(h.mem, fixed_step));
-  check("ERKStepSetMaxNumSteps", ERKStepSetMaxNumSteps(h.mem, sys.max_steps_per_output));
-  // At a discontinuity an order-8 method at a tight tolerance needs many rejections in a
-  // row to shrink its step; ARKODE's default of 7 gives up where GSL and CVODE do not.
-  check("ERKStepSetMaxErrTestFails", ERKStepSetMaxErrTestFails(h.mem, 100));
+  return detail::timed_solve(source, sys, times, tol, [&](reference_solution& out) {
+    detail::callback_state st;
+    st.sys = &sys;
+    arkode_handles h;
+    const auto fail = [&](const std::string& call, int flag) {
+      throw std::runtime_error(
+          st.failure(source, call, flag, detail::sundials_flag_name(ERKStepGetReturnFlagName(flag))));
+    };
+    const auto check = [&](const char* call, int flag) {
+      if (flag != 0) fail(call, flag);
+    };
+    check("SUNContext_Create", SUNContext_Create(nullptr, &h.ctx));
+    h.y = N_VNew_Serial(sys.n, h.ctx);
+    if (!h.y) throw std::runtime_error(source + ": N_VNew_Serial returned null");
+    std::copy(sys.y0.begin(), sys.y0.end(), N_VGetArrayPointer(h.y));
+    h.mem = ERKStepCreate(&arkode_rhs, 0.0, h.y, h.ctx);
+    if (!h.mem) throw std::runtime_error(source + ": ERKStepCreate returned null");
+    check("ERKStepSetErrHandlerFn",
+          ERKStepSetErrHandlerFn(h.mem, &detail::keep_sundials_message<detail::callback_state, ARK_WARNING>, &st));
+    check("ERKStepSetUserData", ERKStepSetUserData(h.mem, &st));
+    check("ERKStepSetOrder", ERKStepSetOrder(h.mem, order));
+    check("ERKStepSStolerances", ERKStepSStolerances(h.mem, tol.rtol, tol.atol));
+    if (fixed_step > 0.0) check("ERKStepSetFixedStep", ERKStepSetFixedStep(h.mem, fixed_step));
+    check("ERKStepSetMaxNumSteps", ERKStepSetMaxNumSteps(h.mem, sys.max_steps_per_output));
+    // At a discontinuity an order-8 method at a tight tolerance needs many rejections in a
+    // row to shrink its step; ARKODE's default of 7 gives up where GSL and CVODE do not.
+    check("ERKStepSetMaxErrTestFails", ERKStepSetMaxErrTestFails(h.mem, 100));
 
-  reference_solution out;
-  out.source = source;
-  out.times.assign(times.begin(), times.end());
-  out.y.reserve(times.size());
-  const auto n = static_cast<std::size_t>(sys.n);
-  for (double tout : times) {
-    check("ERKStepSetStopTime", ERKStepSetStopTime(h.mem, tout));
-    sunrealtype t = 0.0;
-    const int flag = ERKStepEvolve(h.mem, tout, h.y, &t, ARK_NORMAL);
-    if (st.error) std::rethrow_exception(st.error);
-    const double* y = N_VGetArrayPointer(h.y);
-    const bool finite = std::all_of(y, y + n, [](double v) { return std::isfinite(v); });
-    // At a fixed step nothing shrinks the step: a step beyond the stability limit grows
-    // until the right-hand side or the state is not finite, which is the run diverging.
-    if (fixed_step > 0.0 && (st.non_finite || !finite)) {
-      out.diverged = true;
-      break;
+    const auto n = static_cast<std::size_t>(sys.n);
+    for (double tout : times) {
+      check("ERKStepSetStopTime", ERKStepSetStopTime(h.mem, tout));
+      sunrealtype t = 0.0;
+      const int flag = ERKStepEvolve(h.mem, tout, h.y, &t, ARK_NORMAL);
+      if (st.error) std::rethrow_exception(st.error);
+      const double* y = N_VGetArrayPointer(h.y);
+      const bool finite = std::all_of(y, y + n, [](double v) { return std::isfinite(v); });
+      // At a fixed step nothing shrinks the step: a step beyond the stability limit grows
+      // until the right-hand side or the state is not finite, which is the run diverging.
+      if (fixed_step > 0.0 && (st.non_finite || !finite)) {
+        out.diverged = true;
+        break;
+      }
+      if (flag < 0) fail("ERKStepEvolve at t=" + detail::num(t) + " towards t=" + detail::num(tout), flag);
+      if (!finite) throw std::runtime_error(source + ": non-finite state at t=" + detail::num(tout));
+      out.y.emplace_back(y, y + n);
     }
-    if (flag < 0) fail("ERKStepEvolve at t=" + detail::num(t) + " towards t=" + detail::num(tout), flag);
-    if (!finite) throw std::runtime_error(source + ": non-finite state at t=" + detail::num(tout));
-    out.y.emplace_back(y, y + n);
-  }
-  auto& s = out.stats;
-  check("ERKStepGetNumSteps", ERKStepGetNumSteps(h.mem, &s.steps));
-  check("ERKStepGetNumErrTestFails", ERKStepGetNumErrTestFails(h.mem, &s.failed_steps));
-  check("ERKStepGetNumRhsEvals", ERKStepGetNumRhsEvals(h.mem, &s.rhs_evals));
-  s.rhs_evals_counted = st.calls;
-  s.rtol = tol.rtol;
-  s.atol = tol.atol;
-  s.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return out;
+    auto& s = out.stats;
+    check("ERKStepGetNumSteps", ERKStepGetNumSteps(h.mem, &s.steps));
+    check("ERKStepGetNumErrTestFails", ERKStepGetNumErrTestFails(h.mem, &s.failed_steps));
+    check("ERKStepGetNumRhsEvals", ERKStepGetNumRhsEvals(h.mem, &s.rhs_evals));
+    s.rhs_evals_counted = st.calls;
+  });
 }
 
 }  // namespace stepbench

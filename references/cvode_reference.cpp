@@ -15,7 +15,6 @@
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <exception>
 #include <stdexcept>
@@ -289,25 +288,17 @@ class cvode_session {
 reference_solution solve_cvode(const ode_system& sys, std::span<const double> times, cvode_method method,
                                reference_tolerances tol) {
   cvode_session cv(sys, method);
-  detail::validate_reference_input(cv.source(), sys, times, tol);
-  const auto start = std::chrono::steady_clock::now();
-  cv.create(tol);
-  cv.attach_solver();
-  cv.enable_contacts();
-  reference_solution out;
-  out.source = cv.source();
-  out.times.assign(times.begin(), times.end());
-  out.y.reserve(times.size());
-  for (double tout : times) {
-    const auto y = cv.advance(tout);
-    out.y.emplace_back(y.begin(), y.end());
-  }
-  out.stats = cv.stats();
-  out.contacts = cv.contacts();
-  out.stats.rtol = tol.rtol;
-  out.stats.atol = tol.atol;
-  out.stats.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return out;
+  return detail::timed_solve(cv.source(), sys, times, tol, [&](reference_solution& out) {
+    cv.create(tol);
+    cv.attach_solver();
+    cv.enable_contacts();
+    for (double tout : times) {
+      const auto y = cv.advance(tout);
+      out.y.emplace_back(y.begin(), y.end());
+    }
+    out.stats = cv.stats();
+    out.contacts = cv.contacts();
+  });
 }
 
 }  // namespace stepbench

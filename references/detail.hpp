@@ -1,5 +1,6 @@
 #pragma once
 // Shared by the GSL, CVODE and ARKODE wrappers; not part of the interface (reference.hpp).
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -22,6 +23,25 @@ inline std::string num(double v) {
 // Both solvers are public, so both check their input, not only solve_reference.
 void validate_reference_input(std::string_view source, const ode_system& sys, std::span<const double> times,
                               reference_tolerances tol);
+
+// The frame of every wrapper: checks the input, then times solve(out), which fills the
+// states and the counters; the source, the output times and the tolerances are filled
+// here, so that every solver gives the same record.
+template <class Solve>
+reference_solution timed_solve(std::string_view source, const ode_system& sys, std::span<const double> times,
+                               reference_tolerances tol, Solve&& solve) {
+  validate_reference_input(source, sys, times, tol);
+  const auto start = std::chrono::steady_clock::now();
+  reference_solution out;
+  out.source = source;
+  out.times.assign(times.begin(), times.end());
+  out.y.reserve(times.size());
+  solve(out);
+  out.stats.rtol = tol.rtol;
+  out.stats.atol = tol.atol;
+  out.stats.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
 
 // What a C callback needs, and what it hands back: a C++ exception must not cross the
 // library's C frames, so it is stashed and rethrown once the library has returned; a

@@ -46,7 +46,7 @@ reference_solution solve_reference(std::string_view source, const ode_system& sy
                                    reference_tolerances tol) {
   // Each solver validates its input, times itself (steady_clock) and fills source, times,
   // rtol and atol, so that calling it directly gives the same record as calling it here.
-  if (source == "gsl_rk8pd") return solve_gsl_rk8pd(sys, times, tol);
+  if (source == "gsl_rk8pd") return solve_gsl(sys, times, gsl_method::rk8pd, tol);
   if (source == "cvode_bdf") return solve_cvode(sys, times, cvode_method::bdf, tol);
   if (source == "cvode_adams") return solve_cvode(sys, times, cvode_method::adams, tol);
   if (source == "arkode_erk8") return solve_arkode_erk(sys, times, 8, tol);

@@ -77,10 +77,7 @@ struct reference_tolerances {
 
 // Integrates from t = 0 to each of `times` (increasing, all > 0) and returns the state
 // there. Throws std::runtime_error, with the failing call and its return code, on any
-// solver failure.
-reference_solution solve_gsl_rk8pd(const ode_system& sys, std::span<const double> times, reference_tolerances tol = {});
-
-// The same driver with another embedded stepper (rkf45 is a peer, not a reference).
+// solver failure. GSL's driver with its rk8pd stepper (the reference) or rkf45 (a peer).
 enum class gsl_method { rk8pd, rkf45 };
 reference_solution solve_gsl(const ode_system& sys, std::span<const double> times, gsl_method method,
                              reference_tolerances tol = {});

@@ -11,6 +11,7 @@
 
 #include "core/drive.hpp"
 #include "core/measure.hpp"
+#include "default_ball_scene.hpp"
 #include "integrators/all.hpp"
 #include "parts/study.hpp"
 #include "problems/bouncing_ball.hpp"

@@ -1,6 +1,7 @@
 // The lecture's worked examples and the closed forms of the problems.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -9,7 +10,6 @@
 #include "problems/bouncing_ball.hpp"
 #include "problems/constant_acceleration.hpp"
 #include "problems/damped_spring.hpp"
-#include "problems/incline.hpp"
 #include "problems/pendulum.hpp"
 #include "problems/projectile.hpp"
 #include "problems/sliding_block.hpp"
@@ -18,6 +18,43 @@
 using namespace stepbench;
 
 namespace {
+
+// The lecture's projectile formulas, launch and landing at the same height.
+double apex_time(const projectile& p) { return p.launch_velocity().z() / p.gravity; }
+double apex_height(const projectile& p) {
+  const double vz = p.launch_velocity().z();
+  return vz * vz / (2.0 * p.gravity);
+}
+double range(const projectile& p) { return p.speed * p.speed * std::sin(2.0 * p.angle_rad()) / p.gravity; }
+
+// Launch angle (radians) that reaches apex height h above the launch point at speed s:
+// a = asin( sqrt(2 g h) / s ). Returns NaN when h is out of reach.
+double launch_angle_for_height(double h, double s, double g) { return std::asin(std::sqrt(2.0 * g * h) / s); }
+
+// The two launch angles (radians) that land at range r: a = asin(r g / s^2) / 2 and
+// pi/2 - a. NaN when r is beyond the maximum range s^2 / g.
+std::array<double, 2> launch_angles_for_range(double r, double s, double g) {
+  const double low = 0.5 * std::asin(r * g / (s * s));
+  return {low, std::numbers::pi / 2.0 - low};
+}
+
+// Friction on an incline (the lecture's forces): its two worked examples are closed-form.
+namespace incline {
+
+// Normal force on an incline of angle theta: |F_n| = m g cos(theta).
+double normal_force(double mass, double g, double theta) { return mass * g * std::cos(theta); }
+
+// Acceleration down the slope of a sliding block with kinetic friction mu_k:
+// a = g sin(theta) - mu_k g cos(theta). Negative means kinetic friction would stop it.
+double sliding_acceleration(double g, double theta, double mu_k) {
+  return g * std::sin(theta) - mu_k * g * std::cos(theta);
+}
+
+// Tilt at which a block at rest starts to slide: m g sin(theta) = mu_s m g cos(theta),
+// so theta = atan(mu_s).
+double sliding_angle(double mu_s) { return std::atan(mu_s); }
+
+}  // namespace incline
 
 template <class I, class P>
 phase<typename P::vec> final_state(const P& p, double dt, double horizon) {
@@ -69,22 +106,22 @@ TEST(lecture, euler_example_eleven_steps) {
 // precision from those formulas).
 TEST(lecture, projectile_range_apex_flight_time) {
   const projectile p;
-  EXPECT_NEAR(p.range(), 163.97643104248456, 1e-10);
-  EXPECT_NEAR(p.apex_height(), 112.63038540299603, 1e-10);
+  EXPECT_NEAR(range(p), 163.97643104248456, 1e-10);
+  EXPECT_NEAR(apex_height(p), 112.63038540299603, 1e-10);
   EXPECT_NEAR(p.flight_time(), 9.588700212101104, 1e-12);
   EXPECT_DOUBLE_EQ(p.horizon(), p.flight_time());
   // The closed form lands at the range, at launch height, and peaks at the apex.
-  EXPECT_NEAR(p.exact(p.flight_time()).x.x(), p.range(), 1e-10);
+  EXPECT_NEAR(p.exact(p.flight_time()).x.x(), range(p), 1e-10);
   EXPECT_NEAR(p.exact(p.flight_time()).x.z(), 0.0, 1e-10);
-  EXPECT_NEAR(p.exact(p.apex_time()).x.z(), p.apex_height(), 1e-10);
-  EXPECT_NEAR(p.exact(p.apex_time()).v.z(), 0.0, 1e-12);
+  EXPECT_NEAR(p.exact(apex_time(p)).x.z(), apex_height(p), 1e-10);
+  EXPECT_NEAR(p.exact(apex_time(p)).v.z(), 0.0, 1e-12);
   // RK4 is exact on uniform gravity: it lands on the range with only 10 steps.
   const auto s = final_state<rk4>(p, p.horizon() / 10, p.horizon());
-  EXPECT_NEAR(s.x.x(), p.range(), 1e-10);
+  EXPECT_NEAR(s.x.x(), range(p), 1e-10);
   EXPECT_NEAR(s.x.z(), 0.0, 1e-10);
   // The inverse formulas recover the launch angle.
-  EXPECT_NEAR(launch_angle_for_height(p.apex_height(), p.speed, p.gravity), p.angle_rad(), 1e-12);
-  const auto angles = launch_angles_for_range(p.range(), p.speed, p.gravity);
+  EXPECT_NEAR(launch_angle_for_height(apex_height(p), p.speed, p.gravity), p.angle_rad(), 1e-12);
+  const auto angles = launch_angles_for_range(range(p), p.speed, p.gravity);
   EXPECT_NEAR(angles[1], p.angle_rad(), 1e-12);
   EXPECT_NEAR(angles[0], std::numbers::pi / 2 - p.angle_rad(), 1e-12);
 }

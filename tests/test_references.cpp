@@ -119,7 +119,7 @@ TEST(gsl_rk8pd, rhs_call_identity) {
   for (const auto& sys : {undamped(), damped(), kicked()}) {
     for (const reference_tolerances tol :
          {reference_tolerances{}, reference_tolerances{1e-8, 1e-10}, reference_tolerances{1e-5, 1e-7}}) {
-      const auto s = solve_gsl_rk8pd(sys, output_times(), tol).stats;
+      const auto s = solve_gsl(sys, output_times(), gsl_method::rk8pd, tol).stats;
       EXPECT_EQ(s.rhs_evals_counted, 1 + 13 * (s.steps + s.failed_steps))
           << "rtol " << tol.rtol << ": steps " << s.steps << ", failed " << s.failed_steps;
       std::cout << "  rtol " << tol.rtol << ": steps " << s.steps << ", failed " << s.failed_steps << ", calls "

@@ -43,7 +43,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <string_view>
 #include <vector>
 
 namespace stepbench::exact {
@@ -84,15 +83,6 @@ struct bouncing_ball {
   double vz0 = 0.0;
   double k_r = 0.5;  // restitution, [0, 1]
   double k_f = 0.0;  // friction, [0, 1]
-
-  std::string_view invalid_reason() const {
-    if (!(std::isfinite(g) && g > 0.0)) return "g must be finite and > 0";
-    if (!(std::isfinite(h) && h > 0.0)) return "h must be finite and > 0";
-    if (!(std::isfinite(vx0) && std::isfinite(vz0))) return "vx0 and vz0 must be finite";
-    if (!(k_r >= 0.0 && k_r <= 1.0)) return "k_r must be in [0, 1]";
-    if (!(k_f >= 0.0 && k_f <= 1.0)) return "k_f must be in [0, 1]";
-    return "";
-  }
 
   double first_contact_time() const { return time_to_ground(h, vz0, g); }
   double impact_speed() const { return std::hypot(vz0, std::sqrt(2.0 * g * h)); }  // v_1

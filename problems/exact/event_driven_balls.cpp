@@ -51,15 +51,6 @@ double place_on_grid(ball_scene& s, std::uint64_t seed) {
   return std::min(cw, ch);
 }
 
-ball_scene default_ball_scene(int n, std::uint64_t seed) {
-  ball_scene s;
-  if (n < 1) throw std::invalid_argument("default_ball_scene: n must be >= 1");
-  s.n = n;
-  if (place_on_grid(s, seed) <= 2.0 * s.radius)
-    throw std::invalid_argument("default_ball_scene: too many balls for a loose grid in the box");
-  return s;
-}
-
 inelastic_collapse::inelastic_collapse(double t, int a, int b, const std::string& why)
     : std::runtime_error("event_driven_balls: inelastic collapse at t = " + std::to_string(t) + ": " + why +
                          "; no event-driven truth beyond"),
@@ -236,22 +227,6 @@ bool event_driven_balls::next_event(double t_max) {
   if (collapse_) throw *collapse_;
   set_now(t_last_);
   return true;
-}
-
-int event_driven_balls::resting_count() const {
-  return static_cast<int>(std::count(resting_.begin(), resting_.end(), 1));
-}
-
-double event_driven_balls::energy() const {
-  double e = 0.0;
-  for (int i = 0; i < s_.n; ++i) e += 0.5 * v_now_[i].squaredNorm() + s_.gravity * x_now_[i].y();
-  return s_.mass * e;
-}
-
-vec2 event_driven_balls::momentum() const {
-  vec2 p = vec2::Zero();
-  for (const vec2& v : v_now_) p += v;
-  return s_.mass * p;
 }
 
 void event_driven_balls::evaluate(std::size_t i, double t, vec2& x, vec2& v) const {

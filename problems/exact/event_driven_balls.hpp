@@ -156,18 +156,17 @@ struct ball_scene {
 // differs between standard libraries), so this keeps a seed's scene the same everywhere.
 inline double unit_draw(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1p-53; }
 
-// The default scene, reproducible from a seed. Box W = 2 m, H = 1 m, r = 0.05 m (the
-// floor holds 20 balls in a row), g = 9.8, k_r = 1, k_f = 0, m = 1 kg. Balls sit on a
-// loose grid of cols = ceil(sqrt(n W / H)) columns and rows = ceil(n / cols) rows of
-// cells (cw = W / cols, ch = H / rows), ball i in column i % cols, row i / cols from the
-// bottom, at the cell centre plus a jitter uniform in [-jx, jx) x [-jz, jz) with
-// jx = (cw / 2 - r) / 2, jz = (ch / 2 - r) / 2 (so no ball leaves its cell: no overlaps).
-// Velocity components are uniform in [-2, 2) m/s. Draw order per ball: jitter x, jitter
-// z, v_x, v_z, each one unit_draw of std::mt19937_64(seed). Throws
-// std::invalid_argument when the cells are too small for the balls (n > 171).
-ball_scene default_ball_scene(int n = 16, std::uint64_t seed = 1);
-// Its placement of s.n balls in the box and radius of s (x0 and v0 replaced); returns the
-// smaller side of a cell, which must exceed 2 r.
+// A scene reproducible from a seed: s.n balls placed in the box W x H and radius r of s
+// (x0 and v0 replaced). Balls sit on a loose grid of cols = ceil(sqrt(n W / H)) columns
+// and rows = ceil(n / cols) rows of cells (cw = W / cols, ch = H / rows), ball i in
+// column i % cols, row i / cols from the bottom, at the cell centre plus a jitter uniform
+// in [-jx, jx) x [-jz, jz) with jx = (cw / 2 - r) / 2, jz = (ch / 2 - r) / 2 (so no ball
+// leaves its cell: no overlaps). Velocity components are uniform in [-2, 2) m/s. Draw
+// order per ball: jitter x, jitter z, v_x, v_z, each one unit_draw of
+// std::mt19937_64(seed). Returns the smaller side of a cell, which must exceed 2 r. In
+// the default box (W = 2 m, H = 1 m, r = 0.05 m: the floor holds 20 balls in a row) the
+// cells are too small for more than 171 balls; that scene with g = 9.8, k_r = 1, k_f = 0,
+// m = 1 kg is the tests' default_ball_scene (tests/default_ball_scene.hpp).
 double place_on_grid(ball_scene& s, std::uint64_t seed);
 
 enum class contact_kind { left_wall, right_wall, floor, ceiling, ball };  // the walls in slot order
@@ -217,11 +216,6 @@ class event_driven_balls {
   const std::vector<vec2>& velocities() const { return v_now_; }
   const std::vector<contact_event>& events() const { return events_; }
   bool resting(int i) const { return resting_[static_cast<std::size_t>(i)] != 0; }
-  int resting_count() const;
-
-  // Kinetic plus potential energy, sum m |v|^2 / 2 + m g z, at time().
-  double energy() const;
-  vec2 momentum() const;
 
  private:
   // A contact's identity and tie-break key: the (lower) ball, then slot 0..3 for the

@@ -25,7 +25,6 @@
 //   (where v_t tanh(u) and (v_t^2 / g) ln cosh(u) would give 0 * inf or lose x to underflow).
 #include <cmath>
 #include <numbers>
-#include <string_view>
 
 namespace stepbench::exact {
 
@@ -50,19 +49,6 @@ struct falling_drag {
 
   // From the mass and the drag coefficient c of F_d = -c |v| v (c = 0 gives v_t = +inf).
   static falling_drag from_mass_and_drag(double g, double mass, double c) { return {g, std::sqrt(mass * g / c)}; }
-
-  std::string_view invalid_reason() const {
-    if (!(std::isfinite(g) && g > 0.0)) return "g must be finite and > 0";
-    if (!(terminal_speed > 0.0)) return "terminal_speed must be > 0 (+inf for no drag)";
-    return "";
-  }
-
-  // The ODE's right-hand side, dv/dt = g (1 - v/v_t)(1 + v/v_t) for v >= 0 (factored: no
-  // cancellation of 1 - v^2/v_t^2 near the terminal speed).
-  double acceleration_at_speed(double v) const {
-    const double r = v / terminal_speed;
-    return g * (1.0 - r) * (1.0 + r);
-  }
 
   fall_state at(double t) const {
     if (!(t > 0.0)) return {0.0, 0.0, 0.0};

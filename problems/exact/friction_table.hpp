@@ -88,13 +88,6 @@ constexpr bool has_name(const friction_record& r, std::string_view name) {
          name.substr(r.upper.size(), on.size()) == on && name.ends_with(r.lower);
 }
 
-// The record named `name`, or nullptr.
-constexpr const friction_record* find_friction(std::string_view name) {
-  for (const auto& r : friction_table)
-    if (has_name(r, name)) return &r;
-  return nullptr;
-}
-
 // The record's name (allocates; for listings, not for inner loops).
 inline std::string friction_name(const friction_record& r) {
   return std::string(r.upper) + "_on_" + std::string(r.lower);
@@ -126,6 +119,5 @@ constexpr bool friction_names_unique() {
 }
 }  // namespace detail
 static_assert(detail::friction_names_unique(), "two friction records answer to the same name");
-static_assert(find_friction("steel_on_steel")->mu_k_dry == 0.57);  // lookup works at compile time
 
 }  // namespace stepbench::exact

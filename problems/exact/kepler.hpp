@@ -23,7 +23,6 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
-#include <string_view>
 
 namespace stepbench::exact {
 
@@ -123,19 +122,9 @@ struct kepler_orbit {
   double a = 1.0;   // semi-major axis
   double e = 0.5;   // eccentricity, 0 <= e < 1
 
-  // Empty when the orbit is an ellipse this code covers.
-  std::string_view invalid_reason() const {
-    if (!(std::isfinite(gm) && gm > 0.0)) return "gm must be finite and > 0";
-    if (!(std::isfinite(a) && a > 0.0)) return "a must be finite and > 0";
-    if (!(e >= 0.0 && e < 1.0)) return "e must be in [0, 1)";
-    return "";
-  }
-
   double mean_motion() const { return std::sqrt(gm / a) / a; }
   double period() const { return 2.0 * std::numbers::pi * a * std::sqrt(a / gm); }
   double semi_minor_axis() const { return a * std::sqrt((1.0 - e) * (1.0 + e)); }
-  double specific_energy() const { return -gm / (2.0 * a); }
-  double angular_momentum() const { return std::sqrt(gm * a) * std::sqrt((1.0 - e) * (1.0 + e)); }
 
   kepler_state initial() const {
     return {a * (1.0 - e), 0.0, 0.0, std::sqrt(gm / a) * std::sqrt((1.0 + e) / (1.0 - e))};

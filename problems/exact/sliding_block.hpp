@@ -35,7 +35,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <string_view>
 
 namespace stepbench::exact {
 
@@ -50,15 +49,6 @@ struct sliding_block {
   double mu_s = 0.5;                  // static friction coefficient
   double mu_k = 0.5;                  // kinetic friction coefficient
   double v0 = 1.0;                    // initial velocity along the slope, positive up
-
-  std::string_view invalid_reason() const {
-    if (!(std::isfinite(g) && g > 0.0)) return "g must be finite and > 0";
-    if (!(theta >= 0.0 && theta <= 1.5707963267948966)) return "theta must be in [0, pi/2]";
-    if (!(std::isfinite(mu_s) && mu_s >= 0.0)) return "mu_s must be finite and >= 0";
-    if (!(std::isfinite(mu_k) && mu_k >= 0.0)) return "mu_k must be finite and >= 0";
-    if (!std::isfinite(v0)) return "v0 must be finite";
-    return "";
-  }
 
   // Magnitude of the deceleration while moving up: g (sin theta + mu_k cos theta).
   double up_deceleration() const { return g * (std::sin(theta) + mu_k * std::cos(theta)); }

@@ -225,10 +225,14 @@ class loop_timer {
 // j-th displayed frame after t = 0 (the initial state, shown at t = 0, is not a frame).
 struct loop_result {
   int dim = 0;
-  std::vector<double> display_t;  // the game clock at each frame
-  std::vector<frame_plan> plan;   // the frame as the timer planned it: its interval, steps, alpha, clamp, stall
-  std::vector<double> shown_t;    // the simulated time of the state it showed (n dt; the blend's (n - 1 + alpha) dt)
-  std::vector<double> shown;      // the shown position, dim per frame
+  std::vector<double> display_t;   // the game clock at each frame
+  std::vector<double> interval;    // the frame's wall duration
+  std::vector<double> frame_time;  // the game time it consumed
+  std::vector<double> shown_t;     // the simulated time of the state it showed (n dt; the blend's (n - 1 + alpha) dt)
+  std::vector<double> alpha;       // accumulator / dt after its steps; NaN for variable and substeps
+  std::vector<int> steps;          // physics steps it took
+  std::vector<std::int8_t> clamped, stall;
+  std::vector<double> shown;          // the shown position, dim per frame
   std::vector<double> final_physics;  // [x; v] after the last whole physics step
   std::vector<double> final_shown;    // [x; v] shown at the last frame (display time = the horizon)
   double physics_t = 0.0;             // the simulated time of final_physics
@@ -240,8 +244,13 @@ struct loop_result {
   template <class X>
   void record(const frame_plan& f, double t_shown, const Eigen::MatrixBase<X>& x) {
     display_t.push_back(f.game_t);
-    plan.push_back(f);
+    interval.push_back(f.interval);
+    frame_time.push_back(f.frame_time);
     shown_t.push_back(t_shown);
+    alpha.push_back(f.alpha);
+    steps.push_back(f.steps);
+    clamped.push_back(f.clamped);
+    stall.push_back(f.stall);
     shown.insert(shown.end(), x.derived().data(), x.derived().data() + x.size());
   }
 };
@@ -347,6 +356,7 @@ struct loop_schedule {
   double frame_budget_s = 0.0;  // 1 / display rate
   long frames = 0;              // frames to the horizon
   long late_frames = 0;         // frames whose physics work outlasted their display interval (their budget)
+  int steps_max = 0;            // most steps in one frame (with the feedback)
   double worst_work_s = 0.0;    // the most physics work in one frame
   double load = 0.0;            // physics work over the game time it advanced, over the run
   double wall_s = 0.0;          // wall time the run took to reach the horizon
@@ -376,6 +386,7 @@ inline loop_schedule schedule_loop(const loop_config& cfg, double step_cost_s) {
     if (f.game_t <= cfg.horizon) {
       ++out.frames;
       out.late_frames += late;
+      out.steps_max = std::max(out.steps_max, f.steps);
       out.worst_work_s = std::max(out.worst_work_s, work);
       total_work += work;
       game = f.game_t;

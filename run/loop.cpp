@@ -70,15 +70,14 @@ void count_steps(loop_row& row, const loop_config& config, const loop_result& ru
   row.alpha_min = row.alpha_max = nan;
   double lag_clock = 0.0;
   for (std::size_t j = 0; j < counted; ++j) {
-    const frame_plan& f = run.plan[j];
-    steps += f.steps;
-    row.steps_per_frame_max = std::max<long>(row.steps_per_frame_max, f.steps);
-    if (f.stall) row.stall_burst_steps = f.steps;
-    row.clamp_hits += f.clamped;
+    steps += run.steps[j];
+    row.steps_per_frame_max = std::max<long>(row.steps_per_frame_max, run.steps[j]);
+    if (run.stall[j]) row.stall_burst_steps = run.steps[j];
+    row.clamp_hits += run.clamped[j];
     lag_clock += run.display_t[j] - run.shown_t[j];
     if (uses_accumulator(config.design)) {
-      row.alpha_min = j == 0 ? f.alpha : std::min(row.alpha_min, f.alpha);
-      row.alpha_max = j == 0 ? f.alpha : std::max(row.alpha_max, f.alpha);
+      row.alpha_min = j == 0 ? run.alpha[j] : std::min(row.alpha_min, run.alpha[j]);
+      row.alpha_max = j == 0 ? run.alpha[j] : std::max(row.alpha_max, run.alpha[j]);
     }
   }
   row.steps_per_frame_mean = counted ? static_cast<double>(steps) / static_cast<double>(counted) : nan;
@@ -137,9 +136,8 @@ loop_row measure_loop(const loop_config& config, std::string clock, const loop_r
   // what final_shown_err and the frame-rate independence compare).
   std::size_t counted = frames;
   if (frames > 0) {
-    const frame_plan& last = run.plan.back();
-    const double full = config.clamp_s > 0.0 ? std::min(last.interval, config.clamp_s) : last.interval;
-    if (last.frame_time < full * (1.0 - 1e-9)) counted = frames - 1;
+    const double full = config.clamp_s > 0.0 ? std::min(run.interval.back(), config.clamp_s) : run.interval.back();
+    if (run.frame_time.back() < full * (1.0 - 1e-9)) counted = frames - 1;
   }
   row.frames = static_cast<long>(counted);
 

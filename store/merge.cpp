@@ -177,6 +177,7 @@ void join_table(const std::vector<shard_file>& shards, H5::Group& dst, const std
       h5::column joined = columns_detail::empty_column(f.type);
       std::visit(
           [&]<class T>(std::vector<T>& v) {
+            v.reserve(rows.size());
             for (const auto& [r, k, i] : rows) v.push_back(columns_detail::value_at<T>(columns[k], i));
           },
           joined);

@@ -258,7 +258,7 @@ def test_display_only_when_asked_and_never_the_debug_line(bench, tmp_path):
     """A study run keeps Google Benchmark's table off the terminal unless --verbose (which
     shows the whole context); a plain run shows it, without the DEBUG-build line; a
     --benchmark_out given replaces bench.json."""
-    one = ["--problem=pendulum", f"--benchmark_filter={ONE_CASE}"]
+    one = ["--problem=pendulum", "--parts=sweep", f"--benchmark_filter={ONE_CASE}"]  # the display only
     done = run_bench(bench, *one, f"--study_out={tmp_path / 'a.h5'}", check=True)
     assert "real_time" not in done.stdout and (tmp_path / "bench.json").exists()
     assert not [p for p in tmp_path.iterdir() if ".tmp." in p.name]

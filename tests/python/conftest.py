@@ -1,4 +1,5 @@
-"""Shared fixtures: the executables, two real study files made once per session, a plain
+"""Shared fixtures: the executables, two real study files made once per session (under
+ctest, once a run of the suite, for both pytest runs: tests/CMakeLists.txt), a plain
 sweep and a quick timed study (every method, every problem), that the study-file, report
 and benchmark tests all read, and the report of each, drawn once per session, that the
 report, scan, challenge and browser tests read."""
@@ -29,6 +30,9 @@ def run_study(args, **kwargs):
 
 def pytest_addoption(parser):
     parser.addoption("--stepbench", required=True, help="path to the stepbench executable")
+    parser.addoption("--plain-study", default=None,
+                     help="a quick sweep already made (ctest's plain_study fixture: stepbench sweep "
+                          "--quick --out PATH); without it the session makes one")
     parser.addoption("--timed-study", default=None,
                      help="a quick timed study already made (ctest's quick_study fixture: "
                           "stepbench_bench --quick --study_out=PATH, its stdout and stderr in "
@@ -49,8 +53,13 @@ def bench(stepbench):
 
 
 @pytest.fixture(scope="session")
-def plain_study(stepbench, tmp_path_factory):
-    """`stepbench sweep --quick`: every method on every problem, no timings."""
+def plain_study(stepbench, tmp_path_factory, request):
+    """`stepbench sweep --quick`: every method on every problem, no timings. Under ctest it
+    is made once (fixture plain_study) for the two pytest runs that read it."""
+    given = request.config.getoption("--plain-study")
+    if given:
+        assert pathlib.Path(given).is_file(), f"--plain-study {given}: not made"
+        return pathlib.Path(given)
     path = tmp_path_factory.mktemp("plain") / "study.h5"
     run_study([stepbench, "sweep", "--quick", "--quiet", "--out", str(path)], stdout=subprocess.DEVNULL)
     return path

@@ -410,7 +410,7 @@ TEST(sweep, fixed_ladder_runs_to_round_off_or_the_work_budget) {
   const auto& spring = find(default_study(), "damped_spring");
   const auto& verlet = find(spring, "velocity_verlet");
   EXPECT_GT(verlet.rows.size(), 12u);
-  if (opts.max_levels == sweep_options{}.max_levels) {  // the default ladder (not the sanitizers' 14 levels)
+  if (opts.max_levels == sweep_options{}.max_levels) {  // the default ladder (not the sanitizers' 13 levels)
     EXPECT_LT(verlet.rows.back().metrics.err_pos_max, 1e-12);
   }
   EXPECT_TRUE(find(spring, "rk4").ladder_end.starts_with("round-off")) << find(spring, "rk4").ladder_end;

@@ -11,7 +11,9 @@ trap 'rm -rf "$work"' EXIT
 fails=0
 bad() { echo "FAIL: $*"; fails=$((fails + 1)); }
 
-sweep=(sweep --quick --quiet --problem damped_spring)
+# The sweep part alone: the writer is the same for every part (the whole quick study of the
+# problem took 22 s under the sanitizers).
+sweep=(sweep --quick --quiet --problem damped_spring --parts sweep)
 "$bin" "${sweep[@]}" --out "$work/study.h5" >/dev/null || { echo "FAIL: the first sweep failed"; exit 1; }
 cp "$work/study.h5" "$work/previous.h5"
 size=$(stat -c %s "$work/study.h5")

@@ -11,7 +11,8 @@
 
 #include <gtest/gtest.h>
 
-#include <Eigen/Dense>
+#include <Eigen/Core>
+#include <Eigen/LU>
 #include <algorithm>
 #include <atomic>
 #include <chrono>

@@ -57,6 +57,10 @@ void set_timings(study& s, double ns, double spread, long reps) {
         if (!r.metrics.diverged && !r.metrics.failed) r.time = {ns, ns * (1 - spread), ns * (1 + spread), reps, false};
 }
 
+}  // namespace
+
+// The fixture has external linkage: a TEST_F class (global) derives from it, and in the
+// tests' unity unit this file is not the main file (-Wsubobject-linkage).
 class compare_test : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -78,6 +82,8 @@ class compare_test : public ::testing::Test {
  private:
   fs::path dir_;
 };
+
+namespace {
 
 // Rewrites one field of one row of /problems/<problem>/methods/<method>/runs in place,
 // through a compound type holding only that field (HDF5 partial I/O).

@@ -18,6 +18,7 @@
 #include "problems/bouncing_balls.hpp"
 #include "registry/registry.hpp"
 #include "run/sweep.hpp"
+#include "run_fixed.hpp"
 
 using namespace stepbench;
 
@@ -26,12 +27,7 @@ namespace {
 bouncing_ball ball() { return bouncing_ball{}; }
 bouncing_ball_locate located_ball() { return bouncing_ball_locate{}; }
 
-template <class P, class I>
-drive_result<typename P::vec> run_fixed(const P& p, const I& method, double dt) {
-  const auto times = sample_times(p.horizon(), 4);
-  const auto plan = plan_records(p.horizon(), dt, times);
-  return drive(p, method, dt, p.horizon(), plan);
-}
+using test_support::run_fixed;
 
 }  // namespace
 

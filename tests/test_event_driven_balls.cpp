@@ -15,7 +15,7 @@
 #include "default_ball_scene.hpp"
 #include "problems/exact/event_driven_balls.hpp"
 
-using namespace stepbench::exact;
+namespace stepbench::exact {
 
 namespace {
 
@@ -532,3 +532,5 @@ TEST(chaos, separation_growth) {
   std::printf("[ chaos    ] mean over %d seeds: growth %.2f per ball-ball contact, lambda %.1f /s (x10 every %.3f s)\n",
               runs, sum_growth / runs, sum_lambda / runs, std::log(10.0) / (sum_lambda / runs));
 }
+
+}  // namespace stepbench::exact

@@ -22,7 +22,7 @@
 #include "problems/exact/kepler.hpp"
 #include "problems/exact/sliding_block.hpp"
 
-using namespace stepbench::exact;
+namespace stepbench::exact {
 
 namespace {
 
@@ -838,3 +838,5 @@ TEST(bouncing_ball, contact_index_brackets_t_up_to_the_accumulation_time) {
 }
 
 }  // namespace
+
+}  // namespace stepbench::exact

@@ -18,20 +18,12 @@
 #include "registry/registry.hpp"
 #include "run/energy.hpp"
 #include "run/sweep.hpp"
+#include "run_fixed.hpp"
 #include "study/energy.hpp"
 
 using namespace stepbench;
 
-namespace {
-
-template <class P, class I>
-drive_result<typename P::vec> run_fixed(const P& p, const I& method, double dt, int samples = 4) {
-  const auto times = sample_times(p.horizon(), samples);
-  const auto plan = plan_records(p.horizon(), dt, times);
-  return drive(p, method, dt, p.horizon(), plan);
-}
-
-}  // namespace
+using test_support::run_fixed;
 
 // Every reference solver agrees with Kepler's equation (the closed form) to 1e-9 relative
 // over the three orbits of e = 0.9.

@@ -50,6 +50,11 @@ struct study_part {
   std::string_view summary;                    // what it answers, one line (`stepbench list --parts`)
   std::string_view group = {};                 // its group under the file's root when not its name ("problems")
   merge_rule merge = merge_rule::per_problem;  // how the shards of a study hold it (store/merge.hpp)
+  // Its rows are cases stepbench_bench times (bench/cases.cpp): a listing of the cases
+  // (--benchmark_list_tests) runs only the parts that have them.
+  bool has_timed_cases = false;
+  // Its progress advances once a problem (part_context::step_done), not once a run.
+  bool progress_per_problem = false;
   // judged_again: what spans problems, judged again on the merged file.
   void (*judge_again)(H5::Group& root, const std::vector<std::string>& problems) = nullptr;
   // The tables it writes that no column map of store/ declares: a part's own, declared in

@@ -27,7 +27,7 @@ std::string describe_options(const sweep_options& opts) {
 
 std::size_t sweep_parts(const sweep_options& opts) {
   std::size_t n = 0;
-  for (const auto* p : selected_parts(opts)) n += p->name == "sweep" ? shard_problems(opts).size() : 1;
+  for (const auto* p : selected_parts(opts)) n += p->progress_per_problem ? shard_problems(opts).size() : 1;
   return n;
 }
 

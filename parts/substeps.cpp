@@ -13,6 +13,7 @@ namespace stepbench {
 extern const study_part substeps_part{
     .name = "substeps",
     .summary = "n explicit substeps a frame against one implicit step, at equal cost and equal error",
+    .has_timed_cases = true,
     .describe =
         [](const sweep_options& o) {
           const auto& ss = o.substeps;

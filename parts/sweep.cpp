@@ -69,6 +69,8 @@ extern const study_part sweep_part{
     .name = "sweep",
     .summary = "every method on every problem over its dt or tolerance ladder, measured against the truth",
     .group = "problems",
+    .has_timed_cases = true,
+    .progress_per_problem = true,
     .describe = describe,
     .run = run,
     .write = write_problems,

@@ -46,10 +46,13 @@ void validate(const sweep_options& opts) {
   // every rate's: each rate must divide the fastest.
   if (!opts.frame_rates.hz.empty()) {
     const double fastest = *std::max_element(opts.frame_rates.hz.begin(), opts.frame_rates.hz.end());
-    for (double hz : opts.frame_rates.hz)
-      if (!(hz > 0.0) || std::abs(fastest / hz - std::round(fastest / hz)) > 1e-9)
+    for (double hz : opts.frame_rates.hz) {
+      if (!(hz > 0.0 && std::isfinite(hz)))
+        throw std::invalid_argument(fmt::format("frame rate {:g} Hz is not a positive, finite rate", hz));
+      if (std::abs(fastest / hz - std::round(fastest / hz)) > 1e-9)
         throw std::invalid_argument(
             fmt::format("frame rate {:g} Hz does not divide the fastest, {:g} Hz", hz, fastest));
+    }
   }
   if (opts.shard_count < 1 || opts.shard_index < 0 || opts.shard_index >= opts.shard_count)
     throw std::invalid_argument(fmt::format("shard {} of {} does not exist", opts.shard_index + 1, opts.shard_count));

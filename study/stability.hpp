@@ -25,7 +25,7 @@
 
 namespace stepbench {
 
-// The two linear test problems (defined in study/stability.cpp, not study problems):
+// The two linear test problems (defined in run/stability.cpp, not study problems):
 //   oscillator  x'' = -omega^2 x, as the force F = -m omega^2 x; y = omega dt;
 //   decay       a pure damper F = -m lambda v, so v' = -lambda v and x only integrates v
 //               (the form a damper takes in a game; the velocity equation is the one that

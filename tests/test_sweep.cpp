@@ -226,6 +226,27 @@ TEST(sweep, invalid_options_are_rejected) {
   opts = {};
   opts.tolerances = {0.0};
   EXPECT_THROW(validate(opts), std::invalid_argument);
+  // The frame rates: each positive and finite (an infinite rate divided the infinite
+  // fastest to NaN, which passed the divisibility check), and each a divisor of the fastest.
+  const auto message = [](const sweep_options& o) {
+    try {
+      validate(o);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  for (const double bad :
+       {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN(), 0.0, -60.0}) {
+    opts = {};
+    opts.frame_rates.hz = {60.0, bad};
+    EXPECT_NE(message(opts).find("is not a positive, finite rate"), std::string::npos) << bad << ": " << message(opts);
+  }
+  opts = {};
+  opts.frame_rates.hz = {60.0, 45.0};
+  EXPECT_EQ(message(opts), "frame rate 45 Hz does not divide the fastest, 60 Hz");
+  opts.frame_rates.hz = {30.0, 60.0, 120.0};
+  EXPECT_EQ(message(opts), "accepted");
 }
 
 // Explicit Euler on m x'' + c x' + k x = 0 multiplies each mode by 1 + h lambda, lambda =

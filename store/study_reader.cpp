@@ -3,7 +3,6 @@
 #include <H5Cpp.h>
 #include <fcntl.h>
 #include <fmt/format.h>
-#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -16,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "store/bounded_child.hpp"
 #include "store/h5.hpp"
 #include "store/study_file.hpp"
 
@@ -76,6 +76,9 @@ struct reading_child {
   int fd = -1;
 };
 
+// The CPU time a child may take to read one file (a whole study reads in well under a second).
+constexpr long reading_cpu_seconds = 20;
+
 std::runtime_error cannot_read(const std::string& path, const std::string& what) {
   return std::runtime_error(fmt::format("cannot read study file '{}': {}", path, what));
 }
@@ -126,16 +129,10 @@ reading_child start_reading(const std::string& path, const study_parts_reader& r
     // under a second and a few hundred MB, so past these the file is damaged: the child
     // is stopped (SIGXCPU) or its allocation fails, and the parent says so. (Not the
     // address-space bound under AddressSanitizer, which reserves terabytes of it.)
-    const rlimit cpu{20, 20};
-    ::setrlimit(RLIMIT_CPU, &cpu);
-#if !defined(__SANITIZE_ADDRESS__)
     // The memory bound: 2 GiB for HDF5's work, plus the bytes of this file and of those
     // read before it (inherited), each held up to three times (ours, HDF5's copy, its
     // core file).
-    const std::size_t bound = (std::size_t{2} << 30) + 3 * held;
-    const rlimit memory{bound, bound};
-    ::setrlimit(RLIMIT_AS, &memory);
-#endif
+    bound_child(reading_cpu_seconds, (std::size_t{2} << 30) + 3 * held);
     const int null = ::open("/dev/null", O_WRONLY);
     ::dup2(null, STDOUT_FILENO);
     ::dup2(null, STDERR_FILENO);
@@ -175,12 +172,8 @@ study finish_reading(reading_child& c) {
   c.pid = -1;
   // How the child ended when it did not end normally: a signal ("SIGSEGV"), or a
   // sanitizer's report ("exit 1").
-  if (WIFSIGNALED(status) && WTERMSIG(status) == SIGXCPU)
-    throw fail("damaged: reading it did not end within 20 s of CPU time (HDF5 looping on it)");
-  if (WIFSIGNALED(status))
-    throw fail(fmt::format("damaged: reading it crashes the HDF5 library (SIG{})", sigabbrev_np(WTERMSIG(status))));
-  if (WEXITSTATUS(status) != 0)
-    throw fail(fmt::format("damaged: reading it crashes the HDF5 library (exit {})", WEXITSTATUS(status)));
+  if (WIFSIGNALED(status) || WEXITSTATUS(status) != 0)
+    throw fail(abnormal_end(status, reading_cpu_seconds, "reading it"));
   if (!answer.empty() && answer[0] == 'H')
     throw fail(fmt::format("HDF5: {} (truncated or corrupt?)", answer.substr(1)));
   if (!answer.empty()) throw fail(answer.substr(1));

@@ -5,9 +5,11 @@ fixed seed, each copy with 1 to 64 random bytes changed or (one in eight) cut sh
 the reading commands (advise, compare, ratios) read the copies in turn, and each must
 end by an exit status it documents, never by a signal, with at most one line on
 stderr; so must `advise --scan` on as many damaged copies of a small scan file
-(seed SEED + 1). The report's readers (scripts/stepbench_report: study.load, and on a copy it
-accepts scan.load and the range answers, as the report reads them) read every copy in
-one child process, which must end normally too, each refusal one line naming the copy.
+(seed SEED + 1), and `merge` of a quarter as many damaged copies of a study shard with
+the other, intact shard (seed SEED + 2; a merge it made prints its summary). The
+report's readers (scripts/stepbench_report: study.load, and on a copy it accepts
+scan.load and the range answers, as the report reads them) read every copy in one child
+process, which must end normally too, each refusal one line naming the copy.
 No run may hang: each has a timeout, past which it is a failure. The runs go two at a
 time (WORKERS).
 
@@ -26,7 +28,8 @@ SEED = 16
 PROBLEM = "damped_spring"
 # What each command may answer with: advise 3 is "no method meets the tolerance", which a
 # changed error column can make true.
-ALLOWED = {"advise": (0, 1, 2, 3), "compare": (0, 1, 2), "ratios": (0, 1, 2), "advise --scan": (0, 1, 2, 3)}
+ALLOWED = {"advise": (0, 1, 2, 3), "compare": (0, 1, 2), "ratios": (0, 1, 2), "advise --scan": (0, 1, 2, 3),
+           "merge": (0, 1, 2)}
 SCAN = ["--problem", "stiff_spring", "--param", "stiff_spring.k_s=1e1:1e3:3:log", "--hz", "60", "--substeps", "1"]
 SCRIPTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scripts")
 
@@ -105,15 +108,25 @@ def main():
                        check=True, stdout=subprocess.DEVNULL)
         scan_base = os.path.join(work, "scan.h5")
         subprocess.run([stepbench, "scan", *SCAN, "--quiet", "--out", scan_base], check=True, stdout=subprocess.DEVNULL)
+        # The two shards of a two-problem study: merge reads a damaged copy of the first
+        # with the second.
+        shards = [os.path.join(work, f"shard{k}.h5") for k in (1, 2)]
+        for k, shard in enumerate(shards, 1):
+            subprocess.run([stepbench, "sweep", "--quick", "--quiet", "--problem", PROBLEM, "--problem", "projectile",
+                            "--shard", f"{k}/2", "--out", shard], check=True, stdout=subprocess.DEVNULL)
         with open(base, "rb") as f:
             data = f.read()
         with open(scan_base, "rb") as f:
             scan_data = f.read()
+        with open(shards[0], "rb") as f:
+            shard_data = f.read()
         # One random stream a file, so that the study's copies are those of the seed alone.
-        paths, scan_paths = [], []
-        for name, original, into, seed in (("copy", data, paths, SEED), ("scan", scan_data, scan_paths, SEED + 1)):
+        paths, scan_paths, shard_paths = [], [], []
+        for name, original, into, seed, n in (("copy", data, paths, SEED, copies),
+                                              ("scan", scan_data, scan_paths, SEED + 1, copies),
+                                              ("shard", shard_data, shard_paths, SEED + 2, copies // 4)):
             rng = random.Random(seed)
-            for k in range(copies):
+            for k in range(n):
                 path = os.path.join(work, f"{name}{k:03d}.h5")
                 with open(path, "wb") as f:
                     f.write(mutate(original, rng))
@@ -140,7 +153,9 @@ def main():
                 return "compare", ["compare", base, path] if k % 2 == 0 else ["compare", path, base]
             return "ratios", ["ratios", "--study", path]
         commands = [study_command(k, path) for k, path in enumerate(paths)] + \
-            [("advise --scan", ["advise", "--scan", path, "--tol", "1e-3"]) for path in scan_paths]
+            [("advise --scan", ["advise", "--scan", path, "--tol", "1e-3"]) for path in scan_paths] + \
+            [("merge", ["merge", *((path, shards[1]) if k % 2 == 0 else (shards[1], path)), "-o",
+                        os.path.join(work, "merged.h5")]) for k, path in enumerate(shard_paths)]
         report_timeout = REPORT_TIMEOUT_BASE + REPORT_TIMEOUT_PER_COPY * copies
         start = time.monotonic()
         with ThreadPoolExecutor(WORKERS) as pool:
@@ -152,7 +167,9 @@ def main():
             for (name, args), done in zip(commands, runs):
                 key = (name, outcome(done, COMMAND_TIMEOUT))
                 counts[key] = counts.get(key, 0) + 1
-                if done.returncode not in ALLOWED[name] or len(done.stderr.splitlines()) > 1:
+                # One line on stderr, but for merge's summary of a merge it made.
+                lines = len(done.stderr.splitlines())
+                if done.returncode not in ALLOWED[name] or (lines > 1 and (done.returncode != 0 or name != "merge")):
                     failures.append(f"{' '.join(args)}: {outcome(done, COMMAND_TIMEOUT)}, "
                                     f"stderr: {done.stderr.strip()!r}")
             report = report.result()
@@ -160,8 +177,8 @@ def main():
             last = report.stdout.split()[-1:] or ["(before the first copy)"]
             failures.append(f"report reader: {outcome(report, report_timeout)} at {last[0]}: "
                             f"{report.stderr.strip().splitlines()[-1:]}")
-        print(f"{copies} damaged copies of a {len(data)}-byte study and of a {len(scan_data)}-byte scan file "
-              f"(seed {SEED}), read in "
+        print(f"{copies} damaged copies of a {len(data)}-byte study and of a {len(scan_data)}-byte scan file, "
+              f"{len(shard_paths)} of a {len(shard_data)}-byte study shard (seed {SEED}), read in "
               f"{time.monotonic() - start:.0f} s by {WORKERS} workers:")
         for (name, end), n in sorted(counts.items()):
             print(f"  {name:13} {end}: {n}")

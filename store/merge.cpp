@@ -74,7 +74,10 @@ void replace_attr(H5::H5Object& obj, const std::string& name, const T& value) {
 // The object at `path` in `src`, copied whole (attributes, datasets, subgroups) to the
 // same path in `dst`.
 void copy_object(const H5::H5File& src, H5::H5File& dst, const std::string& path) {
-  check(H5Ocopy(src.getId(), path.c_str(), dst.getId(), path.c_str(), H5P_DEFAULT, H5P_DEFAULT), "H5Ocopy");
+  if (H5Ocopy(src.getId(), path.c_str(), dst.getId(), path.c_str(), H5P_DEFAULT, H5P_DEFAULT) < 0)
+    throw std::runtime_error(
+        fmt::format("cannot copy /{} from study shard '{}': HDF5: H5Ocopy failed (truncated or corrupt?)", path,
+                    src.getFileName()));
 }
 
 struct shard_file {

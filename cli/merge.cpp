@@ -145,10 +145,10 @@ int run_merge_isolated(const merge_args& a) {
       if (const auto size = std::filesystem::file_size(path, ec); !ec) bytes += size;
     }
   // A merge of the default study's shards takes about a second; the memory bound is the
-  // readers' (2 GiB for HDF5's work and each file three times).
+  // readers'.
   constexpr long merge_cpu_seconds = 60;
   return run_in_bounded_child(
-      [&] { return run_merge(a); }, merge_cpu_seconds, (std::size_t{2} << 30) + 3 * bytes, "merging them",
+      [&] { return run_merge(a); }, merge_cpu_seconds, child_memory_bound(bytes), "merging them",
       [&](const std::string& end) {
         read_studies(a.inputs);  // throws naming the first shard it cannot read
         throw std::runtime_error(fmt::format("merge: the shards {}: {}", fmt::join(a.inputs, ", "), end));

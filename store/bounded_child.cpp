@@ -11,19 +11,10 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "store/study_file.hpp"
+
 namespace stepbench {
-namespace {
-
-void write_all(int fd, const std::string& text) {
-  for (std::size_t done = 0; done < text.size();) {
-    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return;  // the reader is gone: nothing to tell
-    done += static_cast<std::size_t>(n);
-  }
-}
-
-std::string read_all(int fd) {
+std::string read_to_end(int fd) {
   std::string out;
   char buf[1 << 12];
   for (;;) {
@@ -33,8 +24,6 @@ std::string read_all(int fd) {
     out.append(buf, static_cast<std::size_t>(n));
   }
 }
-
-}  // namespace
 
 void bound_child(long cpu_seconds, std::size_t memory_bytes) {
   const rlimit cpu{static_cast<rlim_t>(cpu_seconds), static_cast<rlim_t>(cpu_seconds)};
@@ -89,11 +78,11 @@ int run_in_bounded_child(const std::function<int()>& work, long cpu_seconds, std
       answer = std::string("E") + e.what();
     }
     std::fflush(nullptr);
-    write_all(fds[1], answer);
+    write_bytes(fds[1], answer.data(), answer.size());  // failing when the parent is gone: nothing to tell
     std::_Exit(0);
   }
   ::close(fds[1]);
-  const std::string answer = read_all(fds[0]);
+  const std::string answer = read_to_end(fds[0]);
   ::close(fds[0]);
   int status = 0;
   while (::waitpid(child, &status, 0) < 0)
@@ -104,7 +93,7 @@ int run_in_bounded_child(const std::function<int()>& work, long cpu_seconds, std
   const bool ended_by_itself = WIFEXITED(status) && WEXITSTATUS(status) == 0 && !answer.empty();
   if (ended_by_itself) {
     ::lseek(::fileno(err), 0, SEEK_SET);  // the child's writes moved the offset it shares
-    std::fputs(read_all(::fileno(err)).c_str(), stderr);
+    std::fputs(read_to_end(::fileno(err)).c_str(), stderr);
   }
   std::fclose(err);
   if (!ended_by_itself) {

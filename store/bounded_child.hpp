@@ -17,6 +17,14 @@ namespace stepbench {
 // terabytes of address space for itself).
 void bound_child(long cpu_seconds, std::size_t memory_bytes);
 
+// The memory bound of a child that works on files of `file_bytes` in all: 2 GiB for
+// HDF5's work, plus the files, each held up to three times (ours, HDF5's copy, its core
+// file).
+constexpr std::size_t child_memory_bound(std::size_t file_bytes) { return (std::size_t{2} << 30) + 3 * file_bytes; }
+
+// Everything a child writes to `fd` until it closes it (or ends).
+std::string read_to_end(int fd);
+
 // How a child that was waited for with `status` ended, when the work in it did not end
 // by itself: "damaged: <doing> did not end within N s of CPU time (HDF5 looping on it)",
 // or "damaged: <doing> crashes the HDF5 library (SIGSEGV)" (a signal; "exit 1" for a

@@ -129,10 +129,8 @@ reading_child start_reading(const std::string& path, const study_parts_reader& r
     // under a second and a few hundred MB, so past these the file is damaged: the child
     // is stopped (SIGXCPU) or its allocation fails, and the parent says so. (Not the
     // address-space bound under AddressSanitizer, which reserves terabytes of it.)
-    // The memory bound: 2 GiB for HDF5's work, plus the bytes of this file and of those
-    // read before it (inherited), each held up to three times (ours, HDF5's copy, its
-    // core file).
-    bound_child(reading_cpu_seconds, (std::size_t{2} << 30) + 3 * held);
+    // The memory bound counts this file and those read before it (inherited).
+    bound_child(reading_cpu_seconds, child_memory_bound(held));
     const int null = ::open("/dev/null", O_WRONLY);
     ::dup2(null, STDOUT_FILENO);
     ::dup2(null, STDERR_FILENO);
@@ -156,14 +154,7 @@ reading_child start_reading(const std::string& path, const study_parts_reader& r
 // The study, once the child has read it whole; throws the line read_study prints.
 study finish_reading(reading_child& c) {
   const auto fail = [&](const std::string& what) { return cannot_read(c.path, what); };
-  std::string answer;
-  char buf[1 << 12];
-  for (;;) {
-    const ssize_t n = ::read(c.fd, buf, sizeof buf);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) break;
-    answer.append(buf, static_cast<std::size_t>(n));
-  }
+  const std::string answer = read_to_end(c.fd);
   ::close(c.fd);
   c.fd = -1;
   int status = 0;

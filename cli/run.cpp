@@ -100,12 +100,17 @@ int run_run(const run_args& a) {
   const run_metrics metrics = measure(problem, run, truth);
 
   // Positions and velocities as the errors are measured: the problem's observed
-  // positions (n_pendulum's bobs in m, not its link angles), else its state.
+  // positions (n_pendulum's bobs in m, not its link angles), else its state; for the run,
+  // the ones it draws (xpbd's particles: run_record's drawn_final).
   const int dim = problem.observed_dim();
   auto part = [&](const std::vector<double>& y, int offset) {
     if (y.empty()) return std::vector<double>{};
     const std::vector<double> o = problem.observed(y);
     return std::vector<double>(o.begin() + offset, o.begin() + offset + dim);
+  };
+  auto drawn = [&](int offset) {
+    if (run.drawn_final.empty()) return part(run.final_y, offset);
+    return std::vector<double>(run.drawn_final.begin() + offset, run.drawn_final.begin() + offset + dim);
   };
   json out = run.work;  // force_evals, jacobian_evals, newton_iterations, linear_solves
   out.update(metrics);  // the errors, diverged and failed
@@ -117,8 +122,8 @@ int run_run(const run_args& a) {
               {"horizon", horizon},
               {"steps", run.steps},
               {"rejected_steps", run.rejected_steps},
-              {"position", part(run.final_y, 0)},
-              {"velocity", part(run.final_y, dim)},
+              {"position", drawn(0)},
+              {"velocity", drawn(dim)},
               {"truth_source", truth.source},
               {"true_position", part(truth.y.back(), 0)},
               {"true_velocity", part(truth.y.back(), dim)}});
@@ -139,8 +144,8 @@ int run_run(const run_args& a) {
   const std::string pos_label = fmt::format("position [{}]", unit), vel_label = fmt::format("velocity [{}/s]", unit);
   const std::size_t w = std::max<std::size_t>(14, vel_label.size());
   fmt::print("  {:<{}} {}\n", pos_label, w,
-             with_truth(part(run.final_y, 0), part(truth.y.back(), 0), fmt::format(", from {}", truth.source)));
-  fmt::print("  {:<{}} {}\n", vel_label, w, with_truth(part(run.final_y, dim), part(truth.y.back(), dim), ""));
+             with_truth(drawn(0), part(truth.y.back(), 0), fmt::format(", from {}", truth.source)));
+  fmt::print("  {:<{}} {}\n", vel_label, w, with_truth(drawn(dim), part(truth.y.back(), dim), ""));
   fmt::print("  {:<{}} {:.6e} {}\n", "err_pos_final", w, metrics.err_pos_final, unit);
   fmt::print("  {:<{}} {:.6e} {}/s\n", "err_vel_final", w, metrics.err_vel_final, unit);
   fmt::print("  {:<{}} {:.6e} {}\n", "err_pos_max", w, metrics.err_pos_max, unit);

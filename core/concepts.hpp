@@ -162,6 +162,16 @@ concept has_observed_positions = requires(const P& p, const typename P::vec& x, 
   {p.observe(x, x, out, out)};
 };
 
+// A scene of several bodies (n_pendulum's bobs, spring_chain's masses, bouncing_balls):
+// its observed positions are blocks of body_dim() coordinates, one block a body, and a
+// position error is the largest of any one body's Euclidean error (what a player sees:
+// the body furthest off), not the norm of the stacked vector, which grows like sqrt(N)
+// on N bodies equally off. A problem without it is one body.
+template <class P>
+concept has_bodies = requires(const P& p) {
+  { p.body_dim() } -> std::convertible_to<int>;
+};
+
 // A problem with a period (pendulum, kepler): the long-run energy study counts its
 // horizon in periods.
 template <class P>

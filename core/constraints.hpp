@@ -44,6 +44,15 @@ concept has_constraint_view = requires(const P& p, const typename P::vec& x, typ
   {p.from_particles(s, out, out)};
 };
 
+// A problem whose positions are observed (has_observed_positions) and which position-based
+// methods step as particles (has_constraint_view): `observe_particles` writes the
+// positions and velocities those particles draw, in observe's layout. XPBD is scored on
+// them, not on the state read back from them (which puts the bobs back on exact links).
+template <class P>
+concept has_drawn_particles = requires(const P& p, const particle_system& s, Eigen::VectorXd& out) {
+  {p.observe_particles(s, out, out)};
+};
+
 // The distance a constraint holds: from its particle a (or its anchor) to particle b.
 inline double constraint_length(const particle_system& s, const distance_constraint& c) {
   const Eigen::Vector3d pa = c.a < 0 ? c.anchor : Eigen::Vector3d(s.x.col(c.a));

@@ -21,12 +21,23 @@ double norm(std::span<const double> a, int offset, int dim, std::span<const doub
   return std::sqrt(s);
 }
 
-agreement compare(std::span<const std::vector<double>> a, std::span<const std::vector<double>> b, int dim,
+double worst_body(std::span<const double> a, int offset, int dim, int body_dim, std::span<const double> b) {
+  if (body_dim >= dim) return norm(a, offset, dim, b);
+  double worst = 0.0;
+  for (int i = 0; i < dim; i += body_dim) {
+    const double e = norm(a, offset + i, body_dim, b);
+    if (std::isnan(e)) return e;
+    worst = std::max(worst, e);
+  }
+  return worst;
+}
+
+agreement compare(std::span<const std::vector<double>> a, std::span<const std::vector<double>> b, int dim, int body_dim,
                   double pos_scale, double vel_scale) {
   agreement out;
   for (size_t j = 0; j < a.size(); ++j) {
-    out.pos_rel = std::max(out.pos_rel, norm(a[j], 0, dim, b[j]) / pos_scale);
-    out.vel_rel = std::max(out.vel_rel, norm(a[j], dim, dim, b[j]) / vel_scale);
+    out.pos_rel = std::max(out.pos_rel, worst_body(a[j], 0, dim, body_dim, b[j]) / pos_scale);
+    out.vel_rel = std::max(out.vel_rel, worst_body(a[j], dim, dim, body_dim, b[j]) / vel_scale);
   }
   return out;
 }
@@ -50,20 +61,20 @@ agreement compare_observed(const problem_instance& p, std::span<const std::vecto
     for (const auto& y : ys) out.push_back(p.observed(y));
     return out;
   };
-  return compare(observed(a), observed(b), p.observed_dim(), t.pos_scale, t.vel_scale);
+  return compare(observed(a), observed(b), p.observed_dim(), p.body_dim(), t.pos_scale, t.vel_scale);
 }
 
 void set_scales(const problem_instance& p, truth_table& t) {
-  const int dim = p.observed_dim();
+  const int dim = p.observed_dim(), body = p.body_dim();
   const auto y0 = p.initial();
   const auto o0 = p.observed(y0);
-  double xs = norm(o0, 0, dim), vs = norm(o0, dim, dim);
+  double xs = worst_body(o0, 0, dim, body), vs = worst_body(o0, dim, dim, body);
   double es = p.has_energy() ? std::max(std::abs(p.energy(y0)), kinetic(p, y0)) : 1.0;
   double ls = p.has_angular_momentum() ? std::abs(p.angular_momentum(y0)) : 0.0;
   for (const auto& y : t.y) {
     const auto o = p.observed(y);
-    xs = std::max(xs, norm(o, 0, dim));
-    vs = std::max(vs, norm(o, dim, dim));
+    xs = std::max(xs, worst_body(o, 0, dim, body));
+    vs = std::max(vs, worst_body(o, dim, dim, body));
     if (p.has_energy()) es = std::max({es, std::abs(p.energy(y)), kinetic(p, y)});
     if (p.has_angular_momentum()) ls = std::max(ls, std::abs(p.angular_momentum(y)));
   }
@@ -216,7 +227,11 @@ truth_table build_truth(const problem_instance& problem, std::span<const double>
 
 run_metrics measure(const problem_instance& problem, const run_result& run, const truth_table& truth) {
   run_metrics m;
-  const int dim = problem.dim(), observed_dim = problem.observed_dim();
+  const int dim = problem.dim(), observed_dim = problem.observed_dim(), body = problem.body_dim();
+  // The positions the run draws: its state's observed ones, or its own (xpbd's particles).
+  const auto drawn = [&](std::size_t j) {
+    return run.drawn_samples.empty() ? problem.observed(run.sample_y[j]) : run.drawn_samples[j];
+  };
   auto all_nan = [&] {
     m.err_pos_final = m.err_vel_final = m.err_pos_max = m.err_pos_rms = m.energy_drift = m.energy_err_max = nan;
     m.angmom_drift = m.angmom_err_max = m.contact_count_err = m.contact_time_err = m.contact_pos_err = nan;
@@ -239,9 +254,10 @@ run_metrics measure(const problem_instance& problem, const run_result& run, cons
     // (blowup_factor + 1) times the initial state's extent are the run's own growth (the
     // truth-based test below, |x - x_true| > blowup_factor x amplitude, on a motion that
     // stays within its initial extent; a problem starting at the origin is not judged).
-    const double extent = norm(problem.observed(problem.initial()), 0, observed_dim);
+    const double extent = worst_body(problem.observed(problem.initial()), 0, observed_dim, body);
     double reach = 0.0;
-    for (const auto& y : run.sample_y) reach = std::max(reach, norm(problem.observed(y), 0, observed_dim));
+    for (std::size_t j = 0; j < run.sample_y.size(); ++j)
+      reach = std::max(reach, worst_body(drawn(j), 0, observed_dim, body));
     all_nan();
     if (extent > 0.0 && !(reach <= (blowup_factor + 1.0) * extent)) {
       m.diverged = true;
@@ -259,7 +275,7 @@ run_metrics measure(const problem_instance& problem, const run_result& run, cons
   for (size_t j = 0; j < truth.times.size(); ++j) {
     if (std::abs(run.sample_t[j] - truth.times[j]) > 1e-12 * std::max(1.0, truth.times[j]))
       throw std::logic_error("measure: a sample time differs from the truth's");
-    const double e = norm(problem.observed(run.sample_y[j]), 0, observed_dim, problem.observed(truth.y[j]));
+    const double e = worst_body(drawn(j), 0, observed_dim, body, problem.observed(truth.y[j]));
     m.err_pos_max = std::max(m.err_pos_max, e);
     sum_sq += e * e;
   }
@@ -272,9 +288,10 @@ run_metrics measure(const problem_instance& problem, const run_result& run, cons
   }
   const auto& y_final = run.final_y;
   const auto& y_true = truth.y.back();
-  const auto o_final = problem.observed(y_final), o_true = problem.observed(y_true);
-  m.err_pos_final = norm(o_final, 0, observed_dim, o_true);
-  m.err_vel_final = norm(o_final, observed_dim, observed_dim, o_true);
+  const auto o_final = run.drawn_final.empty() ? problem.observed(y_final) : run.drawn_final;
+  const auto o_true = problem.observed(y_true);
+  m.err_pos_final = worst_body(o_final, 0, observed_dim, body, o_true);
+  m.err_vel_final = worst_body(o_final, observed_dim, observed_dim, body, o_true);
   // A conserved quantity q (energy, angular momentum): its signed error at the end and its
   // largest error over the samples, over the truth's scale of it; NaN where there is none.
   const auto conserved = [&](bool has, auto q, double scale, double& drift, double& err_max) {
@@ -302,8 +319,10 @@ run_metrics measure(const problem_instance& problem, const run_result& run, cons
   m.contact_pos_err = matched_x > 0 ? 0.0 : nan;
   for (std::size_t k = 0; k < matched; ++k)
     m.contact_time_err = std::max(m.contact_time_err, std::abs(run.contact_times[k] - truth.contact_times[k]));
+  // Contact positions are the state's, which is what a problem with contacts observes.
   for (std::size_t k = 0; k < matched_x; ++k)
-    m.contact_pos_err = std::max(m.contact_pos_err, norm(run.contact_positions[k], 0, dim, truth.contact_positions[k]));
+    m.contact_pos_err =
+        std::max(m.contact_pos_err, worst_body(run.contact_positions[k], 0, dim, body, truth.contact_positions[k]));
   if (!(m.err_pos_max <= blowup_factor * truth.pos_scale)) {
     m.diverged = true;
     m.note = fmt::format("position error {:.3g} exceeds {:g} times the amplitude", m.err_pos_max, blowup_factor);

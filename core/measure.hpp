@@ -43,8 +43,8 @@ struct truth_table {
   std::vector<double> times;
   std::vector<std::vector<double>> y;  // [x; v] at times (NaN when not trusted)
   std::vector<reference_check> references;
-  double pos_scale = 1.0;     // max |x| over the initial state and the samples
-  double vel_scale = 1.0;     // max |v| likewise
+  double pos_scale = 1.0;     // max |x_i| over the bodies, the initial state and the samples
+  double vel_scale = 1.0;     // max |v_i| likewise
   double energy_scale = 1.0;  // max of |E| and kinetic energy likewise (see measure.cpp)
   double angmom_scale = 1.0;  // max |L| likewise (problems with an angular momentum)
   double agreement_limit = 0.0;
@@ -84,7 +84,14 @@ truth_table build_truth(const problem_instance& problem, std::span<const double>
 // |a - b| over the `dim` entries from `offset` (|a| when b is empty).
 double norm(std::span<const double> a, int offset, int dim, std::span<const double> b = {});
 
-agreement compare(std::span<const std::vector<double>> a, std::span<const std::vector<double>> b, int dim,
+// The largest of any one body's |a_i - b_i| (|a_i| when b is empty): the `dim` entries
+// from `offset` in blocks of `body_dim`, one a body (core/concepts.hpp's has_bodies); NaN
+// when any is. With one body (body_dim == dim) it is norm(). Every position error and
+// amplitude here is one: a player sees the body furthest off, and a stacked norm would
+// grow like sqrt(N) on N bodies equally off (docs/measurement.md).
+double worst_body(std::span<const double> a, int offset, int dim, int body_dim, std::span<const double> b = {});
+
+agreement compare(std::span<const std::vector<double>> a, std::span<const std::vector<double>> b, int dim, int body_dim,
                   double pos_scale, double vel_scale);
 
 // A row of a study completed: it neither diverged, nor failed, nor was skipped. The one
@@ -93,7 +100,9 @@ agreement compare(std::span<const std::vector<double>> a, std::span<const std::v
 constexpr bool row_completed(bool diverged, bool failed, bool skipped) { return !diverged && !failed && !skipped; }
 
 struct run_metrics {
-  double err_pos_final = 0.0;  // |x_N - x(T)|, Euclidean, in the problem's position unit
+  // Position errors are the worst body's (worst_body): |x_i,N - x_i(T)|, Euclidean, in the
+  // problem's position unit, on the positions the run draws (run_record's drawn_samples).
+  double err_pos_final = 0.0;
   double err_vel_final = 0.0;
   double err_pos_max = 0.0;     // max over the sample times
   double err_pos_rms = 0.0;     // root mean square over the sample times

@@ -80,6 +80,13 @@ struct run_record {
   // over the recorded samples; NaN for a method that steps the problem's state.
   double constraint_violation = std::numeric_limits<double>::quiet_NaN();
   std::vector<double> sample_t;
+  // A method that steps its own particles on a problem whose positions are observed (xpbd
+  // on n_pendulum, core/constraints.hpp's has_drawn_particles): the positions and
+  // velocities it draws, [X; V] in problem_instance::observed's layout, at sample_t and
+  // where it stopped. Errors are measured on them; empty for every other run, whose
+  // drawn positions are its state's observed ones.
+  std::vector<std::vector<double>> drawn_samples;
+  std::vector<double> drawn_final;
   // Contacts (a problem with contacts, run by a loop that resolves them: core/drive.hpp).
   long contacts = 0;                  // contacts resolved (responses applied)
   long tunnelled = 0;                 // contacts found deeper than the problem's tunnelling depth

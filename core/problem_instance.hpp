@@ -49,6 +49,10 @@ class problem_instance {
   // [x; v], observed_dim() entries each: the state itself, except for a problem whose
   // coordinates are not positions (core/concepts.hpp's has_observed_positions).
   virtual int observed_dim() const = 0;
+  // The coordinates of one body in the observed positions (core/concepts.hpp's
+  // has_bodies): a position error is the largest of any one body's; observed_dim() for a
+  // problem of one body.
+  virtual int body_dim() const = 0;
   // max_j |C_j| / L_j of the state's constraint view (core/constraints.hpp): 0 for rigid
   // links in generalized coordinates, a compliant constraint's stretch; NaN without a view.
   virtual double constraint_violation(std::span<const double> y) const = 0;

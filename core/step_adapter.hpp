@@ -35,6 +35,16 @@
 namespace stepbench::peers {
 
 namespace adapter_detail {
+// The positions an adapter draws where they are not its state's (xpbd's particles): a
+// sample's, or where the run stopped.
+template <class Adapter>
+[[gnu::always_inline]] inline void record_drawn(run_record& out, const Adapter& a, bool final) {
+  if constexpr (requires(std::vector<double> & y) { a.drawn_into(y); }) {
+    std::vector<double>& y = final ? out.drawn_final : out.drawn_samples.emplace_back();
+    a.drawn_into(y);
+  }
+}
+
 // The state at t recorded; false (and the run marked non-finite) when it is not finite.
 template <class Vec, class Adapter>
 [[gnu::always_inline]] inline bool record_if_finite(drive_result<Vec>& out, const Adapter& a, double t, Vec& x,
@@ -42,6 +52,7 @@ template <class Vec, class Adapter>
   a.state_into(x, v);
   if (!all_finite(x, v)) return out.non_finite = true, false;
   out.record(t, x, v);
+  record_drawn(out, a, false);
   return true;
 }
 
@@ -54,6 +65,7 @@ template <class Vec, class Adapter>
   if constexpr (requires { a.constraint_violation(); }) out.constraint_violation = a.constraint_violation();
   out.non_finite = out.non_finite || !all_finite(x, v);
   out.final_state = {x, v};
+  record_drawn(out, a, true);
 }
 }  // namespace adapter_detail
 

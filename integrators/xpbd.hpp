@@ -117,6 +117,13 @@ struct xpbd_method {
       p.from_particles(solver.s, x, v);
       worst_violation = std::max(worst_violation, stepbench::constraint_violation(solver.s));
     }
+    // The positions the particles draw, [X; V] (run_record's drawn_samples): on a problem
+    // that observes its positions (n_pendulum's bobs), the error is measured on these.
+    void drawn_into(std::vector<double>& y) const requires has_drawn_particles<P> {
+      Eigen::VectorXd pos(p.observed_dim()), vel(p.observed_dim());
+      p.observe_particles(solver.s, pos, vel);
+      y = stacked(pos, vel);
+    }
     long force_evals() const { return solver.passes; }
     double constraint_violation() const { return worst_violation; }
     mutable double worst_violation = 0.0;

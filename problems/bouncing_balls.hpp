@@ -96,6 +96,7 @@ struct bouncing_balls {
 
   int count() const { return static_cast<int>(balls); }
   int dim() const { return 2 * count(); }
+  int body_dim() const { return 2; }  // (x, y) a ball: errors are the worst ball's
   double mass() const { return mass_kg; }
   double horizon() const { return duration; }
   double scale() const { return std::sqrt(std::max(balls, 16.0) / 16.0); }

@@ -100,6 +100,7 @@ struct n_pendulum {
 
   // The bobs' positions and velocities, (x, y) a bob: what errors are measured on.
   int observed_dim() const { return 2 * count(); }
+  int body_dim() const { return 2; }  // errors are the worst bob's
   void observe(const vec& x, const vec& v, Eigen::VectorXd& pos, Eigen::VectorXd& vel) const {
     double px = 0.0, py = 0.0, vx = 0.0, vy = 0.0;
     for (int i = 0; i < count(); ++i) {
@@ -128,6 +129,14 @@ struct n_pendulum {
       s.constraints.push_back({.a = i - 1, .b = i, .rest_length = length_m});
     }
     return s;
+  }
+  // The bobs as the particles draw them, in observe's layout (bob i: particle i's x, y):
+  // what XPBD is scored on, wherever its links have stretched.
+  void observe_particles(const particle_system& s, Eigen::VectorXd& pos, Eigen::VectorXd& vel) const {
+    for (int i = 0; i < count(); ++i) {
+      pos.segment<2>(2 * i) = s.x.col(i).head<2>();
+      vel.segment<2>(2 * i) = s.v.col(i).head<2>();
+    }
   }
   // Each link's angle from its direction, theta = atan2(d_x, -d_y), and its rate from
   // d x d' = |d|^2 theta' (d = l (sin theta, -cos theta), d' = l theta' (cos theta, sin theta)).

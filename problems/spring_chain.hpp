@@ -59,6 +59,7 @@ struct spring_chain {
 
   int count() const { return static_cast<int>(masses); }
   int dim() const { return 3 * count(); }
+  int body_dim() const { return 3; }  // (x, y, z) a mass: errors are the worst mass's
   double mass() const { return rope_mass_kg / masses; }
   double rest_length() const { return rope_length_m / (masses - 1); }
   double horizon() const { return duration; }

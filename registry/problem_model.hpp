@@ -89,6 +89,10 @@ class problem_model final : public problem_instance {
     if constexpr (stepbench::has_observed_positions<P>) return p_.observed_dim();
     return p_.dim();
   }
+  int body_dim() const override {
+    if constexpr (stepbench::has_bodies<P>) return p_.body_dim();
+    return observed_dim();
+  }
   std::vector<double> observed(std::span<const double> y) const override {
     if constexpr (stepbench::has_observed_positions<P>) {
       const int n = p_.observed_dim();

@@ -114,6 +114,20 @@ std::vector<double> observed_positions(const P& p, const typename P::vec& x) {
   }
 }
 
+// The positions a run draws: its own particles' where it steps them (xpbd, `own`) on a
+// problem that observes its positions, else its state's observed ones.
+template <class P>
+std::vector<double> drawn_positions(const P& p, const typename P::vec& x, const particle_system* own) {
+  if constexpr (has_drawn_particles<P>) {
+    if (own) {
+      Eigen::VectorXd pos(p.observed_dim()), vel(p.observed_dim());
+      p.observe_particles(*own, pos, vel);
+      return {pos.data(), pos.data() + pos.size()};
+    }
+  }
+  return observed_positions(p, x);
+}
+
 // The Small Steps rows of one problem: every design at every n, at t = time.
 template <class P>
 void small_steps_of(const P& p, const challenge_options& o, std::vector<small_steps_row>& rows) {
@@ -125,6 +139,7 @@ void small_steps_of(const P& p, const challenge_options& o, std::vector<small_st
   const typename P::vec v_true = Eigen::Map<const Eigen::VectorXd>(truth.y[0].data() + dim, dim);
   const particle_system true_particles = p.particles(x_true, v_true);
   const auto true_pos = observed_positions(p, x_true);
+  const int body_dim = inst->body_dim();
   const double frames = o.small_steps_time * o.hz, frame = 1.0 / o.hz;
   const auto s0 = p.initial();
 
@@ -132,7 +147,8 @@ void small_steps_of(const P& p, const challenge_options& o, std::vector<small_st
   // stretch), or the view of a force-based method's state.
   auto finish = [&](small_steps_row r, const typename P::vec& x, const typename P::vec& v,
                     const particle_system* own = nullptr) {
-    r.err_pos = all_finite(x, v) ? norm(observed_positions(p, x), 0, static_cast<int>(true_pos.size()), true_pos) : nan;
+    const int n = static_cast<int>(true_pos.size());
+    r.err_pos = all_finite(x, v) ? worst_body(drawn_positions(p, x, own), 0, n, body_dim, true_pos) : nan;
     r.diverged = !(r.err_pos <= blowup_factor * truth.pos_scale);
     r.link_err = r.diverged ? nan : link_error(own ? *own : p.particles(x, v), true_particles);
     rows.push_back(std::move(r));

@@ -163,7 +163,7 @@ TEST(sweep, references_stand_in_for_a_missing_closed_form) {
   const auto without = build_truth(*p, times, {.use_closed_form = false});
   EXPECT_NE(without.source, "closed_form");
   EXPECT_TRUE(without.trusted);
-  const auto a = compare(with.y, without.y, 1, with.pos_scale, with.vel_scale);
+  const auto a = compare(with.y, without.y, 1, 1, with.pos_scale, with.vel_scale);
   EXPECT_LT(a.worst(), 1e-9);
   for (const auto& r : without.references) EXPECT_FALSE(r.compared_with.empty());
 }
@@ -567,4 +567,39 @@ TEST(sweep, findings_pick_their_methods_by_capability) {
   EXPECT_FALSE(judges_ladder_as_substeps("xpbd_iterations"));  // ten passes a step
   EXPECT_FALSE(judges_ladder_as_substeps("semi_implicit_euler"));
   EXPECT_FALSE(judges_ladder_as_substeps("no_such_method"));
+}
+
+// A scene of several bodies: a position error is the worst body's, not the stacked
+// vector's norm. By hand on a rope of two masses: at the first sample mass 0 is off by
+// (3, 4, 0) mm (5 mm) and mass 1 by (0, 0, 1) mm (stacked: sqrt(26) mm); at the last,
+// mass 1 by 2 mm along x and 7 mm/s in velocity.
+TEST(measure, position_errors_are_the_worst_bodys) {
+  auto p = make_problem("spring_chain");
+  p->set("masses", 2);
+  ASSERT_EQ(p->body_dim(), 3);
+  const std::vector<double> y0 = p->initial();
+  truth_table truth;
+  truth.times = {0.5, 1.0};
+  truth.y = {y0, y0};
+  run_result run;
+  run.sample_t = truth.times;
+  run.sample_y = {y0, y0};
+  run.sample_y[0][0] += 3e-3;
+  run.sample_y[0][1] += 4e-3;
+  run.sample_y[0][5] += 1e-3;
+  run.sample_y[1][3] += 2e-3;
+  run.sample_y[1][6 + 3] += 7e-3;
+  run.final_y = run.sample_y[1];
+  const run_metrics m = measure(*p, run, truth);
+  EXPECT_NEAR(m.err_pos_max, 5e-3, 1e-16);
+  EXPECT_NEAR(m.err_pos_rms, std::sqrt((25e-6 + 4e-6) / 2.0), 1e-16);
+  EXPECT_NEAR(m.err_pos_final, 2e-3, 1e-16);
+  EXPECT_NEAR(m.err_vel_final, 7e-3, 1e-16);
+  EXPECT_TRUE(m.completed());
+  // One body is the plain norm; a NaN in any body is the error.
+  const double missing = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<double> a{3.0, 4.0, 0.0, 1.0}, nan_body{0.0, 0.0, missing, 1.0};
+  EXPECT_EQ(worst_body(a, 0, 4, 4), std::sqrt(26.0));
+  EXPECT_EQ(worst_body(a, 0, 4, 2), 5.0);
+  EXPECT_TRUE(std::isnan(worst_body(nan_body, 0, 4, 2)));
 }

@@ -334,3 +334,33 @@ TEST(xpbd, runs_record_their_constraint_violation) {
   const truth_table qt = build_truth(*q, end, {});
   EXPECT_TRUE(std::isnan(measure(*q, q->run("rk4", 0.1, q->horizon(), end), qt).constraint_violation_max));
 }
+
+// XPBD is scored on the bobs it draws (its particles, links a little stretched), not on
+// the link angles read back from them, which put every bob back on its link's length.
+// By hand: the worst bob's distance from the truth's, over the frames.
+TEST(xpbd, is_scored_on_the_bobs_it_draws) {
+  auto p = make_problem("n_pendulum");
+  std::vector<double> frames;
+  for (int i = 1; i <= 120; ++i) frames.push_back(i / 60.0);
+  const truth_table truth = build_truth(*p, frames, {});
+  const run_result run = p->run("xpbd", 1.0 / 120.0, 2.0, frames);  // 2 substeps a 60 Hz frame
+  ASSERT_EQ(run.drawn_samples.size(), frames.size());
+  ASSERT_EQ(run.drawn_final.size(), 12u);
+  double drawn = 0.0, read_back = 0.0, stretch = 0.0;
+  for (std::size_t j = 0; j < frames.size(); ++j) {
+    const auto exact = p->observed(truth.y[j]), back = p->observed(run.sample_y[j]);
+    const auto& bobs = run.drawn_samples[j];
+    for (int i = 0; i < 3; ++i) {
+      const double dx = bobs[2 * i] - exact[2 * i], dy = bobs[2 * i + 1] - exact[2 * i + 1];
+      drawn = std::max(drawn, std::sqrt(dx * dx + dy * dy));
+      read_back = std::max(read_back, std::hypot(back[2 * i] - exact[2 * i], back[2 * i + 1] - exact[2 * i + 1]));
+    }
+    stretch = std::max(stretch, std::abs(std::hypot(bobs[0], bobs[1]) - 0.3));  // the first link
+  }
+  const run_metrics m = measure(*p, run, truth);
+  EXPECT_EQ(m.err_pos_max, drawn);
+  EXPECT_GT(stretch, 1e-6);                                      // the particles are not on the links
+  EXPECT_GT(std::abs(m.err_pos_max - read_back), 1e-3 * drawn);  // and that is what is scored
+  // A method that steps the state draws the state's bobs.
+  EXPECT_TRUE(p->run("rk4", 1.0 / 120.0, 2.0, frames).drawn_samples.empty());
+}

@@ -2,8 +2,12 @@
 // untimed) into an HDF5 study file.
 #include "run/sweep.hpp"
 
+#include <fmt/chrono.h>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+
+#include <ctime>
+#include <filesystem>
 
 #include "cli/args.hpp"
 #include "cli/commands.hpp"
@@ -18,7 +22,7 @@ namespace {
 struct sweep_args {
   sweep_options opts;
   std::vector<std::string> sets;
-  std::string shard, out = "results/study.h5";  // shard: K/N
+  std::string shard, out;  // shard: K/N; out: new_study_path() when not given
   std::vector<std::string> parts;
   bool quiet = false, quick = false, strict = false;
 };
@@ -26,6 +30,16 @@ struct sweep_args {
 std::string observed(const method_study& ms) {
   if (ms.fit.state == fit_result::status::fitted) return fmt::format("{:.3f}", ms.fit.order);
   return ms.fit.state == fit_result::status::exact ? "exact" : "n/a";
+}
+
+// Without --out, a new file that overwrites no study (results/study.h5 is the main study,
+// hours of timing): results/sweep-<UTC date and time>.h5, with -2, -3 ... while that exists.
+std::string new_study_path() {
+  const std::string stamp = fmt::format("{:%Y%m%d-%H%M%S}", fmt::gmtime(std::time(nullptr)));
+  for (int k = 1;; ++k) {
+    std::string path = fmt::format("results/sweep-{}{}.h5", stamp, k > 1 ? fmt::format("-{}", k) : "");
+    if (!std::filesystem::exists(path)) return path;
+  }
 }
 
 int run_sweep_command(sweep_args a) {
@@ -36,6 +50,7 @@ int run_sweep_command(sweep_args a) {
   a.opts.progress = !a.quiet;
   validate(a.opts);
   selected_parts(a.opts);
+  if (a.out.empty()) a.out = new_study_path();
   check_writable(a.out);  // before the work, so a bad path costs nothing
   const study s = run_sweep(a.opts);
   write_study(s, a.out);
@@ -86,7 +101,9 @@ command add_sweep(CLI::App& app) {
   sub->add_option("--shard", a->shard,
                   "K/N: sweep shard K of N, a deterministic share of the selected problems balanced by their counted "
                   "cost, with every part of the study that belongs to them (`stepbench merge` joins the shards)");
-  sub->add_option("--out", a->out, "study file to write")->capture_default_str();
+  sub->add_option("--out", a->out,
+                  "study file to write (default: a new results/sweep-<UTC date-time>.h5, never an existing file; "
+                  "the summary line says where)");
   sub->add_flag("--quick", a->quick,
                 "the quick preset (the CI study): 8 levels (no more), every other tolerance, the quick scan, every "
                 "part but the challenge");

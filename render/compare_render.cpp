@@ -138,7 +138,13 @@ std::string findings(const comparison& c, table_format f) {
     out += render(t, f);
   };
   const std::string flag = md ? "`--require-base`" : "--require-base";
-  section("Regressions", c.count(change_kind::regression), changes_table(c, change_kind::regression));
+  // With --require-base what only BASE has counts too, as the result line counts it.
+  const std::size_t changed = c.count(change_kind::regression), gone = c.options.require_base ? c.removed.size() : 0;
+  if (changed == 0 && gone > 0)
+    out += fmt::format("{}Regressions ({}): the removed, below ({})\n", md ? "\n### " : "\n", gone, flag);
+  else
+    section("Regressions", changed + gone, changes_table(c, change_kind::regression),
+            gone > 0 ? fmt::format(", {} of them removed, below ({})", gone, flag) : "");
   section("Improvements", c.count(change_kind::improvement), changes_table(c, change_kind::improvement));
   section("Added, only in NEW", c.added.size(), presence_table(c.added));
   section("Removed, only in BASE", c.removed.size(), presence_table(c.removed),
@@ -196,12 +202,14 @@ std::string report(const comparison& c, table_format f) {
 }  // namespace
 
 std::string summary_line(const comparison& c) {
+  // With --require-base a removed case is a regression, and is counted as one here.
+  const std::size_t gone = c.options.require_base ? c.removed.size() : 0;
   std::string s = fmt::format(
-      "{}, {}, {} added, {} removed{}", plural(c.count(change_kind::regression), "regression", "regressions"),
+      "{}, {}, {} added, {} removed{}", plural(c.count(change_kind::regression) + gone, "regression", "regressions"),
       plural(c.count(change_kind::improvement), "improvement", "improvements"), c.added.size(), c.removed.size(),
-      c.removed.empty()        ? ""
-      : c.options.require_base ? " (regressions)"
-                               : " (not compared)");
+      c.removed.empty() ? ""
+      : gone > 0        ? " (regressions: --require-base)"
+                        : " (not compared)");
   if (c.timing_compared)
     s += fmt::format("; timing: {} of {} rows slower, {} faster{}", c.slower(), c.timing.size(), c.faster(),
                      c.options.gate_timing ? " (gating)" : " (informs)");

@@ -83,6 +83,10 @@ expect_exit 0 "$work/base.h5" "$work/worse.h5" --error-factor 1000
 expect_exit 0 "$work/base.h5" "$work/fewer.h5" && { grep -q "velocity_verlet" "$work/out" || bad "removed method not named"; }
 expect_exit 0 "$work/base.h5" "$work/fewer.h5" --allow-removed
 expect_exit 1 "$work/base.h5" "$work/fewer.h5" --require-base && { grep -q "velocity_verlet" "$work/out" || bad "removed method not named"; }
+# ... and the result line and the Regressions section count it in the same words.
+grep -qF "Result: REGRESSION (exit 1): 1 regression, " "$work/out" || bad "require-base: the result line does not count the removal"
+grep -qF "Regressions (1): the removed, below (--require-base)" "$work/out" || bad "require-base: the section says no regressions"
+! grep -q "Regressions: none" "$work/out" || bad "require-base: 'Regressions: none' under a REGRESSION result"
 expect_exit 2 "$work/base.h5" "$work/fewer.h5" --require-base --allow-removed
 expect_exit 0 "$work/fewer.h5" "$work/base.h5" && { grep -qE "Added, only in NEW \(1\)" "$work/out" || bad "added not listed"; }
 

@@ -71,6 +71,19 @@ json advice_json(const advice& a) {
   return out;
 }
 
+// The study file at `path`; a file `stepbench scan` wrote (scans, no problems) is refused
+// with the option that reads it.
+study study_not_scan(const std::string& path) {
+  study s = read_study(path);
+  if (!s.problems.empty()) return s;
+  const std::vector<scan_result> scans = read_scans(path);
+  if (!scans.empty())
+    throw std::invalid_argument(
+        fmt::format("'{}' holds a scan of {}, not a study: read it with `stepbench advise --scan {} --tol X`", path,
+                    scans.front().options.problem, path));
+  return s;
+}
+
 int run_advise(const advise_args& args) {
   const double tol = parse_positive(args.tol_text, "--tol");
   if (!args.scan.empty()) {
@@ -90,11 +103,11 @@ int run_advise(const advise_args& args) {
     const double hz = parse_number(args.hz_text, "--hz");
     if (args.metric != "err_pos_max")
       throw std::invalid_argument("--hz answers for err_pos_max only (the frame-rate study measures that)");
-    const frame_advice f = advise_frame(read_study(args.study), args.problem, hz, tol);
+    const frame_advice f = advise_frame(study_not_scan(args.study), args.problem, hz, tol);
     print_answer(args.json, frame_advice_json(f), format_frame_advice(f));
     return f.met() ? 0 : advise_exit_no_method;
   }
-  const study s = read_study(args.study);
+  const study s = study_not_scan(args.study);
   const advice a = advise(s, args.problem, args.metric, tol);
   print_answer(args.json, advice_json(a), format_advice(a));
   return a.met() ? 0 : advise_exit_no_method;

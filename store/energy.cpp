@@ -11,10 +11,8 @@ namespace {
 const column_map<energy_run>& energy_columns() {
   using R = energy_run;
   static const auto columns = column_map<R>("energy_summary", "/energy/<p>/summary")
-                                  .field(
-                                      "method", [](auto& r) -> auto& { return r.info.name; })
-                                  .field(
-                                      "symplectic", [](auto& r) -> auto& { return r.info.traits.symplectic; })
+                                  .member("method", &R::info, &method_info::name)
+                                  .member("symplectic", &R::info, &method_info::traits, &capabilities::symplectic)
                                   .member("dt", &R::dt)
                                   .member("steps", &R::steps)
                                   .member("force_evals", &R::force_evals)

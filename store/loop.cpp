@@ -19,17 +19,11 @@ const column_map<loop_run>& loop_run_columns() {
   using R = loop_run;
   using L = loop_row;
   using S = loop_schedule;
-  const auto run = [](auto... path) {
-    return [=](auto& r) -> auto& { return (r.row.*....*path); };
-  };
-  const auto cost = [](auto... path) {
-    return [=](auto& r) -> auto& { return (r.cost.*....*path); };
-  };
   static const auto columns =
       column_map<R>("loop_runs", "/loop/<p>/<m>/runs")
           .derived("design", [](const R& r) { return to_string(r.row.config.design); })
-          .field("clock", run(&L::clock))
-          .field("display_hz", run(&L::config, &loop_config::display_hz))
+          .member("clock", &R::row, &L::clock)
+          .member("display_hz", &R::row, &L::config, &loop_config::display_hz)
           .derived(
               "physics_hz",
               [](const R& r) { return r.row.config.design == loop_design::variable ? nan : r.row.config.physics_hz; })
@@ -37,39 +31,39 @@ const column_map<loop_run>& loop_run_columns() {
           .derived(
               "substeps",
               [](const R& r) { return r.row.config.design == loop_design::substeps ? r.row.config.substeps() : 0; })
-          .field("clamp_s", run(&L::config, &loop_config::clamp_s))
+          .member("clamp_s", &R::row, &L::config, &loop_config::clamp_s)
           .derived(
               "jitter_seed",
               [](const R& r) { return r.row.config.jitter_seed ? static_cast<long>(*r.row.config.jitter_seed) : -1L; })
-          .field("stall_at_s", run(&L::config, &loop_config::stall_at_s))
-          .field("frames", run(&L::frames))
-          .field("physics_steps", run(&L::physics_steps))
-          .field("force_evals", run(&L::force_evals))
-          .field("shown_err_max", run(&L::shown_err_max))
-          .field("shown_err_rms", run(&L::shown_err_rms))
-          .field("final_shown_err", run(&L::final_shown_err))
-          .field("clock_dependence", run(&L::clock_dependence))
-          .field("physics_clock_dependence", run(&L::physics_clock_dependence))
-          .field("judder", run(&L::judder))
-          .field("lag_s", run(&L::lag_s))
-          .field("lag_clock_s", run(&L::lag_clock_s))
-          .field("steps_per_frame_mean", run(&L::steps_per_frame_mean))
-          .field("steps_per_frame_max", run(&L::steps_per_frame_max))
-          .field("stall_burst_steps", run(&L::stall_burst_steps))
-          .field("clamp_hits", run(&L::clamp_hits))
-          .field("alpha_min", run(&L::alpha_min))
-          .field("alpha_max", run(&L::alpha_max))
-          .field("physics_t", run(&L::physics_t))
-          .field("diverged", run(&L::diverged))
-          .field("note", run(&L::note))
-          .field("step_cost_ns", cost(&loop_cost::step_cost_ns))
+          .member("stall_at_s", &R::row, &L::config, &loop_config::stall_at_s)
+          .member("frames", &R::row, &L::frames)
+          .member("physics_steps", &R::row, &L::physics_steps)
+          .member("force_evals", &R::row, &L::force_evals)
+          .member("shown_err_max", &R::row, &L::shown_err_max)
+          .member("shown_err_rms", &R::row, &L::shown_err_rms)
+          .member("final_shown_err", &R::row, &L::final_shown_err)
+          .member("clock_dependence", &R::row, &L::clock_dependence)
+          .member("physics_clock_dependence", &R::row, &L::physics_clock_dependence)
+          .member("judder", &R::row, &L::judder)
+          .member("lag_s", &R::row, &L::lag_s)
+          .member("lag_clock_s", &R::row, &L::lag_clock_s)
+          .member("steps_per_frame_mean", &R::row, &L::steps_per_frame_mean)
+          .member("steps_per_frame_max", &R::row, &L::steps_per_frame_max)
+          .member("stall_burst_steps", &R::row, &L::stall_burst_steps)
+          .member("clamp_hits", &R::row, &L::clamp_hits)
+          .member("alpha_min", &R::row, &L::alpha_min)
+          .member("alpha_max", &R::row, &L::alpha_max)
+          .member("physics_t", &R::row, &L::physics_t)
+          .member("diverged", &R::row, &L::diverged)
+          .member("note", &R::row, &L::note)
+          .member("step_cost_ns", &R::cost, &loop_cost::step_cost_ns)
           .derived("frame_budget_ns", [](const R& r) { return r.cost.schedule.frame_budget_s * 1e9; })
           .derived("worst_frame_work_ns", [](const R& r) { return r.cost.schedule.worst_work_s * 1e9; })
-          .field("late_frames", cost(&loop_cost::schedule, &S::late_frames))
-          .field("physics_load", cost(&loop_cost::schedule, &S::load))
+          .member("late_frames", &R::cost, &loop_cost::schedule, &S::late_frames)
+          .member("physics_load", &R::cost, &loop_cost::schedule, &S::load)
           .derived("outcome", [](const R& r) { return to_string(r.cost.schedule.outcome); })
           .derived("outcome_without_clamp", [](const R& r) { return to_string(r.cost.without_clamp); })
-          .field("clamp_prevented_spiral", cost(&loop_cost::clamp_prevented_spiral));
+          .member("clamp_prevented_spiral", &R::cost, &loop_cost::clamp_prevented_spiral);
   return columns;
 }
 

@@ -420,7 +420,30 @@ void check_writable(const std::string& path) {
   std::remove(tmp.c_str());
 }
 
-void write_study_file(const std::string& path, const std::function<void(H5::H5File&)>& fill) {
+namespace {
+
+// A file built in memory (HDF5's core driver, no backing store) and named after a
+// temporary path beside `path`.
+H5::H5File in_memory_file(const std::string& path) {
+  H5::FileAccPropList in_memory;
+  in_memory.setCore(std::size_t{1} << 20, false);
+  return H5::H5File(temp_path_for(path), H5F_ACC_TRUNC, H5::FileCreatPropList::DEFAULT, in_memory);
+}
+
+// The file's image.
+std::vector<unsigned char> file_image(H5::H5File& file) {
+  file.flush(H5F_SCOPE_GLOBAL);
+  const ssize_t size = H5Fget_file_image(file.getId(), nullptr, 0);
+  std::vector<unsigned char> image(size > 0 ? static_cast<std::size_t>(size) : 0);
+  if (size <= 0 || H5Fget_file_image(file.getId(), image.data(), image.size()) != size)
+    throw H5::FileIException("H5Fget_file_image", "cannot take the file's image");
+  return image;
+}
+
+}  // namespace
+
+void write_study_file(const std::string& path, const std::function<void(H5::H5File&)>& fill, std::string_view failing,
+                      const std::function<void()>& before_write) {
   check_writable(path);
   H5::Exception::dontPrint();
   std::vector<unsigned char> image;
@@ -430,24 +453,10 @@ void write_study_file(const std::string& path, const std::function<void(H5::H5Fi
     image = file_image(file);
     file.close();
   } catch (const H5::Exception& e) {
-    throw std::runtime_error(fmt::format("cannot write results file '{}': HDF5: {}", path, e.getDetailMsg()));
+    throw std::runtime_error(fmt::format("{} '{}': HDF5: {}", failing, path, e.getDetailMsg()));
   }
+  if (before_write) before_write();
   write_image(image, path);
-}
-
-H5::H5File in_memory_file(const std::string& path) {
-  H5::FileAccPropList in_memory;
-  in_memory.setCore(std::size_t{1} << 20, false);
-  return H5::H5File(temp_path_for(path), H5F_ACC_TRUNC, H5::FileCreatPropList::DEFAULT, in_memory);
-}
-
-std::vector<unsigned char> file_image(H5::H5File& file) {
-  file.flush(H5F_SCOPE_GLOBAL);
-  const ssize_t size = H5Fget_file_image(file.getId(), nullptr, 0);
-  std::vector<unsigned char> image(size > 0 ? static_cast<std::size_t>(size) : 0);
-  if (size <= 0 || H5Fget_file_image(file.getId(), image.data(), image.size()) != size)
-    throw H5::FileIException("H5Fget_file_image", "cannot take the file's image");
-  return image;
 }
 
 void write_image(const std::vector<unsigned char>& image, const std::string& path) {

@@ -76,13 +76,8 @@ int run_energy(const energy_args& a) {
                p.period, p.dt, count_of(p.steps_per_period, "step"), p.e0,
                std::isfinite(p.l0) ? fmt::format(", L0 = {:.6g} kg m^2/s", p.l0) : "");
     // Relative errors (dE/E, dL/L: no unit); the drifts per period of the problem.
-    table t{{{"method"},
-             right_column("max |dE|/E"),
-             right_column("final dE/E"),
-             right_column("dE/E drift", "1/period"),
-             {"verdict"},
-             right_column("max |dL|/L"),
-             right_column("dL/L drift", "1/period")},
+    table t{{"method", right_column("max |dE|/E"), right_column("final dE/E"), right_column("dE/E drift", "1/period"),
+             "verdict", right_column("max |dL|/L"), right_column("dL/L drift", "1/period")},
             {}};
     std::vector<std::string> failures;  // below the table: a long reason would stretch its column
     for (const auto& r : p.runs) {

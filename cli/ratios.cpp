@@ -183,10 +183,10 @@ void print_step_cost(const json& sc, const std::string& title, int ns_digits, co
   const auto& ns = sc["ns_per_step"];
   const auto& fe = sc["force_evals_per_step"];
   fmt::print("\n{}, {} at dt = {:.6g} s:\n", title, sc["problem"].get<std::string>(), sc["dt"].get<double>());
-  table costs{{{"method"}, right_column("time a step", "ns"), right_column("force evaluations a step")}, {}};
+  table costs{{"method", right_column("time a step", "ns"), right_column("force evaluations a step")}, {}};
   for (const auto& [k, v] : ns.items()) costs.add({k, fixed(v, ns_digits), fixed(fe[k], 2)});
   fmt::print("{}", render_text(costs));
-  table ratios{{{"ratio"}, right_column("measured"), {"target"}, {"verdict"}}, {}};
+  table ratios{{"ratio", right_column("measured"), "target", "verdict"}, {}};
   for (const auto& l : lines) {
     if (!ns.contains(l.x) || !ns.contains(l.y)) continue;
     const double r = ns[l.x].get<double>() / ns[l.y].get<double>();
@@ -199,7 +199,7 @@ void print_step_cost(const json& sc, const std::string& title, int ns_digits, co
 void print_ns_per_call(const json& per_problem) {
   if (per_problem.empty()) return;
   fmt::print("\nns per right-hand-side call (median over the timed rows of time / force evaluations):\n");
-  table t{{{"method"}}, {}};
+  table t{{"method"}, {}};
   std::vector<std::string> methods;
   for (const auto& e : per_problem) {
     t.columns.push_back(right_column(e["problem"].get<std::string>(), "ns"));
@@ -225,14 +225,8 @@ void print_equal_error(const json& out) {
   fmt::print(
       "\nEqual error: time to reach err_pos_max, interpolated on each method's measured curve (log-log between the two "
       "rows that bracket the target; dt in s, tol relative; the study's rule)\n");
-  table t{{{"problem"},
-           right_column("target", "m or rad"),
-           {"fastest of ours"},
-           {"fastest peer"},
-           right_column("peer / ours"),
-           right_column("ours / peer"),
-           {"beyond the noise"},
-           {"target <= 0.5"}},
+  table t{{"problem", right_column("target", "m or rad"), "fastest of ours", "fastest peer",
+           right_column("peer / ours"), right_column("ours / peer"), "beyond the noise", "target <= 0.5"},
           {}};
   std::string open;
   for (const auto& e : out["equal_error"]) {
@@ -249,7 +243,7 @@ void print_equal_error(const json& out) {
   for (const auto& e : out["equal_error"]) {
     if (e["problem"] != "pendulum" || e["target"].get<double>() != 1e-6) continue;
     fmt::print("\n  pendulum, every method to err_pos_max = 1e-6:\n");
-    table ranked{{{"method"}, right_column("time"), {"origin"}, right_column("at")}, {}};
+    table ranked{{"method", right_column("time"), "origin", right_column("at")}, {}};
     for (const auto& r : e["ranked"]) {
       const std::string origin = r["origin"].get<std::string>();
       ranked.add({r["method"].get<std::string>(), format_time_ns(r["time_ns"].get<double>()),

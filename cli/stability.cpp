@@ -42,12 +42,8 @@ int run_stability(bool as_json) {
       s.run_steps, s.envelope_growth, s.blowup_factor);
   fmt::print("  adaptive methods: the step they take when every attempt is accepted (tolerance {:g})\n\n",
              always_accept_tolerance);
-  table t{{{"integrator"},
-           {"test"},
-           right_column("y_max theory (a)"),
-           right_column("y_max measured (b)"),
-           right_column("(b)/(a)-1"),
-           {"long runs"}},
+  table t{{"integrator", "test", right_column("y_max theory (a)"), right_column("y_max measured (b)"),
+           right_column("(b)/(a)-1"), "long runs"},
           {}};
   for (const auto& l : d.limits) {
     // A method unstable, or stable, for every dt has no limit to measure.

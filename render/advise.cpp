@@ -66,12 +66,8 @@ std::string format_advice(const advice& a, std::size_t runners_up) {
   for (const auto& p : r.ranked)
     if (!answer || p.method != answer->method) others.push_back(&p);
   if (!others.empty()) {
-    table t{{right_column("rank"),
-             {"method"},
-             {"dt or tolerance"},
-             right_column("cost"),
-             right_column(a.metric, a.unit),
-             {"stability margin"}},
+    table t{{right_column("rank"), "method", "dt or tolerance", right_column("cost"), right_column(a.metric, a.unit),
+             "stability margin"},
             {}};
     for (std::size_t i = 0; i < others.size() && i < runners_up; ++i) {
       const auto& m = a.methods[others[i]->method];
@@ -83,7 +79,7 @@ std::string format_advice(const advice& a, std::size_t runners_up) {
       out += fmt::format("  ... and {} more that also meet the tolerance\n", others.size() - runners_up);
   }
   if (!r.excluded.empty()) {
-    table t{{{"method"}, {"reason"}}, {}};
+    table t{{"method", "reason"}, {}};
     for (const auto& e : r.excluded) t.add({label(a.methods[e.method]), e.reason});
     out += "excluded:\n" + render_text(t);
   }
@@ -115,7 +111,7 @@ std::string format_frame_advice(const frame_advice& f) {
       "measured over {:.3g} s of whole frames against the truth at the frame ends; cost a frame = {}\n", f.horizon,
       timed ? "the benchmark's median ns per step x steps a frame" : "force evaluations (untimed study)");
   if (f.ranked.size() > 1) {
-    table t{{{"method"}, right_column("substeps"), right_column("err_pos_max", f.unit), right_column("cost a frame")},
+    table t{{"method", right_column("substeps"), right_column("err_pos_max", f.unit), right_column("cost a frame")},
             {}};
     for (std::size_t i = 1; i < f.ranked.size(); ++i)
       t.add({f.ranked[i].method, fmt::format("{}", f.ranked[i].substeps),
@@ -126,7 +122,7 @@ std::string format_frame_advice(const frame_advice& f) {
     out += "not ranked:\n";
     for (const auto& n : f.not_meeting) out += "  " + n + "\n";
   }
-  table t{{{"method"}, {"one step a frame"}, right_column("err_pos_max", f.unit)}, {}};
+  table t{{"method", "one step a frame", right_column("err_pos_max", f.unit)}, {}};
   for (const auto& o : f.one_step)
     t.add({o.method, o.completed ? "stable" : (o.diverged ? "diverges" : "fails: " + o.note),
            o.completed ? fmt::format("{:.3g}", o.err_pos_max) : "-"});

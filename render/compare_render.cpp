@@ -25,14 +25,8 @@ std::string param_text(const std::string& name, double param) {
 }
 
 table changes_table(const comparison& c, change_kind k) {
-  table t{{{"problem"},
-           {"method"},
-           {"dt or tolerance"},
-           {"what"},
-           right_column("old"),
-           right_column("new"),
-           right_column("ratio"),
-           {"note"}},
+  table t{{"problem", "method", "dt or tolerance", "what", right_column("old"), right_column("new"),
+           right_column("ratio"), "note"},
           {}};
   for (const auto& x : c.changes)
     if (x.kind == k)
@@ -45,13 +39,13 @@ table changes_table(const comparison& c, change_kind k) {
 }
 
 table presence_table(const std::vector<presence>& items) {
-  table t{{{"problem"}, {"method"}, {"what"}, {"detail"}}, {}};
+  table t{{"problem", "method", "what", "detail"}, {}};
   for (const auto& p : items) t.add({p.problem, p.method.empty() ? "-" : p.method, p.what, p.detail});
   return t;
 }
 
 table differences_table(const comparison& c) {
-  table t{{{"what"}, {"BASE"}, {"NEW"}}, {}};
+  table t{{"what", "BASE", "NEW"}, {}};
   for (const auto& d : c.differences) t.add({d.what, d.old_value, d.new_value});
   return t;
 }
@@ -63,14 +57,8 @@ std::string side_text(const timing& s) {
 }
 
 table timing_flagged_table(const comparison& c) {
-  table t{{{"problem"},
-           {"method"},
-           {"dt or tolerance"},
-           {"old median"},
-           {"new median"},
-           right_column("new/old"),
-           right_column("threshold"),
-           {"flag"}},
+  table t{{"problem", "method", "dt or tolerance", "old median", "new median", right_column("new/old"),
+           right_column("threshold"), "flag"},
           {}};
   for (const auto& r : c.timing)
     if (r.flag != 0)
@@ -81,14 +69,8 @@ table timing_flagged_table(const comparison& c) {
 }
 
 table timing_summary_table(const comparison& c) {
-  table t{{{"method"},
-           right_column("problems"),
-           right_column("rows"),
-           right_column("geomean new/old"),
-           right_column("min"),
-           right_column("max"),
-           right_column("slower"),
-           right_column("faster")},
+  table t{{"method", right_column("problems"), right_column("rows"), right_column("geomean new/old"),
+           right_column("min"), right_column("max"), right_column("slower"), right_column("faster")},
           {}};
   for (const auto& s : c.timing_summaries)
     t.add({s.method, std::to_string(s.problems), std::to_string(s.rows), fmt::format("{:.3f}", s.geomean),
@@ -159,7 +141,7 @@ std::string report(const comparison& c, table_format f) {
   std::string out;
   if (md) {
     out = fmt::format("## stepbench compare: {}\n\n**{}** (exit {})\n\n", verdict(c), summary_line(c), c.exit_status());
-    table files{{{""}, {"file"}, {"build"}}, {}};
+    table files{{"", "file", "build"}, {}};
     files.add({"BASE", "`" + c.base_path + "`", file_line(c.base_meta, c.base_timed)});
     files.add({"NEW", "`" + c.new_path + "`", file_line(c.new_meta, c.new_timed)});
     out += render_markdown(files);

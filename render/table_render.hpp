@@ -24,6 +24,8 @@ struct column {
 
   column(std::string label_, std::string unit_ = {}, align alignment_ = align::left)
       : label(std::move(label_)), unit(std::move(unit_)), alignment(alignment_) {}
+  // A left-aligned column of no unit, written as its label: {"method", right_column("cost")}.
+  column(const char* label_) : column(std::string(label_)) {}
   std::string heading() const;
 };
 // A right-aligned column (numbers).

@@ -9,16 +9,9 @@ h5::column empty_column(schema::field_type type) {
 }
 
 read_column column_of(const h5::table_data& t, const std::string& field, schema::field_type type) {
-  switch (type) {
-    case schema::field_type::f64:
-      return &t.reals(field);
-    case schema::field_type::i64:
-    case schema::field_type::i8:
-      return &t.ints(field);
-    case schema::field_type::str:
-      break;
-  }
-  return &t.strings(field);
+  if (type == schema::field_type::f64) return &t.reals(field);
+  if (type == schema::field_type::str) return &t.strings(field);
+  return &t.ints(field);  // i64 or i8
 }
 
 }  // namespace stepbench::columns_detail

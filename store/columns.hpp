@@ -95,27 +95,18 @@ class column_map {
   // The schema's table `name`, stored at `where` (for the reader and the docs): its fields
   // are those bound below, in their order (store/schema.cpp lists the tables).
   column_map(std::string_view name, std::string_view where) : spec_{name, where, {}} {}
-  // A study part's own table, declared in its file (parts/part.hpp) and outliving the map:
-  // the fields bound below are written checked against it.
-  explicit column_map(const schema::table& declared) : column_map(declared.name, declared.where) {
-    declared_ = &declared;
-  }
   // spec_ points into the map's vectors: a move keeps their buffers, a copy would not.
   column_map(column_map&&) = default;
   column_map(const column_map&) = delete;
 
-  const schema::table& spec() const { return declared_ ? *declared_ : spec_; }
+  const schema::table& spec() const { return spec_; }
 
-  // The field `name` is the member at `path` (member pointers, outermost first): row.*a.*b.
+  // The field `name` is the member at `path` (member pointers, outermost first): row.*a.*b;
+  // written and read.
   template <class... Path>
   column_map&& member(std::string_view name, Path... path) {
     static_assert((std::is_member_object_pointer_v<Path> && ...), "a path of member pointers");
-    return field(
-        name, [=](auto& r) -> auto& { return columns_detail::member_at(r, path...); });
-  }
-  // The field `name` is the member access(row) refers to; written and read.
-  template <class Access>
-  column_map&& field(std::string_view name, Access access) {
+    const auto access = [=](auto& r) -> auto& { return columns_detail::member_at(r, path...); };
     using M = std::remove_cvref_t<decltype(access(std::declval<Row&>()))>;
     return add(
         name, columns_detail::type_of<M>(), writer(access),
@@ -241,7 +232,6 @@ class column_map {
   }
 
   schema::table spec_;
-  const schema::table* declared_ = nullptr;
   std::vector<binding> bindings_;
   std::vector<schema::field> fields_;
   std::vector<schema::field_group> groups_;

@@ -8,35 +8,30 @@ namespace stepbench {
 
 namespace {
 
-const column_map<energy_run>& energy_columns() {
-  using R = energy_run;
-  static const auto columns = column_map<R>("energy_summary", "/energy/<p>/summary")
-                                  .field(
-                                      "method", [](auto& r) -> auto& { return r.info.name; })
-                                  .field(
-                                      "symplectic", [](auto& r) -> auto& { return r.info.traits.symplectic; })
-                                  .member("dt", &R::dt)
-                                  .member("steps", &R::steps)
-                                  .member("force_evals", &R::force_evals)
-                                  .member("completed", &R::completed)
-                                  .member("max_rel_err", &R::max_rel_err)
-                                  .member("final_rel_err", &R::final_rel_err)
-                                  .member("drift_per_period", &R::drift_per_period)
-                                  .member("first_tenth_max", &R::first_tenth_max)
-                                  .member("last_tenth_max", &R::last_tenth_max)
-                                  .member("last_tenth_mean", &R::last_tenth_mean)
-                                  .member("verdict", &R::verdict)
-                                  .member("drift_sign", &R::drift_sign)
-                                  .member("angmom_max_rel_err", &R::angmom_max_rel_err)
-                                  .member("angmom_drift_per_period", &R::angmom_drift_per_period)
-                                  .member("seconds", &R::seconds)
-                                  .member("note", &R::note);
-  return columns;
-}
+const auto energy_columns =
+    column_map<energy_run>("energy_summary", "/energy/<p>/summary")
+        .member("method", &energy_run::info, &method_info::name)
+        .member("symplectic", &energy_run::info, &method_info::traits, &capabilities::symplectic)
+        .member("dt", &energy_run::dt)
+        .member("steps", &energy_run::steps)
+        .member("force_evals", &energy_run::force_evals)
+        .member("completed", &energy_run::completed)
+        .member("max_rel_err", &energy_run::max_rel_err)
+        .member("final_rel_err", &energy_run::final_rel_err)
+        .member("drift_per_period", &energy_run::drift_per_period)
+        .member("first_tenth_max", &energy_run::first_tenth_max)
+        .member("last_tenth_max", &energy_run::last_tenth_max)
+        .member("last_tenth_mean", &energy_run::last_tenth_mean)
+        .member("verdict", &energy_run::verdict)
+        .member("drift_sign", &energy_run::drift_sign)
+        .member("angmom_max_rel_err", &energy_run::angmom_max_rel_err)
+        .member("angmom_drift_per_period", &energy_run::angmom_drift_per_period)
+        .member("seconds", &energy_run::seconds)
+        .member("note", &energy_run::note);
 
 }  // namespace
 
-std::vector<schema::table> energy_tables() { return {energy_columns().spec()}; }
+std::vector<schema::table> energy_tables() { return {energy_columns.spec()}; }
 
 void write_energy(H5::Group& root, const energy_study& s) {
   if (s.problems.empty()) return;
@@ -63,7 +58,7 @@ void write_energy(H5::Group& root, const energy_study& s) {
     attr(pg, "horizon", ep.horizon);
     attr(pg, "energy0", ep.e0);
     attr(pg, "angular_momentum0", ep.l0);
-    energy_columns().write(pg, "summary", ep.runs);
+    energy_columns.write(pg, "summary", ep.runs);
     H5::Group series = pg.createGroup("series");
     for (const auto& r : ep.runs) {
       if (!r.completed) continue;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <stdexcept>
 
 namespace stepbench::h5 {
@@ -210,7 +211,7 @@ hsize_t checked_extent(const H5::DataSpace& space, std::size_t element_size, hsi
 // A field of a table as the reader takes it from the raw record.
 struct member {
   std::string name;
-  table_data::kind kind;
+  table_data::values kind;  // its column, empty
   std::size_t offset, size;
 };
 
@@ -227,13 +228,13 @@ std::vector<member> checked_members(const H5::CompType& type, const std::string&
     const std::string name = type.getMemberName(static_cast<unsigned>(i));
     const H5::DataType t = type.getMemberDataType(static_cast<unsigned>(i));
     const std::size_t offset = type.getMemberOffset(static_cast<unsigned>(i)), size = t.getSize();
-    table_data::kind kind;
+    table_data::values kind;
     if (t == H5::PredType::NATIVE_DOUBLE)
-      kind = table_data::kind::real;
+      kind = std::vector<double>{};
     else if (t == H5::PredType::NATIVE_INT64 || t == H5::PredType::NATIVE_INT8)
-      kind = table_data::kind::integer;
+      kind = std::vector<std::int64_t>{};
     else if (is_vlen_string(t))
-      kind = table_data::kind::text;
+      kind = std::vector<std::string>{};
     else
       throw std::runtime_error(fmt::format("{}: field '{}' is of a type this reader does not read", what, name));
     if (offset > record || size > record - offset)
@@ -252,22 +253,6 @@ std::vector<member> checked_members(const H5::CompType& type, const std::string&
   return out;
 }
 
-// HDF5 allocates the strings of a read; this hands them back however the read ended.
-class vlen_guard {
- public:
-  vlen_guard(const H5::DataType& type, const H5::DataSpace& space, const H5::DSetMemXferPropList& xfer, void* buffer)
-      : type_(type), space_(space), xfer_(xfer), buffer_(buffer) {}
-  ~vlen_guard() { H5Dvlen_reclaim(type_.getId(), space_.getId(), xfer_.getId(), buffer_); }
-  vlen_guard(const vlen_guard&) = delete;
-  vlen_guard& operator=(const vlen_guard&) = delete;
-
- private:
-  const H5::DataType& type_;
-  const H5::DataSpace& space_;
-  const H5::DSetMemXferPropList& xfer_;
-  void* buffer_;
-};
-
 // The allocator of the strings a table read returns: a damaged length (stored beside the
 // string, unchecked by HDF5) would have it allocate and fill gigabytes; no string of a
 // file is longer than the file, so a longer one fails the read instead.
@@ -285,27 +270,6 @@ T at(const unsigned char* p) {
 
 }  // namespace
 
-bool table_data::has(const std::string& field) const {
-  return std::any_of(fields_.begin(), fields_.end(), [&](const auto& f) { return f.first == field; });
-}
-
-template <class T>
-static const std::vector<T>& column_named(const std::map<std::string, std::vector<T>>& columns,
-                                          const std::string& field, const char* kind, const std::string& table) {
-  const auto it = columns.find(field);
-  if (it == columns.end()) throw std::runtime_error(fmt::format("missing {} field '{}' in {}", kind, field, table));
-  return it->second;
-}
-const std::vector<double>& table_data::reals(const std::string& field) const {
-  return column_named(reals_, field, "real", name_);
-}
-const std::vector<std::int64_t>& table_data::ints(const std::string& field) const {
-  return column_named(integers_, field, "integer", name_);
-}
-const std::vector<std::string>& table_data::strings(const std::string& field) const {
-  return column_named(texts_, field, "string", name_);
-}
-
 table_data read_table(const H5::DataSet& ds) {
   table_data out;
   out.name_ = object_name(ds);
@@ -318,16 +282,8 @@ table_data read_table(const H5::DataSet& ds) {
   const H5::DataSpace space = ds.getSpace();
   const std::size_t record = type.getSize();
   out.rows_ = checked_extent(space, record, file_size(ds), out.name_);
-  for (const auto& m : members) {
-    out.fields_.emplace_back(m.name, m.kind);
-    // Every field has its column, empty in a table of no rows (a shard without points).
-    if (m.kind == table_data::kind::real)
-      out.reals_[m.name];
-    else if (m.kind == table_data::kind::integer)
-      out.integers_[m.name];
-    else
-      out.texts_[m.name];
-  }
+  // Every field has its column, empty in a table of no rows (a shard without points).
+  for (const auto& m : members) out.columns_.emplace(m.name, m.kind);
   if (out.rows_ == 0) return out;
   std::vector<unsigned char> raw(out.rows_ * record, 0);
   // HDF5 converts through a buffer of 1 MiB by default, allocated and freed on each read:
@@ -339,24 +295,26 @@ table_data read_table(const H5::DataSet& ds) {
   hsize_t longest = file_size(ds);
   sized.setVlenMemManager(bounded_malloc, &longest, release, nullptr);
   {
-    const vlen_guard strings(type, space, sized, raw.data());
+    // HDF5 allocates the strings of a read; this hands them back however the read ended.
+    const auto reclaim = [&](void* buffer) { H5Dvlen_reclaim(type.getId(), space.getId(), sized.getId(), buffer); };
+    const std::unique_ptr<void, decltype(reclaim)> strings(raw.data(), reclaim);
     ds.read(raw.data(), type, H5::DataSpace::ALL, H5::DataSpace::ALL, sized);
     for (const auto& m : members)
-      for (std::size_t r = 0; r < out.rows_; ++r) {
-        const unsigned char* p = raw.data() + r * record + m.offset;
-        switch (m.kind) {
-          case table_data::kind::real:
-            out.reals_[m.name].push_back(at<double>(p));
-            break;
-          case table_data::kind::integer:
-            out.integers_[m.name].push_back(m.size == 1 ? at<std::int8_t>(p) : at<std::int64_t>(p));
-            break;
-          case table_data::kind::text: {
-            const char* s = at<const char*>(p);
-            out.texts_[m.name].emplace_back(s ? s : "");
-          }
-        }
-      }
+      std::visit(
+          [&]<class T>(std::vector<T>& column) {
+            for (std::size_t r = 0; r < out.rows_; ++r) {
+              const unsigned char* p = raw.data() + r * record + m.offset;
+              if constexpr (std::is_same_v<T, std::string>) {
+                const char* s = at<const char*>(p);
+                column.emplace_back(s ? s : "");
+              } else if constexpr (std::is_same_v<T, std::int64_t>) {
+                column.push_back(m.size == 1 ? at<std::int8_t>(p) : at<std::int64_t>(p));
+              } else {
+                column.push_back(at<double>(p));
+              }
+            }
+          },
+          out.columns_.at(m.name));
   }
   return out;
 }

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <map>
+#include <stdexcept>
 #include <string>
 #include <variant>
 #include <vector>
@@ -62,22 +63,31 @@ std::vector<std::string> children(const H5::Group& g);  // link names in creatio
 // A table read back whole, in one read: its fields in the file's order and its columns.
 class table_data {
  public:
-  enum class kind { real, integer, text };  // double; int8 or int64; variable-length string
+  // double; int8 or int64; variable-length string
+  using values = std::variant<std::vector<double>, std::vector<std::int64_t>, std::vector<std::string>>;
   std::size_t rows() const { return rows_; }
-  bool has(const std::string& field) const;
+  bool has(const std::string& field) const { return columns_.contains(field); }
   // A missing field (or one of another kind) is an error naming it and the table.
-  const std::vector<double>& reals(const std::string& field) const;
-  const std::vector<std::int64_t>& ints(const std::string& field) const;
-  const std::vector<std::string>& strings(const std::string& field) const;
+  const std::vector<double>& reals(const std::string& field) const { return column<double>(field, "real"); }
+  const std::vector<std::int64_t>& ints(const std::string& field) const {
+    return column<std::int64_t>(field, "integer");
+  }
+  const std::vector<std::string>& strings(const std::string& field) const {
+    return column<std::string>(field, "string");
+  }
 
  private:
   friend table_data read_table(const H5::DataSet& ds);
+  template <class T>
+  const std::vector<T>& column(const std::string& field, const char* kind) const {
+    const auto it = columns_.find(field);
+    const auto* column = it == columns_.end() ? nullptr : std::get_if<std::vector<T>>(&it->second);
+    if (!column) throw std::runtime_error("missing " + std::string(kind) + " field '" + field + "' in " + name_);
+    return *column;
+  }
   std::string name_;
   std::size_t rows_ = 0;
-  std::vector<std::pair<std::string, kind>> fields_;
-  std::map<std::string, std::vector<double>> reals_;
-  std::map<std::string, std::vector<std::int64_t>> integers_;
-  std::map<std::string, std::vector<std::string>> texts_;
+  std::map<std::string, values> columns_;
 };
 
 table_data read_table(const H5::DataSet& ds);

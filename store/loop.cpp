@@ -15,80 +15,68 @@ struct loop_run {
   loop_cost cost;
 };
 
-const column_map<loop_run>& loop_run_columns() {
-  using R = loop_run;
-  using L = loop_row;
-  using S = loop_schedule;
-  const auto run = [](auto... path) {
-    return [=](auto& r) -> auto& { return (r.row.*....*path); };
-  };
-  const auto cost = [](auto... path) {
-    return [=](auto& r) -> auto& { return (r.cost.*....*path); };
-  };
-  static const auto columns =
-      column_map<R>("loop_runs", "/loop/<p>/<m>/runs")
-          .derived("design", [](const R& r) { return to_string(r.row.config.design); })
-          .field("clock", run(&L::clock))
-          .field("display_hz", run(&L::config, &loop_config::display_hz))
-          .derived(
-              "physics_hz",
-              [](const R& r) { return r.row.config.design == loop_design::variable ? nan : r.row.config.physics_hz; })
-          .derived("dt", [](const R& r) { return uses_accumulator(r.row.config.design) ? r.row.config.dt() : nan; })
-          .derived(
-              "substeps",
-              [](const R& r) { return r.row.config.design == loop_design::substeps ? r.row.config.substeps() : 0; })
-          .field("clamp_s", run(&L::config, &loop_config::clamp_s))
-          .derived(
-              "jitter_seed",
-              [](const R& r) { return r.row.config.jitter_seed ? static_cast<long>(*r.row.config.jitter_seed) : -1L; })
-          .field("stall_at_s", run(&L::config, &loop_config::stall_at_s))
-          .field("frames", run(&L::frames))
-          .field("physics_steps", run(&L::physics_steps))
-          .field("force_evals", run(&L::force_evals))
-          .field("shown_err_max", run(&L::shown_err_max))
-          .field("shown_err_rms", run(&L::shown_err_rms))
-          .field("final_shown_err", run(&L::final_shown_err))
-          .field("clock_dependence", run(&L::clock_dependence))
-          .field("physics_clock_dependence", run(&L::physics_clock_dependence))
-          .field("judder", run(&L::judder))
-          .field("lag_s", run(&L::lag_s))
-          .field("lag_clock_s", run(&L::lag_clock_s))
-          .field("steps_per_frame_mean", run(&L::steps_per_frame_mean))
-          .field("steps_per_frame_max", run(&L::steps_per_frame_max))
-          .field("stall_burst_steps", run(&L::stall_burst_steps))
-          .field("clamp_hits", run(&L::clamp_hits))
-          .field("alpha_min", run(&L::alpha_min))
-          .field("alpha_max", run(&L::alpha_max))
-          .field("physics_t", run(&L::physics_t))
-          .field("diverged", run(&L::diverged))
-          .field("note", run(&L::note))
-          .field("step_cost_ns", cost(&loop_cost::step_cost_ns))
-          .derived("frame_budget_ns", [](const R& r) { return r.cost.schedule.frame_budget_s * 1e9; })
-          .derived("worst_frame_work_ns", [](const R& r) { return r.cost.schedule.worst_work_s * 1e9; })
-          .field("late_frames", cost(&loop_cost::schedule, &S::late_frames))
-          .field("physics_load", cost(&loop_cost::schedule, &S::load))
-          .derived("outcome", [](const R& r) { return to_string(r.cost.schedule.outcome); })
-          .derived("outcome_without_clamp", [](const R& r) { return to_string(r.cost.without_clamp); })
-          .field("clamp_prevented_spiral", cost(&loop_cost::clamp_prevented_spiral));
-  return columns;
-}
+const auto loop_run_columns =
+    column_map<loop_run>("loop_runs", "/loop/<p>/<m>/runs")
+        .derived("design", [](const loop_run& r) { return to_string(r.row.config.design); })
+        .member("clock", &loop_run::row, &loop_row::clock)
+        .member("display_hz", &loop_run::row, &loop_row::config, &loop_config::display_hz)
+        .derived("physics_hz",
+                 [](const loop_run& r) {
+                   return r.row.config.design == loop_design::variable ? nan : r.row.config.physics_hz;
+                 })
+        .derived("dt",
+                 [](const loop_run& r) { return uses_accumulator(r.row.config.design) ? r.row.config.dt() : nan; })
+        .derived("substeps",
+                 [](const loop_run& r) {
+                   return r.row.config.design == loop_design::substeps ? r.row.config.substeps() : 0;
+                 })
+        .member("clamp_s", &loop_run::row, &loop_row::config, &loop_config::clamp_s)
+        .derived("jitter_seed",
+                 [](const loop_run& r) {
+                   return r.row.config.jitter_seed ? static_cast<long>(*r.row.config.jitter_seed) : -1L;
+                 })
+        .member("stall_at_s", &loop_run::row, &loop_row::config, &loop_config::stall_at_s)
+        .member("frames", &loop_run::row, &loop_row::frames)
+        .member("physics_steps", &loop_run::row, &loop_row::physics_steps)
+        .member("force_evals", &loop_run::row, &loop_row::force_evals)
+        .member("shown_err_max", &loop_run::row, &loop_row::shown_err_max)
+        .member("shown_err_rms", &loop_run::row, &loop_row::shown_err_rms)
+        .member("final_shown_err", &loop_run::row, &loop_row::final_shown_err)
+        .member("clock_dependence", &loop_run::row, &loop_row::clock_dependence)
+        .member("physics_clock_dependence", &loop_run::row, &loop_row::physics_clock_dependence)
+        .member("judder", &loop_run::row, &loop_row::judder)
+        .member("lag_s", &loop_run::row, &loop_row::lag_s)
+        .member("lag_clock_s", &loop_run::row, &loop_row::lag_clock_s)
+        .member("steps_per_frame_mean", &loop_run::row, &loop_row::steps_per_frame_mean)
+        .member("steps_per_frame_max", &loop_run::row, &loop_row::steps_per_frame_max)
+        .member("stall_burst_steps", &loop_run::row, &loop_row::stall_burst_steps)
+        .member("clamp_hits", &loop_run::row, &loop_row::clamp_hits)
+        .member("alpha_min", &loop_run::row, &loop_row::alpha_min)
+        .member("alpha_max", &loop_run::row, &loop_row::alpha_max)
+        .member("physics_t", &loop_run::row, &loop_row::physics_t)
+        .member("diverged", &loop_run::row, &loop_row::diverged)
+        .member("note", &loop_run::row, &loop_row::note)
+        .member("step_cost_ns", &loop_run::cost, &loop_cost::step_cost_ns)
+        .derived("frame_budget_ns", [](const loop_run& r) { return r.cost.schedule.frame_budget_s * 1e9; })
+        .derived("worst_frame_work_ns", [](const loop_run& r) { return r.cost.schedule.worst_work_s * 1e9; })
+        .member("late_frames", &loop_run::cost, &loop_cost::schedule, &loop_schedule::late_frames)
+        .member("physics_load", &loop_run::cost, &loop_cost::schedule, &loop_schedule::load)
+        .derived("outcome", [](const loop_run& r) { return to_string(r.cost.schedule.outcome); })
+        .derived("outcome_without_clamp", [](const loop_run& r) { return to_string(r.cost.without_clamp); })
+        .member("clamp_prevented_spiral", &loop_run::cost, &loop_cost::clamp_prevented_spiral);
 
-const column_map<loop_cheapest>& loop_cheapest_columns() {
-  using R = loop_cheapest;
-  static const auto columns = column_map<R>("loop_cheapest", "/loop/<p>/<m>/cheapest")
-                                  .member("display_hz", &R::display_hz)
-                                  .member("target", &R::target)
-                                  .member("found", &R::found)
-                                  .member("design", &R::design)
-                                  .member("physics_hz", &R::physics_hz)
-                                  .member("steps_per_frame_mean", &R::steps_per_frame_mean)
-                                  .member("shown_err_max", &R::shown_err_max);
-  return columns;
-}
+const auto loop_cheapest_columns = column_map<loop_cheapest>("loop_cheapest", "/loop/<p>/<m>/cheapest")
+                                       .member("display_hz", &loop_cheapest::display_hz)
+                                       .member("target", &loop_cheapest::target)
+                                       .member("found", &loop_cheapest::found)
+                                       .member("design", &loop_cheapest::design)
+                                       .member("physics_hz", &loop_cheapest::physics_hz)
+                                       .member("steps_per_frame_mean", &loop_cheapest::steps_per_frame_mean)
+                                       .member("shown_err_max", &loop_cheapest::shown_err_max);
 
 }  // namespace
 
-std::vector<schema::table> loop_tables() { return {loop_run_columns().spec(), loop_cheapest_columns().spec()}; }
+std::vector<schema::table> loop_tables() { return {loop_run_columns.spec(), loop_cheapest_columns.spec()}; }
 
 void write_loop(H5::Group& root, const study& s) {
   const loop_study& ls = s.results.get<loop_study>();
@@ -137,9 +125,9 @@ void write_loop(H5::Group& root, const study& s) {
         rows.push_back({r, cost_verdict(r.config, cost, source)});
         finals.push_back(r.final_physics);
       }
-      loop_run_columns().write(mg, "runs", rows);
+      loop_run_columns.write(mg, "runs", rows);
       h5::dataset(mg, "final_physics_state", finals);
-      loop_cheapest_columns().write(mg, "cheapest", cheapest_designs(m, o));
+      loop_cheapest_columns.write(mg, "cheapest", cheapest_designs(m, o));
     }
   }
 }

@@ -126,16 +126,22 @@ shard_file open_shard(const std::string& path) {
   return s;
 }
 
-// open_shard with its errors as one line naming the file.
-shard_file read_shard(const std::string& path) {
+// read() with its HDF5 and runtime errors as one line: "<failing>: <error>".
+template <class Read>
+auto one_line_errors(const std::string& failing, Read read) {
   H5::Exception::dontPrint();
   try {
-    return open_shard(path);
+    return read();
   } catch (const H5::Exception& e) {
-    throw std::runtime_error(fmt::format("cannot read study shard '{}': {}", path, e.getDetailMsg()));
+    throw std::runtime_error(fmt::format("{}: {}", failing, e.getDetailMsg()));
   } catch (const std::runtime_error& e) {
-    throw std::runtime_error(fmt::format("cannot read study shard '{}': {}", path, e.what()));
+    throw std::runtime_error(fmt::format("{}: {}", failing, e.what()));
   }
+}
+
+// open_shard with its errors as one line naming the file.
+shard_file read_shard(const std::string& path) {
+  return one_line_errors(fmt::format("cannot read study shard '{}'", path), [&] { return open_shard(path); });
 }
 
 // The first line where two `sweep_options` texts differ, from each.
@@ -211,17 +217,12 @@ void merge_per_problem(const std::vector<const shard_file*>& having, H5::H5File&
 }  // namespace
 
 bool is_study_file(const std::string& path) {
-  H5::Exception::dontPrint();
-  try {
+  return one_line_errors(fmt::format("cannot read '{}'", path), [&] {
     if (!std::filesystem::exists(path)) throw std::runtime_error("no such file");
     if (!H5::H5File::isHdf5(path)) throw std::runtime_error("not an HDF5 file");
     const H5::H5File file(path, H5F_ACC_RDONLY);
     return has_attr(file, "selection");
-  } catch (const H5::Exception& e) {
-    throw std::runtime_error(fmt::format("cannot read '{}': {}", path, e.getDetailMsg()));
-  } catch (const std::runtime_error& e) {
-    throw std::runtime_error(fmt::format("cannot read '{}': {}", path, e.what()));
-  }
+  });
 }
 
 held_shards held_shards_of(const std::string& path) { return read_shard(path).held; }
@@ -285,11 +286,7 @@ study_merge_result merge_studies(const std::vector<std::string>& paths, const st
                                    : fmt::format(": shard{} {} of {} not given", absent.size() == 1 ? "" : "s",
                                                  fmt::join(absent, ", "), first.held.count)));
   }
-  check_writable(out);
-
-  std::vector<unsigned char> image;
-  try {
-    H5::H5File dst = in_memory_file(out);
+  const auto fill = [&](H5::H5File& dst) {
     // The root's build and machine from the lowest shard that holds a problem (a timed
     // shard with none has no benchmark context: 0 CPUs at 0 MHz).
     const shard_file* root = nullptr;
@@ -382,13 +379,8 @@ study_merge_result merge_studies(const std::vector<std::string>& paths, const st
         if (scaling >= 0) replace_attr(dst, "cpu_scaling_enabled", static_cast<int>(scaling));
       }
     }
-    image = file_image(dst);
-    dst.close();
-  } catch (const H5::Exception& e) {
-    throw std::runtime_error(fmt::format("cannot merge into '{}': HDF5: {}", out, e.getDetailMsg()));
-  }
-  if (before_write) before_write();
-  write_image(image, out);
+  };
+  write_study_file(out, fill, "cannot merge into", before_write);
   return result;
 }
 

@@ -11,17 +11,13 @@
 namespace stepbench {
 namespace {
 
-const column_map<scan_point>& scan_point_columns() {
-  using R = scan_point;
-  static const auto columns = column_map<R>("scan_points", "/scan/<name>/points")
-                                  .member("point", &R::index)
-                                  .member("trusted", &R::trusted)
-                                  .member("truth_source", &R::truth_source)
-                                  .member("horizon", &R::horizon)
-                                  .member("pos_scale", &R::pos_scale)
-                                  .member("note", &R::note);
-  return columns;
-}
+const auto scan_point_columns = column_map<scan_point>("scan_points", "/scan/<name>/points")
+                                    .member("point", &scan_point::index)
+                                    .member("trusted", &scan_point::trusted)
+                                    .member("truth_source", &scan_point::truth_source)
+                                    .member("horizon", &scan_point::horizon)
+                                    .member("pos_scale", &scan_point::pos_scale)
+                                    .member("note", &scan_point::note);
 
 // A run's counts are stored as doubles (a frame's share of them is not whole).
 template <long work_counters::*count>
@@ -33,42 +29,34 @@ void set_counted(scan_run& r, double v) {
   r.row.work.*count = static_cast<long>(v);
 }
 
-const column_map<scan_run>& scan_run_columns() {
-  using R = scan_run;
-  using M = run_metrics;
-  static const auto columns =
-      column_map<R>("scan_runs", "/scan/<name>/runs")
-          .member("point", &R::point)
-          .member("hz", &R::hz)
-          .member("method", &R::method)
-          .member("substeps", &R::substeps)
-          .member("dt", &R::row, &method_row::param)
-          .derived("completed", [](const R& r) { return r.row.metrics.completed(); })
-          .member("diverged", &R::row, &method_row::metrics, &M::diverged)
-          .member("failed", &R::row, &method_row::metrics, &M::failed)
-          .member("skipped", &R::row, &method_row::metrics, &M::skipped)
-          .field(
-              "err_pos_max", [](const R& r) { return r.row.metrics.completed() ? r.row.metrics.err_pos_max : nan; },
-              [](R& r, double v) { r.row.metrics.err_pos_max = v; })
-          .member("steps", &R::row, &method_row::steps)
-          .field("force_evals", counted<&work_counters::force_evals>, set_counted<&work_counters::force_evals>)
-          .field("newton_iterations", counted<&work_counters::newton_iterations>,
-                 set_counted<&work_counters::newton_iterations>)
-          .member("note", &R::row, &method_row::metrics, &M::note);
-  return columns;
-}
+const auto scan_run_columns =
+    column_map<scan_run>("scan_runs", "/scan/<name>/runs")
+        .member("point", &scan_run::point)
+        .member("hz", &scan_run::hz)
+        .member("method", &scan_run::method)
+        .member("substeps", &scan_run::substeps)
+        .member("dt", &scan_run::row, &method_row::param)
+        .derived("completed", [](const scan_run& r) { return r.row.metrics.completed(); })
+        .member("diverged", &scan_run::row, &method_row::metrics, &run_metrics::diverged)
+        .member("failed", &scan_run::row, &method_row::metrics, &run_metrics::failed)
+        .member("skipped", &scan_run::row, &method_row::metrics, &run_metrics::skipped)
+        .field(
+            "err_pos_max",
+            [](const scan_run& r) { return r.row.metrics.completed() ? r.row.metrics.err_pos_max : nan; },
+            [](scan_run& r, double v) { r.row.metrics.err_pos_max = v; })
+        .member("steps", &scan_run::row, &method_row::steps)
+        .field("force_evals", counted<&work_counters::force_evals>, set_counted<&work_counters::force_evals>)
+        .field("newton_iterations", counted<&work_counters::newton_iterations>,
+               set_counted<&work_counters::newton_iterations>)
+        .member("note", &scan_run::row, &method_row::metrics, &run_metrics::note);
 
-const column_map<scan_best>& scan_best_columns() {
-  using R = scan_best;
-  static const auto columns = column_map<R>("scan_best", "/scan/<name>/best")
-                                  .member("point", &R::point)
-                                  .member("hz", &R::hz)
-                                  .member("method", &R::method)
-                                  .member("substeps", &R::substeps)
-                                  .member("err_pos_max", &R::err_pos_max)
-                                  .member("force_evals_per_frame", &R::force_evals_per_frame);
-  return columns;
-}
+const auto scan_best_columns = column_map<scan_best>("scan_best", "/scan/<name>/best")
+                                   .member("point", &scan_best::point)
+                                   .member("hz", &scan_best::hz)
+                                   .member("method", &scan_best::method)
+                                   .member("substeps", &scan_best::substeps)
+                                   .member("err_pos_max", &scan_best::err_pos_max)
+                                   .member("force_evals_per_frame", &scan_best::force_evals_per_frame);
 
 // /scan/<which>, from a file the reader has checked.
 scan_result read_scan_group(const H5::Group& all, const std::string& which) {
@@ -113,7 +101,7 @@ scan_result read_scan_group(const H5::Group& all, const std::string& which) {
                                          which, s.grid_points, product));
   o.shard_index = static_cast<int>(h5::long_attr(g, "shard_index"));
   o.shard_count = static_cast<int>(h5::long_attr(g, "shard_count"));
-  s.points = scan_point_columns().read(g, "points");
+  s.points = scan_point_columns.read(g, "points");
   std::map<std::size_t, std::size_t> local_of;  // grid index -> row
   for (std::size_t i = 0; i < s.points.size(); ++i) {
     auto& p = s.points[i];
@@ -127,7 +115,7 @@ scan_result read_scan_group(const H5::Group& all, const std::string& which) {
                                            static_cast<std::int64_t>(p.index), s.grid_points));
     local_of[p.index] = i;
   }
-  s.runs = scan_run_columns().read(g, "runs");
+  s.runs = scan_run_columns.read(g, "runs");
   for (std::size_t i = 0; i < s.runs.size(); ++i) {
     auto& r = s.runs[i];
     const auto at = local_of.find(r.point);
@@ -143,7 +131,7 @@ scan_result read_scan_group(const H5::Group& all, const std::string& which) {
 }  // namespace
 
 std::vector<schema::table> scan_tables() {
-  return {scan_point_columns().spec(), scan_run_columns().spec(), scan_best_columns().spec()};
+  return {scan_point_columns.spec(), scan_run_columns.spec(), scan_best_columns.spec()};
 }
 
 std::vector<scan_result> read_scans(const std::string& path) {
@@ -237,14 +225,14 @@ void write_scans(H5::Group& root, const std::vector<scan_result>& scans) {
       for (const auto& p : sc.points) column.push_back(p.values[k]);
       h5::dataset(values, o.axes[k].param, column);
     }
-    scan_point_columns().write(g, "points", sc.points);
+    scan_point_columns.write(g, "points", sc.points);
     // Runs and answers name their point by its place in the whole grid.
     std::vector<scan_run> runs = sc.runs;
     for (auto& r : runs) r.point = sc.points[r.point].index;
-    scan_run_columns().write(g, "runs", runs);
+    scan_run_columns.write(g, "runs", runs);
     std::vector<scan_best> best = sc.best;
     for (auto& b : best) b.point = sc.points[b.point].index;
-    scan_best_columns().write(g, "best", best);
+    scan_best_columns.write(g, "best", best);
   }
 }
 

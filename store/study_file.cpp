@@ -98,28 +98,23 @@ struct equal_error_row {
   bool is_answer = false;
 };
 
-const column_map<equal_error_row>& ranked_equal_error_columns() {
-  using R = equal_error_row;
-  using P = wp_pick;
-  static const auto columns = column_map<R>("equal_error", "/problems/<p>/equal_error")
-                                  .member("metric", &R::metric)
-                                  .member("target", &R::target)
-                                  .member("rank", &R::rank)
-                                  .member("method", &R::method)
-                                  .member("origin", &R::origin)
-                                  .member("kind", &R::kind)
-                                  .member("param", &R::pick, &P::param)
-                                  .member("error", &R::pick, &P::error)
-                                  .member("cost_kind", &R::cost_kind)
-                                  .member("cost", &R::pick, &P::cost)
-                                  .member("cost_lo", &R::pick, &P::cost_lo)
-                                  .member("cost_hi", &R::pick, &P::cost_hi)
-                                  .member("time_ns", &R::pick, &P::time_ns)
-                                  .member("force_evals", &R::pick, &P::force_evals)
-                                  .member("interpolated", &R::pick, &P::interpolated)
-                                  .member("is_answer", &R::is_answer);
-  return columns;
-}
+const auto ranked_equal_error_columns = column_map<equal_error_row>("equal_error", "/problems/<p>/equal_error")
+                                            .member("metric", &equal_error_row::metric)
+                                            .member("target", &equal_error_row::target)
+                                            .member("rank", &equal_error_row::rank)
+                                            .member("method", &equal_error_row::method)
+                                            .member("origin", &equal_error_row::origin)
+                                            .member("kind", &equal_error_row::kind)
+                                            .member("param", &equal_error_row::pick, &wp_pick::param)
+                                            .member("error", &equal_error_row::pick, &wp_pick::error)
+                                            .member("cost_kind", &equal_error_row::cost_kind)
+                                            .member("cost", &equal_error_row::pick, &wp_pick::cost)
+                                            .member("cost_lo", &equal_error_row::pick, &wp_pick::cost_lo)
+                                            .member("cost_hi", &equal_error_row::pick, &wp_pick::cost_hi)
+                                            .member("time_ns", &equal_error_row::pick, &wp_pick::time_ns)
+                                            .member("force_evals", &equal_error_row::pick, &wp_pick::force_evals)
+                                            .member("interpolated", &equal_error_row::pick, &wp_pick::interpolated)
+                                            .member("is_answer", &equal_error_row::is_answer);
 
 // The equal-error table: for each metric and target, every method that reaches it with
 // its cost at equal error interpolated on its measured curve, ranked (core/work_precision.hpp).
@@ -138,7 +133,7 @@ void write_equal_error(H5::Group& g, const problem_study& ps, bool timed) {
       }
     }
   }
-  ranked_equal_error_columns().write(g, "equal_error", rows);
+  ranked_equal_error_columns.write(g, "equal_error", rows);
 }
 
 struct front_row {
@@ -146,22 +141,18 @@ struct front_row {
   double param = 0.0, cost = 0.0, err_pos_max = 0.0;
 };
 
-const column_map<front_row>& front_columns() {
-  using R = front_row;
-  static const auto columns = column_map<R>("front", "/problems/<p>/front_force_evals, /problems/<p>/front_time")
-                                  .member("method", &R::method)
-                                  .member("param", &R::param)
-                                  .member("cost", &R::cost)
-                                  .member("err_pos_max", &R::err_pos_max);
-  return columns;
-}
+const auto front_columns = column_map<front_row>("front", "/problems/<p>/front_force_evals, /problems/<p>/front_time")
+                               .member("method", &front_row::method)
+                               .member("param", &front_row::param)
+                               .member("cost", &front_row::cost)
+                               .member("err_pos_max", &front_row::err_pos_max);
 
 void write_front(H5::Group& g, const problem_study& ps, bool by_time, bool timed) {
   const auto methods = work_precision_input(ps, "err_pos_max");
   std::vector<front_row> rows;
   for (const auto& p : pareto_front(methods, by_time, timed))
     rows.push_back({methods[p.method].name, methods[p.method].rows[p.row].param, p.cost, p.error});
-  front_columns().write(g, by_time ? "front_time" : "front_force_evals", rows);
+  front_columns.write(g, by_time ? "front_time" : "front_force_evals", rows);
 }
 
 void write_problem(H5::Group& parent, const problem_study& ps, const std::optional<timing_settings>& timing) {
@@ -415,8 +406,7 @@ const column_map<method_row>& runs_columns() {
 }
 
 std::vector<schema::table> problems_tables() {
-  return {runs_columns().spec(), parameters_columns().spec(), ranked_equal_error_columns().spec(),
-          front_columns().spec()};
+  return {runs_columns().spec(), parameters_columns().spec(), ranked_equal_error_columns.spec(), front_columns.spec()};
 }
 
 void check_writable(const std::string& path) {
@@ -430,7 +420,30 @@ void check_writable(const std::string& path) {
   std::remove(tmp.c_str());
 }
 
-void write_study_file(const std::string& path, const std::function<void(H5::H5File&)>& fill) {
+namespace {
+
+// A file built in memory (HDF5's core driver, no backing store) and named after a
+// temporary path beside `path`.
+H5::H5File in_memory_file(const std::string& path) {
+  H5::FileAccPropList in_memory;
+  in_memory.setCore(std::size_t{1} << 20, false);
+  return H5::H5File(temp_path_for(path), H5F_ACC_TRUNC, H5::FileCreatPropList::DEFAULT, in_memory);
+}
+
+// The file's image.
+std::vector<unsigned char> file_image(H5::H5File& file) {
+  file.flush(H5F_SCOPE_GLOBAL);
+  const ssize_t size = H5Fget_file_image(file.getId(), nullptr, 0);
+  std::vector<unsigned char> image(size > 0 ? static_cast<std::size_t>(size) : 0);
+  if (size <= 0 || H5Fget_file_image(file.getId(), image.data(), image.size()) != size)
+    throw H5::FileIException("H5Fget_file_image", "cannot take the file's image");
+  return image;
+}
+
+}  // namespace
+
+void write_study_file(const std::string& path, const std::function<void(H5::H5File&)>& fill, std::string_view failing,
+                      const std::function<void()>& before_write) {
   check_writable(path);
   H5::Exception::dontPrint();
   std::vector<unsigned char> image;
@@ -440,24 +453,10 @@ void write_study_file(const std::string& path, const std::function<void(H5::H5Fi
     image = file_image(file);
     file.close();
   } catch (const H5::Exception& e) {
-    throw std::runtime_error(fmt::format("cannot write results file '{}': HDF5: {}", path, e.getDetailMsg()));
+    throw std::runtime_error(fmt::format("{} '{}': HDF5: {}", failing, path, e.getDetailMsg()));
   }
+  if (before_write) before_write();
   write_image(image, path);
-}
-
-H5::H5File in_memory_file(const std::string& path) {
-  H5::FileAccPropList in_memory;
-  in_memory.setCore(std::size_t{1} << 20, false);
-  return H5::H5File(temp_path_for(path), H5F_ACC_TRUNC, H5::FileCreatPropList::DEFAULT, in_memory);
-}
-
-std::vector<unsigned char> file_image(H5::H5File& file) {
-  file.flush(H5F_SCOPE_GLOBAL);
-  const ssize_t size = H5Fget_file_image(file.getId(), nullptr, 0);
-  std::vector<unsigned char> image(size > 0 ? static_cast<std::size_t>(size) : 0);
-  if (size <= 0 || H5Fget_file_image(file.getId(), image.data(), image.size()) != size)
-    throw H5::FileIException("H5Fget_file_image", "cannot take the file's image");
-  return image;
 }
 
 void write_image(const std::vector<unsigned char>& image, const std::string& path) {

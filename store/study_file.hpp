@@ -21,8 +21,12 @@ void check_writable(const std::string& path);
 
 // Builds a study file in memory with `fill` and writes it to a temporary file beside
 // `path`, renamed into place when whole: an existing file is replaced whole or not at all
-// (parts/study.hpp write_study fills it with the root attributes and every part).
-void write_study_file(const std::string& path, const std::function<void(H5::H5File&)>& fill);
+// (parts/study.hpp write_study fills it with the root attributes and every part; a merge
+// with the shards). An HDF5 error is "<failing> '<path>': HDF5: <error>"; `before_write`,
+// if given, runs between the build and the write.
+void write_study_file(const std::string& path, const std::function<void(H5::H5File&)>& fill,
+                      std::string_view failing = "cannot write results file",
+                      const std::function<void()>& before_write = {});
 
 // The root attributes of a study file: format, build, machine, the sweep's settings
 // (`described_options`: the parts' describe lines), timing.
@@ -45,11 +49,8 @@ void write_machine(H5::H5Object& obj, const std::optional<timing_settings>& timi
 // the errno of the write that failed (EIO for one that wrote nothing).
 int write_bytes(int fd, const void* data, std::size_t size);
 
-// A file built in memory (HDF5's core driver, no backing store) and named after a
-// temporary path beside `path`; its image; and the image written to a temporary file
-// beside `path`, renamed into place when whole (as write_study writes).
-H5::H5File in_memory_file(const std::string& path);
-std::vector<unsigned char> file_image(H5::H5File& file);
+// An image of a file written to a temporary file beside `path`, renamed into place when
+// whole (as write_study writes).
 void write_image(const std::vector<unsigned char>& image, const std::string& path);
 
 // A problem's declared parameters (core/parameter.hpp) as the /problems/<p>/parameters

@@ -17,28 +17,22 @@ const column_map<substep_row>& substep_runs_columns() {
   return columns;
 }
 
-const column_map<substep_verdict>& substep_verdict_columns() {
-  using R = substep_verdict;
-  static const auto columns = column_map<R>("substeps_verdict", "/substeps/<p>/verdict")
-                                  .member("implicit_method", &R::implicit_method)
-                                  .member("explicit_method", &R::explicit_method)
-                                  .member("cost_kind", &R::cost_kind)
-                                  .member("implicit_cost", &R::implicit_cost)
-                                  .member("implicit_error", &R::implicit_error)
-                                  .member("implicit_damping", &R::implicit_damping)
-                                  .member("substeps_at_equal_cost", &R::substeps_at_equal_cost)
-                                  .member("explicit_cost", &R::explicit_cost)
-                                  .member("explicit_error", &R::explicit_error)
-                                  .member("explicit_damping", &R::explicit_damping)
-                                  .member("substeps_to_match", &R::substeps_to_match)
-                                  .member("cost_to_match", &R::cost_to_match)
-                                  .member("summary", &R::summary);
-  return columns;
-}
+const auto substep_verdict_columns = column_map<substep_verdict>("substeps_verdict", "/substeps/<p>/verdict")
+                                         .member("implicit_method", &substep_verdict::implicit_method)
+                                         .member("explicit_method", &substep_verdict::explicit_method)
+                                         .member("cost_kind", &substep_verdict::cost_kind)
+                                         .member("implicit_cost", &substep_verdict::implicit_cost)
+                                         .member("implicit_error", &substep_verdict::implicit_error)
+                                         .member("implicit_damping", &substep_verdict::implicit_damping)
+                                         .member("substeps_at_equal_cost", &substep_verdict::substeps_at_equal_cost)
+                                         .member("explicit_cost", &substep_verdict::explicit_cost)
+                                         .member("explicit_error", &substep_verdict::explicit_error)
+                                         .member("explicit_damping", &substep_verdict::explicit_damping)
+                                         .member("substeps_to_match", &substep_verdict::substeps_to_match)
+                                         .member("cost_to_match", &substep_verdict::cost_to_match)
+                                         .member("summary", &substep_verdict::summary);
 
-std::vector<schema::table> substeps_tables() {
-  return {substep_runs_columns().spec(), substep_verdict_columns().spec()};
-}
+std::vector<schema::table> substeps_tables() { return {substep_runs_columns().spec(), substep_verdict_columns.spec()}; }
 
 void write_substeps(H5::Group& root, const std::vector<substep_study>& studies, bool timed) {
   if (studies.empty()) return;
@@ -53,7 +47,7 @@ void write_substeps(H5::Group& root, const std::vector<substep_study>& studies, 
       h5::attr(mg, "needs_jacobian", static_cast<int>(m.info.traits.needs_jacobian));
       substep_runs_columns().write(mg, "runs", m.rows, timed);
     }
-    substep_verdict_columns().write(g, "verdict", substep_verdicts(s, timed));
+    substep_verdict_columns.write(g, "verdict", substep_verdicts(s, timed));
   }
 }
 

@@ -79,56 +79,44 @@ const column_map<equal_error_verdict>& equal_error_columns() {
   return columns;
 }
 
-const column_map<frame_stability>& frame_rate_columns() {
-  using R = frame_stability;
-  static const auto columns = column_map<R>("verdict_frame_rate", "/verdict/frame_rate")
-                                  .member("problem", &R::problem)
-                                  .member("unit", &R::unit)
-                                  .member("hz", &R::hz)
-                                  .member("method", &R::method)
-                                  .member("stable", &R::stable)
-                                  .member("err_pos_max", &R::err_pos_max)
-                                  .member("note", &R::note);
-  return columns;
-}
+const auto frame_rate_columns = column_map<frame_stability>("verdict_frame_rate", "/verdict/frame_rate")
+                                    .member("problem", &frame_stability::problem)
+                                    .member("unit", &frame_stability::unit)
+                                    .member("hz", &frame_stability::hz)
+                                    .member("method", &frame_stability::method)
+                                    .member("stable", &frame_stability::stable)
+                                    .member("err_pos_max", &frame_stability::err_pos_max)
+                                    .member("note", &frame_stability::note);
 
-const column_map<frame_answer>& frame_answer_columns() {
-  using R = frame_answer;
-  static const auto columns = column_map<R>("verdict_frame_answer", "/verdict/frame_answer")
-                                  .member("problem", &R::problem)
-                                  .member("unit", &R::unit)
-                                  .member("hz", &R::hz)
-                                  .member("target", &R::target)
-                                  .member("method", &R::method)
-                                  .member("substeps", &R::substeps)
-                                  .member("err_pos_max", &R::err_pos_max)
-                                  .member("cost_per_frame", &R::cost_per_frame)
-                                  .member("frame_share", &R::frame_share);
-  return columns;
-}
+const auto frame_answer_columns = column_map<frame_answer>("verdict_frame_answer", "/verdict/frame_answer")
+                                      .member("problem", &frame_answer::problem)
+                                      .member("unit", &frame_answer::unit)
+                                      .member("hz", &frame_answer::hz)
+                                      .member("target", &frame_answer::target)
+                                      .member("method", &frame_answer::method)
+                                      .member("substeps", &frame_answer::substeps)
+                                      .member("err_pos_max", &frame_answer::err_pos_max)
+                                      .member("cost_per_frame", &frame_answer::cost_per_frame)
+                                      .member("frame_share", &frame_answer::frame_share);
 
-const column_map<frame_option>& frame_rate_run_columns() {
-  using R = frame_option;
-  static const auto columns = column_map<R>("frame_rate_runs", "/frame_rates/<p>/runs")
-                                  .member("hz", &R::hz)
-                                  .member("method", &R::method)
-                                  .member("substeps", &R::substeps)
-                                  .member("dt", &R::dt)
-                                  .member("completed", &R::completed)
-                                  .member("diverged", &R::diverged)
-                                  .member("err_pos_max", &R::err_pos_max)
-                                  .member("steps", &R::steps)
-                                  .member("force_evals", &R::force_evals)
-                                  .member("cost_per_frame", &R::cost_per_frame)
-                                  .member("note", &R::note);
-  return columns;
-}
+const auto frame_rate_run_columns = column_map<frame_option>("frame_rate_runs", "/frame_rates/<p>/runs")
+                                        .member("hz", &frame_option::hz)
+                                        .member("method", &frame_option::method)
+                                        .member("substeps", &frame_option::substeps)
+                                        .member("dt", &frame_option::dt)
+                                        .member("completed", &frame_option::completed)
+                                        .member("diverged", &frame_option::diverged)
+                                        .member("err_pos_max", &frame_option::err_pos_max)
+                                        .member("steps", &frame_option::steps)
+                                        .member("force_evals", &frame_option::force_evals)
+                                        .member("cost_per_frame", &frame_option::cost_per_frame)
+                                        .member("note", &frame_option::note);
 
 }  // namespace
 
 std::vector<schema::table> verdict_file_tables() {
-  return {equal_error_columns().spec(), frame_rate_columns().spec(), frame_answer_columns().spec(),
-          frame_rate_run_columns().spec()};
+  return {equal_error_columns().spec(), frame_rate_columns.spec(), frame_answer_columns.spec(),
+          frame_rate_run_columns.spec()};
 }
 
 void write_verdict(H5::Group& root, const study& s) {
@@ -148,8 +136,8 @@ void write_verdict(H5::Group& root, const study& s) {
        "lies outside the timing noise: the larger of 15 % (25 % from one repetition) and 3 x the repetitions' "
        "relative spread, the band stepbench compare uses between two runs");
   equal_error_columns().write(g, "equal_error", v.equal_error);
-  frame_rate_columns().write(g, "frame_rate", v.frame_rate);
-  frame_answer_columns().write(g, "frame_answer", v.frame_answers);
+  frame_rate_columns.write(g, "frame_rate", v.frame_rate);
+  frame_answer_columns.write(g, "frame_answer", v.frame_answers);
 }
 
 void write_frame_rates(H5::Group& root, const study& s) {
@@ -161,7 +149,7 @@ void write_frame_rates(H5::Group& root, const study& s) {
     H5::Group pg = fr.createGroup(fs.problem);
     attr(pg, "horizon", fs.horizon);
     attr(pg, "position_unit", fs.unit);
-    frame_rate_run_columns().write(pg, "runs", frame_options(s, fs));
+    frame_rate_run_columns.write(pg, "runs", frame_options(s, fs));
   }
 }
 
@@ -177,7 +165,7 @@ void read_frame_rates(const H5::Group& root, study& s) {
     // The run as the file keeps it: a run that did not complete and did not diverge
     // failed (or was skipped: the file does not tell them apart); its cost a frame is
     // derived again from the sweep's rows (frame_options).
-    for (const frame_option& o : frame_rate_run_columns().read(g, "runs")) {
+    for (const frame_option& o : frame_rate_run_columns.read(g, "runs")) {
       frame_rate_run& r = fs.runs.emplace_back();
       r.hz = o.hz;
       r.method = o.method;
@@ -201,8 +189,8 @@ verdict_tables read_verdict(const H5::Group& root) {
   v.cost_kind = h5::string_attr(g, "cost_kind");
   v.findings = stored_list(h5::string_attr(g, "findings"), '\n');  // a finding is one sentence, never empty
   v.equal_error = equal_error_columns().read(g, "equal_error");
-  v.frame_rate = frame_rate_columns().read(g, "frame_rate");
-  v.frame_answers = frame_answer_columns().read(g, "frame_answer");
+  v.frame_rate = frame_rate_columns.read(g, "frame_rate");
+  v.frame_answers = frame_answer_columns.read(g, "frame_answer");
   return v;
 }
 

@@ -1,20 +1,43 @@
 #include "run/frame_rates.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 
 #include "core/contains.hpp"
 #include "core/measure.hpp"
 
 namespace stepbench {
 
-frames frames_of(double problem_horizon, const std::vector<double>& hz) {
+namespace {
+// Whole frames of the slowest rate (at least one) and the horizon they span.
+double whole_frames_horizon(double problem_horizon, const std::vector<double>& hz) {
   const double slowest = *std::min_element(hz.begin(), hz.end());
+  return std::max(1.0, std::floor(problem_horizon * slowest * (1.0 + 1e-12))) / slowest;
+}
+}  // namespace
+
+std::string frames_over_limit(double problem_horizon, const std::vector<double>& hz, double coordinates) {
+  const double fastest = *std::max_element(hz.begin(), hz.end());
+  const double ends = whole_frames_horizon(problem_horizon, hz) * fastest;
+  if (!(ends <= max_frame_ends))
+    return fmt::format("{:.3g} frame ends ({:g} Hz over {:.3g} s); the limit is {:g}", ends, fastest, problem_horizon,
+                       max_frame_ends);
+  if (!(ends * coordinates <= max_frame_coordinates))
+    return fmt::format("{:.3g} frame ends x {:g} coordinates ({:g} Hz over {:.3g} s) = {:.3g}; the limit is {:g}", ends,
+                       coordinates, fastest, problem_horizon, ends * coordinates, max_frame_coordinates);
+  return "";
+}
+
+frames frames_of(double problem_horizon, const std::vector<double>& hz) {
+  if (!(problem_horizon * *std::max_element(hz.begin(), hz.end()) <= 2 * max_frame_ends))
+    throw std::invalid_argument(frames_over_limit(problem_horizon, hz, 1.0));  // callers check first
   const double fastest = *std::max_element(hz.begin(), hz.end());
   frames f;
-  const long slow_frames = std::max(1L, static_cast<long>(std::floor(problem_horizon * slowest * (1.0 + 1e-12))));
-  f.horizon = static_cast<double>(slow_frames) / slowest;
+  f.horizon = whole_frames_horizon(problem_horizon, hz);
   const long fast_frames = std::lround(f.horizon * fastest);
   for (long j = 1; j <= fast_frames; ++j) f.times.push_back(static_cast<double>(j) / fastest);
   return f;
@@ -40,6 +63,10 @@ std::vector<frame_rate_study> run_frame_rates(const study& s, const frame_rate_o
   for (const auto& ps : s.problems) {
     if (!ps.truth.trusted) continue;
     if (static_cast<long>(std::floor(ps.horizon * slowest * (1.0 + 1e-12))) < 1) continue;  // no whole frame
+    if (const auto why = frames_over_limit(ps.horizon, opts.hz, ps.problem->dim()); !why.empty()) {
+      std::fprintf(stderr, "frame rates: %s left out: %s\n", std::string(ps.problem->name()).c_str(), why.c_str());
+      continue;
+    }
     const frames f = frames_of(ps.horizon, opts.hz);
     frame_rate_study fs;
     fs.problem = std::string(ps.problem->name());

@@ -120,7 +120,6 @@ std::vector<std::vector<double>> scan_grid(const std::vector<scan_axis>& axes) {
 
 void validate(const scan_options& opts) {
   auto problem = make_problem(opts.problem);  // throws, naming an unknown problem
-  if (opts.axes.empty()) throw std::invalid_argument("scan: give at least one --param axis");
   for (std::size_t i = 0; i < opts.axes.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)
       if (opts.axes[i].param == opts.axes[j].param)
@@ -163,6 +162,12 @@ void validate(const scan_options& opts) {
     for (const auto& a : opts.axes)
       if (a.param == name) throw std::invalid_argument(fmt::format("scan: {} is both set and scanned", name));
   }
+  // The frame ends' bound (run/frame_rates.hpp) at the problem as set: refused here, not
+  // after minutes of points; a grid point over it (a horizon or a size scanned) is recorded
+  // as not run, with the reason.
+  if (problem->validate().empty())
+    if (const auto why = frames_over_limit(problem->horizon(), opts.hz, problem->dim()); !why.empty())
+      throw std::invalid_argument(fmt::format("scan: {}: give a lower --hz or a shorter horizon", why));
 }
 
 std::vector<scan_options> default_scans(bool quick) {
@@ -230,6 +235,12 @@ scan_result run_scan(const scan_options& opts) {
     for (const auto& [name, value] : opts.fixed) problem->set(name, value);
     for (std::size_t a = 0; a < opts.axes.size(); ++a) problem->set(opts.axes[a].param, grid[i][a]);
     if (auto why = problem->validate(); !why.empty()) {
+      w.point.trusted = false;
+      w.point.truth_source = "none";
+      w.point.note = "not run: " + why;
+      return;
+    }
+    if (auto why = frames_over_limit(problem->horizon(), opts.hz, problem->dim()); !why.empty()) {
       w.point.trusted = false;
       w.point.truth_source = "none";
       w.point.note = "not run: " + why;

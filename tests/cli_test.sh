@@ -196,6 +196,20 @@ grep -q 'e+0[0-9] ns' "$work/out" && bad "loop prints powers of ten of ns: $(cat
 expect_error "outside the parameter's range: k_s must be a positive finite number" scan --problem stiff_spring --param stiff_spring.k_s=-1:1e7:5 --out "$work/scan.h5"
 expect_error "stiff_spring has no parameter 'kk'" scan --problem stiff_spring --param stiff_spring.kk=1:2:3 --out "$work/scan.h5"
 expect_error "frame rate 45 Hz does not divide the fastest, 60 Hz" scan --problem stiff_spring --param stiff_spring.k_s=1:2:3 --hz 60,45 --out "$work/scan.h5"
+# Rates and horizons are bounded before anything is allocated (a scan at 1e9 Hz grew past
+# 8 GB): 0.533 s x 1e9 Hz = 5.33e8 frame ends, refused; a grid point over the bound is not
+# run, with the reason, and the scan goes on (durations 1 and 1e9 s at 240 Hz).
+expect_error "scan: 5.33e+08 frame ends (1e+09 Hz over 0.533 s); the limit is 1e+07" \
+  scan --problem stiff_spring --param stiff_spring.k_s=1e1:1e7:5:log --hz 1e9 --out "$work/scan.h5"
+"$bin" scan --problem stiff_spring --param stiff_spring.duration=1:1e9:2:log --hz 240 --integrator rk4 --substeps 16 \
+  --quiet --out "$work/long.h5" >/dev/null && /usr/bin/python3 -c '
+import sys, h5py
+with h5py.File(sys.argv[1]) as f:
+    notes = [n.decode() for n in f["scan/stiff_spring/points"]["note"]]
+    runs = f["scan/stiff_spring/runs"][:]
+assert notes == ["", "not run: 2.4e+11 frame ends (240 Hz over 1e+09 s); the limit is 1e+07"], notes
+assert list(runs["point"]) == [0] and runs["err_pos_max"][0] < 1e-3, runs
+' "$work/long.h5" && ok || bad "scan over long horizons: the points over the frame bound are not run"
 [ ! -e "$work/scan.h5" ] && ok || bad "a refused scan wrote its file"
 "$bin" scan --problem stiff_spring --param stiff_spring.k_s=1e1:1e7:25:log --hz 60 --substeps 1,8 --json \
   --out "$work/scan.h5" >"$work/out" 2>"$work/err" || bad "scan failed: $(cat "$work/err")"

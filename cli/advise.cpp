@@ -3,16 +3,23 @@
 #include "judge/advise.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
+#include <algorithm>
+#include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "cli/args.hpp"
 #include "cli/commands.hpp"
 #include "judge/scan.hpp"
 #include "judge/verdict.hpp"
 #include "parts/study.hpp"
+#include "registry/registry.hpp"
 #include "render/advise.hpp"
 #include "render/scan.hpp"
+#include "run/scan.hpp"
+#include "run/sweep.hpp"
 #include "store/scan.hpp"
 #include "study/scan.hpp"
 
@@ -30,8 +37,9 @@ using json = nlohmann::json;
 
 struct advise_args {
   std::string problem, tol_text, metric = "err_pos_max", study = "results/study.h5";
-  std::string hz_text;          // set: the frame-rate question instead
-  std::string scan, scan_name;  // set: the range question, from a scan (study/scan.hpp)
+  std::string hz_text;            // set: the frame-rate question instead
+  std::string scan, scan_name;    // set: the range question, from a scan (study/scan.hpp)
+  std::vector<std::string> sets;  // P.name=value: a scene the study did not run, run here
   bool json = false;
 };
 
@@ -47,8 +55,8 @@ json pick_json(const advice& a, const wp_pick& p) {
 }
 
 json frame_advice_json(const frame_advice& f) {
-  json out = {{"problem", f.problem},     {"hz", f.hz},           {"tol", f.tol},  {"unit", f.unit},
-              {"cost_kind", f.cost_kind}, {"horizon", f.horizon}, {"met", f.met()}};
+  json out = {{"problem", f.problem}, {"scene", f.scene},         {"hz", f.hz},           {"tol", f.tol},
+              {"unit", f.unit},       {"cost_kind", f.cost_kind}, {"horizon", f.horizon}, {"met", f.met()}};
   out["choice"] = f.met() ? json(f.ranked.front()) : json(nullptr);
   out["ranked"] = f.ranked;
   out["one_step"] = f.one_step;
@@ -58,8 +66,8 @@ json frame_advice_json(const frame_advice& f) {
 
 json advice_json(const advice& a) {
   const auto answer = a.result.answer(a.methods);
-  json out = {{"problem", a.problem},  {"metric", a.metric}, {"tol", a.tol},  {"unit", a.unit},
-              {"cost", a.result.cost}, {"timings", a.timed}, {"met", a.met()}};
+  json out = {{"problem", a.problem}, {"scene", a.scene},      {"metric", a.metric}, {"tol", a.tol},
+              {"unit", a.unit},       {"cost", a.result.cost}, {"timings", a.timed}, {"met", a.met()}};
   out["choice"] = answer ? pick_json(a, *answer) : json(nullptr);
   out["runners_up"] = json::array();
   for (const auto& p : a.result.ranked)
@@ -84,10 +92,40 @@ study study_not_scan(const std::string& path) {
   return s;
 }
 
+// The frame-rate question for a scene or rate the study lacks: its frame-rate runs at that
+// rate, run here as a scan of one point (study/scan.hpp), answered by the scan's rule.
+// Ranked as a scan ranks: by the study's measured ns per force evaluation when it is timed.
+int advise_frame_here(const advise_args& args, const std::map<std::string, double>& fixed, double hz, double tol,
+                      const std::string& why, const study* costs) {
+  scan_options o;
+  o.problem = args.problem;
+  o.hz = {hz};
+  o.tol = tol;
+  o.fixed = fixed;
+  validate(o);
+  if (costs) take_costs(o, *costs, args.study);
+  fmt::print(stderr, "{}: running {}'s frame-rate runs at {:g} Hz here (untimed)\n", why, args.problem, hz);
+  const scan_answer a = answer_scan(run_scan(o), tol);
+  print_answer(args.json, scan_answer_json(a), format_scan_answer(a));
+  return a.choices.front().method.empty() ? advise_exit_no_method : 0;
+}
+
+// The dt (or tolerance) question for a scene the study did not run: its sweep, run here.
+study sweep_here(const std::string& problem, const parameter_overrides& sets) {
+  sweep_options o;
+  o.problems = {problem};
+  o.overrides = sets;
+  o.parts = {"sweep"};
+  validate(o);
+  fmt::print(stderr, "--set makes a scene the study did not run: sweeping {} here (untimed)\n", problem);
+  return run_sweep(o);
+}
+
 int run_advise(const advise_args& args) {
   const double tol = parse_positive(args.tol_text, "--tol");
   if (!args.scan.empty()) {
     if (!args.hz_text.empty()) throw std::invalid_argument("--scan answers at the scan's frame rates; drop --hz");
+    if (!args.sets.empty()) throw std::invalid_argument("--scan answers for the scan's scenes; drop --set");
     const scan_result s = read_scan(args.scan, args.scan_name);
     if (!args.problem.empty() && args.problem != s.options.problem)
       throw std::invalid_argument(
@@ -99,15 +137,25 @@ int run_advise(const advise_args& args) {
     return advise_exit_no_method;
   }
   if (args.problem.empty()) throw std::invalid_argument("--problem is required (or --scan FILE)");
+  parameter_overrides sets;
+  for (const auto& text : args.sets) add_override(sets, text, std::vector<std::string>{args.problem});
+  const auto fixed = sets.count(args.problem) ? sets.at(args.problem) : std::map<std::string, double>{};
   if (!args.hz_text.empty()) {
-    const double hz = parse_number(args.hz_text, "--hz");
+    const double hz = parse_positive(args.hz_text, "--hz");
     if (args.metric != "err_pos_max")
       throw std::invalid_argument("--hz answers for err_pos_max only (the frame-rate study measures that)");
-    const frame_advice f = advise_frame(study_not_scan(args.study), args.problem, hz, tol);
+    // A scene or rate the study lacks is run here, ranked by the study's costs if it has them.
+    std::optional<study> s;
+    if (std::filesystem::exists(args.study)) s = study_not_scan(args.study);
+    const std::string missing = !s               ? fmt::format("there is no study file '{}'", args.study)
+                                : !fixed.empty() ? "--set makes a scene the study did not run"
+                                                 : frame_runs_missing(*s, args.problem, hz);
+    if (!missing.empty()) return advise_frame_here(args, fixed, hz, tol, missing, s ? &*s : nullptr);
+    const frame_advice f = advise_frame(*s, args.problem, hz, tol);
     print_answer(args.json, frame_advice_json(f), format_frame_advice(f));
     return f.met() ? 0 : advise_exit_no_method;
   }
-  const study s = study_not_scan(args.study);
+  const study s = fixed.empty() ? study_not_scan(args.study) : sweep_here(args.problem, sets);
   const advice a = advise(s, args.problem, args.metric, tol);
   print_answer(args.json, advice_json(a), format_advice(a));
   return a.met() ? 0 : advise_exit_no_method;
@@ -125,7 +173,9 @@ command add_advise(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--hz", a->hz_text,
                   "frame rate: the methods stable at one step a frame, and the cheapest method and substeps a frame "
-                  "that meet --tol (from the study's frame-rate runs: 30, 60, 120 or 240)");
+                  "that meet --tol (from the study's frame-rate runs; any other rate is run here)");
+  sub->add_option("--set", a->sets,
+                  "P.name=value (repeatable): a scene the study did not run; its runs are made here, untimed");
   sub->add_option("--study", a->study, "study file to read")->capture_default_str();
   sub->add_option("--scan", a->scan,
                   "a file written by `stepbench scan`: the cheapest method and substeps that hold over the whole "

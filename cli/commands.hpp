@@ -11,8 +11,10 @@
 #include <nlohmann/json.hpp>
 
 namespace stepbench {
-struct scan_answer;  // study/scan.hpp
-}
+struct scan_answer;   // study/scan.hpp
+struct scan_options;  // study/scan.hpp
+struct study;         // study/study.hpp
+}  // namespace stepbench
 
 namespace stepbench::cli {
 
@@ -33,6 +35,7 @@ command add_energy(CLI::App& app);
 command add_schema(CLI::App& app);
 command add_scan(CLI::App& app);
 command add_merge(CLI::App& app);
+command add_summary(CLI::App& app);
 
 // A command's answer on stdout: the JSON document (indented by two) with --json, else the text.
 inline void print_answer(bool as_json, const nlohmann::json& out, const std::string& text) {
@@ -44,5 +47,9 @@ inline void print_answer(bool as_json, const nlohmann::json& out, const std::str
 
 // The range answer of a scan as JSON (`scan --json`, `advise --scan --json`).
 nlohmann::json scan_answer_json(const scan_answer& a);
+
+// A scan's ranking cost (scan_options::ns_per_force_eval) from the study `s` read from
+// `path`, when it has timed rows of the scan's problem; else the scan ranks by evaluations.
+void take_costs(scan_options& o, const study& s, const std::string& path);
 
 }  // namespace stepbench::cli

@@ -23,7 +23,8 @@ int main(int argc, char** argv) {
                        "print the version, commit, build type and flags, and exit");
   const std::vector<command> commands{add_list(app),   add_run(app),     add_sweep(app),     add_advise(app),
                                       add_ratios(app), add_compare(app), add_stability(app), add_loop(app),
-                                      add_energy(app), add_schema(app),  add_scan(app),      add_merge(app)};
+                                      add_energy(app), add_schema(app),  add_scan(app),      add_merge(app),
+                                      add_summary(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {  // --help, --help-all, --version: printed by exit()

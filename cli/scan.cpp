@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -30,6 +31,9 @@ nlohmann::json scan_answer_json(const scan_answer& a) {
                         {"points", a.points},
                         {"grid_points", a.grid_points},
                         {"untrusted_points", a.untrusted},
+                        {"cost_kind", a.cost_kind},
+                        {"cost_source", a.cost_source},
+                        {"ns_per_force_eval", a.ns_per_force_eval},
                         {"choices", nlohmann::json::array()},
                         {"one_step_a_frame", nlohmann::json::array()}};
   for (const auto& c : a.choices)
@@ -37,7 +41,8 @@ nlohmann::json scan_answer_json(const scan_answer& a) {
                               {"method", c.method.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.method)},
                               {"substeps", c.substeps},
                               {"worst_err_pos_max", c.worst_err},
-                              {"max_force_evals_per_frame", c.max_force_evals_per_frame}});
+                              {"max_force_evals_per_frame", c.max_force_evals_per_frame},
+                              {"max_cost_per_frame", c.max_cost_per_frame}});
   for (const auto& b : a.breaks)
     out["one_step_a_frame"].push_back({{"hz", b.hz},
                                        {"method", b.method},
@@ -47,11 +52,17 @@ nlohmann::json scan_answer_json(const scan_answer& a) {
   return out;
 }
 
+void take_costs(scan_options& o, const study& s, const std::string& path) {
+  o.ns_per_force_eval = measured_eval_costs(s, o.problem);
+  o.cost_source = o.ns_per_force_eval.empty() ? "" : path;
+}
+
 namespace {
 
 struct scan_args {
   std::string problem, hz_text, dt_text, substeps_text, tol_text = "1e-3", name, out = "results/scan.h5";
   std::string reference_budget_text, work_budget_text, shard;  // shard: K/N
+  std::string costs;  // a timed study's ns per force evaluation ("": results/study.h5 when it exists; "none")
   std::vector<std::string> params, sets, methods;
   int jobs = 0;
   bool json = false, quiet = false;
@@ -107,6 +118,9 @@ int run_scan_command(const scan_args& a) {
   if (auto it = sets.find(a.problem); it != sets.end()) o.fixed = it->second;
   validate(o);
   check_writable(a.out);
+  const std::string costs =
+      a.costs.empty() && std::filesystem::exists("results/study.h5") ? "results/study.h5" : a.costs;
+  if (!costs.empty() && costs != "none") take_costs(o, read_study(costs), costs);
   // Progress on stderr: a line every 5 s (the scan's answer is what stdout carries).
   // Written with fputs, which does not throw: a closed stderr must not end a scan.
   const auto start = std::chrono::steady_clock::now();
@@ -148,7 +162,9 @@ command add_scan(CLI::App& app) {
       "a problem over a grid of its parameters, frame rates and substeps: where each method breaks, and the "
       "cheapest that holds over the whole range");
   sub->add_option("--problem", a->problem, "the problem to scan")->required();
-  sub->add_option("--param", a->params, "an axis, problem.name=lo:hi:count[:log] (repeatable)")->required();
+  sub->add_option("--param", a->params,
+                  "an axis, problem.name=lo:hi:count[:log] (repeatable; none: one point, the problem as --set "
+                  "leaves it)");
   sub->add_option("--hz", a->hz_text, "frame rates, comma-separated; each divides the fastest (30,60,120,240)");
   sub->add_option("--dt", a->dt_text, "frame timesteps instead of rates, comma-separated");
   sub->add_option("--substeps", a->substeps_text, "substeps a frame, comma-separated (1,2,4,8,16,32,64)");
@@ -164,6 +180,10 @@ command add_scan(CLI::App& app) {
                   "this; elsewhere runs are judged on stability alone (default 2e6; inf: everywhere)");
   sub->add_option("--set", a->sets, "fix another parameter, problem.name=value (repeatable)");
   sub->add_option("--name", a->name, "the scan's group under /scan (default: the problem's name)");
+  sub->add_option("--costs", a->costs,
+                  "a timed study whose benchmark gives each method's ns per force evaluation on the problem, by which "
+                  "the answer ranks, as `advise --hz` does on that study (default: results/study.h5 when it exists; "
+                  "none: force evaluations)");
   sub->add_option("--jobs", a->jobs, "threads over the grid points (0: one a core)")->check(CLI::NonNegativeNumber);
   sub->add_option("--shard", a->shard,
                   "K/N: run shard K of N, a deterministic share of the grid points (`stepbench merge` joins them)");

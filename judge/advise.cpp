@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "judge/rows.hpp"
+#include "judge/scan.hpp"
 #include "judge/verdict.hpp"
 
 namespace stepbench {
@@ -26,6 +27,7 @@ advice advise(const study& study, const std::string& problem, const std::string&
                                             names.empty() ? "none" : fmt::format("{}", fmt::join(names, ", "))));
   advice a;
   a.problem = problem;
+  a.scene = scene_text(problem, p->params);
   a.metric = metric;
   a.unit = metric == "err_vel_final" ? p->unit + "/s" : p->unit;
   a.tol = tol;
@@ -33,6 +35,19 @@ advice advise(const study& study, const std::string& problem, const std::string&
   a.methods = work_precision_input(*p, metric);
   a.result = cheapest(a.methods, tol, a.timed, metric, a.unit);
   return a;
+}
+
+std::string frame_runs_missing(const study& s, const std::string& problem, double hz) {
+  const std::string path = s.record ? s.record->path : "";
+  const auto& studies = s.results.get<std::vector<frame_rate_study>>();
+  const auto fs = std::find_if(studies.begin(), studies.end(), [&](const auto& f) { return f.problem == problem; });
+  if (fs == studies.end() || !s.results.find<verdict_tables>())
+    return fmt::format("the study '{}' has no frame-rate runs of {}", path, problem);
+  std::vector<double> rates;
+  for (const auto& r : fs->runs)
+    if (std::find(rates.begin(), rates.end(), r.hz) == rates.end()) rates.push_back(r.hz);
+  if (std::find(rates.begin(), rates.end(), hz) != rates.end()) return "";
+  return fmt::format("the study '{}' ran {} at {} Hz only", path, problem, fmt::join(rates, ", "));
 }
 
 frame_advice advise_frame(const study& s, const std::string& problem, double hz, double tol) {
@@ -53,6 +68,7 @@ frame_advice advise_frame(const study& s, const std::string& problem, double hz,
                     fmt::join(studies | std::views::transform(&frame_rate_study::problem), ", ")));
   frame_advice f;
   f.problem = problem;
+  if (const problem_study* ps = s.find(problem)) f.scene = scene_text(problem, ps->params);
   f.hz = hz;
   f.tol = tol;
   f.cost_kind = verdict->cost_kind;

@@ -22,6 +22,7 @@ inline constexpr int advise_exit_no_method = 3;
 
 struct advice {
   std::string problem, metric, unit;
+  std::string scene;  // the problem's parameters as the study ran it (judge/scan.hpp scene_text)
   double tol = 0.0;
   bool timed = false;
   std::vector<wp_method> methods;
@@ -35,6 +36,7 @@ advice advise(const study& study, const std::string& problem, const std::string&
 
 struct frame_advice {
   std::string problem, unit, cost_kind;  // cost_kind: time_ns or force_evals (per frame)
+  std::string scene;                     // as in advice
   double hz = 0.0, tol = 0.0, horizon = 0.0;
   std::vector<frame_option> one_step;    // every method at one step a frame
   std::vector<frame_option> ranked;      // each method's cheapest substep count meeting tol, cheapest first
@@ -48,5 +50,9 @@ struct frame_advice {
 // substep count a frame whose err_pos_max is at or under `tol`. Throws
 // std::invalid_argument for a rate the runs lack (naming what they have) or a bad tol.
 frame_advice advise_frame(const study& s, const std::string& problem, double hz, double tol);
+
+// Why `s` cannot answer advise_frame for this problem and rate ("" when it can): it has no
+// frame-rate runs of the problem, or not at that rate (naming those it has).
+std::string frame_runs_missing(const study& s, const std::string& problem, double hz);
 
 }  // namespace stepbench

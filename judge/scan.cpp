@@ -1,10 +1,13 @@
 #include "judge/scan.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/number.hpp"
+#include "core/statistics.hpp"
 #include "registry/registry.hpp"
 
 namespace stepbench {
@@ -19,15 +22,49 @@ std::string param_unit(const std::string& problem, const std::string& param) {
   return "";
 }
 
+// "over k_s 10 .. 1e7 N/m (25 points, log)"; a scan of no axis is one point: "at" its scene.
 std::string range_text(const scan_result& s) {
+  if (s.options.axes.empty()) return "at " + scene_text(s.options.problem, s.options.fixed, s.options.fixed);
   std::vector<std::string> parts;
   for (const auto& a : s.options.axes)
     parts.push_back(fmt::format("{} {:g} .. {:g}{} ({} points{})", a.param, a.lo, a.hi,
                                 param_unit(s.options.problem, a.param), a.count, a.log ? ", log" : ""));
-  return fmt::format("{}", fmt::join(parts, " x "));
+  return fmt::format("over {}", fmt::join(parts, " x "));
 }
 
 }  // namespace
+
+std::string scene_text(const std::string& problem, const std::map<std::string, double>& values,
+                       const std::map<std::string, double>& set) {
+  std::vector<std::string> out;
+  std::vector<param_value> declared;
+  try {
+    declared = make_problem(problem)->params();
+  } catch (const std::invalid_argument&) {  // a study of a problem this build lacks: its values, unnamed units
+    for (const auto& [name, value] : values) declared.push_back({name, "1", "", value, value, {}, {}});
+  }
+  for (const auto& p : declared) {
+    const auto it = values.find(p.name);
+    out.push_back(fmt::format("{} = {:g}{}{}", p.name, it == values.end() ? p.value : it->second,
+                              p.unit == "1" ? "" : " " + p.unit, set.count(p.name) ? " (set)" : ""));
+  }
+  return fmt::format("{}", fmt::join(out, ", "));
+}
+
+std::map<std::string, double> measured_eval_costs(const study& s, const std::string& problem) {
+  std::map<std::string, double> out;
+  const problem_study* ps = s.find(problem);
+  if (!s.timed || !ps) return out;
+  for (const auto& ms : ps->methods) {
+    if (ms.info.origin != method_origin::ours || ms.info.kind != method_kind::fixed_step) continue;
+    std::vector<double> per_eval;
+    for (const auto& r : ms.rows)
+      if (r.metrics.completed() && r.work.force_evals > 0 && std::isfinite(r.time.time_ns) && r.time.time_ns > 0.0)
+        per_eval.push_back(r.time.time_ns / static_cast<double>(r.work.force_evals));
+    if (!per_eval.empty()) out[ms.info.name] = median(per_eval);
+  }
+  return out;
+}
 
 scan_answer answer_scan(const scan_result& s, double tol) {
   scan_answer a;
@@ -35,6 +72,9 @@ scan_answer answer_scan(const scan_result& s, double tol) {
   a.unit = s.unit;
   a.tol = tol;
   a.range = range_text(s);
+  a.cost_kind = s.options.ns_per_force_eval.empty() ? "force_evals" : "time_ns";
+  a.cost_source = s.options.cost_source;
+  a.ns_per_force_eval = s.options.ns_per_force_eval;
   a.points = s.points.size();
   a.grid_points = s.grid_points;
   for (const auto& p : s.points) a.untrusted += p.trusted ? 0 : 1;
@@ -45,7 +85,7 @@ scan_answer answer_scan(const scan_result& s, double tol) {
     std::string method;
     int substeps;
     std::size_t runs = 0, judged = 0, within = 0, skipped = 0;
-    double worst = 0.0, cost = 0.0;
+    double worst = 0.0, evals = 0.0, cost = 0.0;
     std::vector<std::size_t> unstable;  // point indices
   };
   std::vector<combo> combos;
@@ -54,8 +94,9 @@ scan_answer answer_scan(const scan_result& s, double tol) {
     auto it = std::find_if(combos.begin(), combos.end(), [&](const combo& c) {
       return c.hz == r.hz && c.method == r.method && c.substeps == r.substeps;
     });
-    combo& c =
-        it != combos.end() ? *it : combos.emplace_back(combo{r.hz, r.method, r.substeps, 0, 0, 0, 0, 0.0, 0.0, {}});
+    combo& c = it != combos.end()
+                   ? *it
+                   : combos.emplace_back(combo{r.hz, r.method, r.substeps, 0, 0, 0, 0, 0.0, 0.0, 0.0, {}});
     ++c.runs;
     const auto& m = r.row.metrics;
     if (m.diverged || m.failed) c.unstable.push_back(r.point);
@@ -64,19 +105,21 @@ scan_answer answer_scan(const scan_result& s, double tol) {
     ++c.judged;
     if (m.completed() && m.err_pos_max <= tol) ++c.within;
     c.worst = m.completed() ? std::max(c.worst, m.err_pos_max) : std::numeric_limits<double>::infinity();
-    c.cost = std::max(c.cost, static_cast<double>(r.row.work.force_evals) / (p.horizon * r.hz));
+    const double evals = static_cast<double>(r.row.work.force_evals) / (p.horizon * r.hz);
+    c.evals = std::max(c.evals, evals);
+    c.cost = std::max(c.cost, scan_cost(s.options, r.method, evals));  // NaN stays NaN: not ranked
   }
   const std::size_t trusted = a.points - a.untrusted;
   for (double hz : s.options.hz) {
-    scan_choice best{hz, "", 0, nan, nan};
+    scan_choice best{hz, "", 0, nan, nan, nan};
     for (const auto& c : combos) {
       // Within the tolerance at every point with a truth, and stable at every point.
       if (c.hz != hz || c.judged != trusted || c.within != trusted || trusted == 0 || c.runs != a.points ||
-          !c.unstable.empty() || c.skipped > 0)
+          !c.unstable.empty() || c.skipped > 0 || std::isnan(c.cost))
         continue;
-      if (best.method.empty() || c.cost < best.max_force_evals_per_frame ||
-          (c.cost == best.max_force_evals_per_frame && c.substeps < best.substeps))
-        best = {hz, c.method, c.substeps, c.worst, c.cost};
+      if (best.method.empty() || c.cost < best.max_cost_per_frame ||
+          (c.cost == best.max_cost_per_frame && c.substeps < best.substeps))
+        best = {hz, c.method, c.substeps, c.worst, c.evals, c.cost};
     }
     a.choices.push_back(best);
     for (const auto& c : combos) {
@@ -102,6 +145,8 @@ scan_answer answer_scan(const scan_result& s, double tol) {
           k = e + 1;
         }
         b.where = fmt::format("diverges for {}", fmt::join(spans, ", "));
+      } else if (!c.unstable.empty() && s.options.axes.empty()) {
+        b.where = "diverges";
       } else if (!c.unstable.empty()) {
         std::vector<std::string> at;
         for (std::size_t k = 0; k < s.options.axes.size(); ++k)
@@ -114,7 +159,7 @@ scan_answer answer_scan(const scan_result& s, double tol) {
         b.where = fmt::format("stable at the {} of {} points it ran (the rest over the work budget)",
                               c.runs - c.skipped, c.runs);
       } else {
-        b.where = "stable everywhere";
+        b.where = s.options.axes.empty() ? "stable" : "stable everywhere";
       }
       a.breaks.push_back(b);
     }

@@ -62,6 +62,7 @@ std::string format_advice(const advice& a, std::size_t runners_up) {
     out += fmt::format("use {} at {}: {}, {} {:.3g} {}; {}\n", label(m), where(m, *answer), cost_text(r.cost, *answer),
                        a.metric, answer->error, a.unit, margin(*answer));
   }
+  if (!a.scene.empty()) out += fmt::format("scene: {}\n", a.scene);
   std::vector<const wp_pick*> others;
   for (const auto& p : r.ranked)
     if (!answer || p.method != answer->method) others.push_back(&p);
@@ -110,6 +111,7 @@ std::string format_frame_advice(const frame_advice& f) {
   out += fmt::format(
       "measured over {:.3g} s of whole frames against the truth at the frame ends; cost a frame = {}\n", f.horizon,
       timed ? "the benchmark's median ns per step x steps a frame" : "force evaluations (untimed study)");
+  if (!f.scene.empty()) out += fmt::format("scene: {}\n", f.scene);
   if (f.ranked.size() > 1) {
     table t{{"method", right_column("substeps"), right_column("err_pos_max", f.unit), right_column("cost a frame")},
             {}};

@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <cmath>
+
 #include "core/number.hpp"
 #include "core/text.hpp"
 #include "store/columns.hpp"
@@ -85,6 +87,20 @@ scan_result read_scan_group(const H5::Group& all, const std::string& which) {
     throw std::runtime_error(
         fmt::format("scan '{}': {} fixed_params but {} fixed_values", which, fixed_names.size(), fixed_values.size()));
   for (std::size_t k = 0; k < fixed_names.size(); ++k) o.fixed[fixed_names[k]] = fixed_values[k];
+  if (g.attrExists("cost_source")) {  // a scan written before the measured costs ranks by evaluations
+    o.cost_source = h5::string_attr(g, "cost_source");
+    const auto cost_methods = stored_list(h5::string_attr(g, "cost_methods"), ',');
+    const auto cost_values = h5::double_array_attr(g, "cost_ns_per_force_eval");
+    if (cost_methods.size() != cost_values.size())
+      throw std::runtime_error(fmt::format("scan '{}': {} cost_methods but {} cost_ns_per_force_eval", which,
+                                           cost_methods.size(), cost_values.size()));
+    for (std::size_t k = 0; k < cost_methods.size(); ++k) {
+      if (!(cost_values[k] > 0.0 && std::isfinite(cost_values[k])))
+        throw std::runtime_error(
+            fmt::format("scan '{}': cost of {} is {}, not a positive time", which, cost_methods[k], cost_values[k]));
+      o.ns_per_force_eval[cost_methods[k]] = cost_values[k];
+    }
+  }
   o.ref_tol.rtol = h5::double_attr(g, "reference_rtol");
   o.ref_tol.atol = h5::double_attr(g, "reference_atol");
   o.limits.work_budget = h5::double_attr(g, "work_budget");
@@ -209,6 +225,15 @@ void write_scans(H5::Group& root, const std::vector<scan_result>& scans) {
     }
     attr(g, "fixed_params", fmt::format("{}", fmt::join(fixed_names, ",")));
     attr(g, "fixed_values", fixed_values);
+    std::vector<std::string> cost_methods;
+    std::vector<double> cost_values;
+    for (const auto& [name, ns] : o.ns_per_force_eval) {
+      cost_methods.push_back(name);
+      cost_values.push_back(ns);
+    }
+    attr(g, "cost_source", o.cost_source);
+    attr(g, "cost_methods", fmt::format("{}", fmt::join(cost_methods, ",")));
+    attr(g, "cost_ns_per_force_eval", cost_values);
     attr(g, "reference_rtol", o.ref_tol.rtol);
     attr(g, "reference_atol", o.ref_tol.atol);
     attr(g, "work_budget", o.limits.work_budget);
@@ -247,6 +272,8 @@ scan_result merge_scans(const std::vector<scan_result>& shards, bool partial, st
     for (const auto& a : o.axes)
       axes.push_back(fmt::format("{}={}:{}:{}{}", a.param, a.lo, a.hi, a.count, a.log ? ":log" : ""));
     for (const auto& [name, value] : o.fixed) fixed.push_back(fmt::format("{}={}", name, value));
+    std::vector<std::string> costs;  // the ranking's: shards ranked alike, or the merged answer mixes them
+    for (const auto& [name, ns] : o.ns_per_force_eval) costs.push_back(fmt::format("{}={}", name, ns));
     return std::vector<std::pair<std::string_view, std::string>>{
         {"problem", o.problem},
         {"axes", fmt::format("{}", fmt::join(axes, " x "))},
@@ -258,6 +285,8 @@ scan_result merge_scans(const std::vector<scan_result>& shards, bool partial, st
         {"reference tolerances", fmt::format("rtol {} atol {}", o.ref_tol.rtol, o.ref_tol.atol)},
         {"reference budget", fmt::format("{}", o.reference_budget)},
         {"work budget", fmt::format("{}", o.limits.work_budget)},
+        {"ranking costs (--costs)",
+         costs.empty() ? "force evaluations" : fmt::format("{} from {}", fmt::join(costs, ","), o.cost_source)},
         {"grid", fmt::format("{} points", s.grid_points)}};
   };
   const auto label = [](const scan_result& s, std::size_t k) {

@@ -2,7 +2,9 @@
 // each point and rate.
 #include "study/scan.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace stepbench {
 
@@ -21,18 +23,27 @@ std::vector<double> scan_axis::values() const {
   return out;
 }
 
-// The cheapest run meeting the tolerance at each point and rate: fewest force
-// evaluations (the same frames at one rate, so the total compares), then fewer substeps.
+double scan_cost(const scan_options& o, const std::string& method, double force_evals) {
+  if (o.ns_per_force_eval.empty()) return force_evals;
+  const auto it = o.ns_per_force_eval.find(method);
+  return it == o.ns_per_force_eval.end() ? std::numeric_limits<double>::quiet_NaN() : force_evals * it->second;
+}
+
+// The cheapest run meeting the tolerance at each point and rate: least scan_cost (the same
+// frames at one rate, so the totals compare), then fewer substeps.
 void compute_best(scan_result& s) {
   const auto& hz = s.options.hz;
   std::vector<const scan_run*> pick(s.points.size() * hz.size(), nullptr);
+  const auto cost = [&](const scan_run& r) {
+    return scan_cost(s.options, r.method, static_cast<double>(r.row.work.force_evals));
+  };
   for (const auto& r : s.runs) {
     const auto rate = static_cast<std::size_t>(std::find(hz.begin(), hz.end(), r.hz) - hz.begin());
-    if (rate == hz.size() || !r.row.metrics.completed() || !(r.row.metrics.err_pos_max <= s.options.tol)) continue;
+    if (rate == hz.size() || !r.row.metrics.completed() || !(r.row.metrics.err_pos_max <= s.options.tol) ||
+        std::isnan(cost(r)))
+      continue;
     const scan_run*& p = pick[r.point * hz.size() + rate];
-    if (!p || r.row.work.force_evals < p->row.work.force_evals ||
-        (r.row.work.force_evals == p->row.work.force_evals && r.substeps < p->substeps))
-      p = &r;
+    if (!p || cost(r) < cost(*p) || (cost(r) == cost(*p) && r.substeps < p->substeps)) p = &r;
   }
   s.best.clear();
   const double nan = std::numeric_limits<double>::quiet_NaN();

@@ -46,6 +46,12 @@ struct scan_options : frame_rate_options {  // its rates and substeps (`scan --d
   std::vector<std::string> methods;
   double tol = 1e-3;                    // in the problem's position unit
   std::map<std::string, double> fixed;  // other parameters of the problem (--set)
+  // The ranking's cost (scan_cost): each method's ns per force evaluation measured on this
+  // problem by a timed study's benchmark (`scan --costs FILE`, the study `advise` reads),
+  // so a scan and `advise --hz` rank one scene alike: a frame's cost is its evaluations x
+  // its method's. Empty: the evaluations alone. `cost_source` names where they come from.
+  std::map<std::string, double> ns_per_force_eval;
+  std::string cost_source;
   reference_tolerances ref_tol{};
   // At a point whose references' predicted work (core/measure.hpp predicted_reference_work:
   // coordinates x w_max T) is over this, the references are not run: the point has no
@@ -83,8 +89,13 @@ struct scan_point {
   double pos_scale = 1.0;  // the motion's amplitude
 };
 
-// The cheapest run at a point and rate that completed with err_pos_max <= tol, by force
-// evaluations (our methods' counted cost; ties to the fewer substeps, then the registry order).
+// The cost by which a scan ranks `force_evals` force evaluations of `method`: their time in
+// ns at the options' measured ns per evaluation, else the count itself; NaN for a method
+// the measured costs lack (it is not ranked).
+double scan_cost(const scan_options& o, const std::string& method, double force_evals);
+
+// The cheapest run at a point and rate that completed with err_pos_max <= tol, by scan_cost
+// (ties to the fewer substeps, then the registry order).
 struct scan_best {
   std::size_t point = 0;
   double hz = 0.0;
@@ -118,6 +129,7 @@ struct scan_choice {
   int substeps = 0;
   double worst_err = 0.0;
   double max_force_evals_per_frame = 0.0;
+  double max_cost_per_frame = 0.0;  // by scan_cost: ns, or force evaluations (scan_answer::cost_kind)
 };
 
 struct scan_break {
@@ -129,7 +141,9 @@ struct scan_break {
 };
 
 struct scan_answer {
-  std::string problem, unit, range;  // range: "k_s 10 .. 1e7 (25 points, log)"
+  std::string problem, unit, range;                    // range: "over k_s 10 .. 1e7 (25 points, log)"
+  std::string cost_kind = "force_evals", cost_source;  // cost_kind: time_ns with measured costs
+  std::map<std::string, double> ns_per_force_eval;
   double tol = 0.0;
   std::size_t points = 0, grid_points = 0, untrusted = 0;
   std::vector<scan_choice> choices;

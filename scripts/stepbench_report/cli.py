@@ -1,5 +1,5 @@
 """scripts/report [study.h5 | scan.h5] [--out results/report] [--problem P] [--self-contained] [--jobs N]
-[--markdown FILE] [--readme FILE]"""
+[--markdown FILE] [--readme FILE [--summary results/summary.json]]"""
 import argparse
 import os
 import shlex
@@ -51,28 +51,39 @@ def _command(argv):
     return " ".join(["scripts/report"] + [shlex.quote(a) for a in argv])
 
 
-def _answers(s, args, argv):
-    """--markdown and --readme: the verdict as Markdown; 0, or 1 with one line on stderr."""
+def _readme_text(args, argv):
+    """--readme: README.md with its block rendered from the summary (readme.py); the text, or
+    None after one line on stderr."""
+    from . import readme, verdict
+    try:
+        summary = readme.load(args.summary)
+        with open(args.readme) as f:
+            return verdict.rewrite_block(f.read(), readme.block(summary, _command(argv)))
+    except readme.SummaryError as e:
+        print(f"report: error: {e}; nothing written", file=sys.stderr)
+    except OSError as e:
+        print(f"report: error: cannot read '{args.readme}': {e.strerror}; nothing written", file=sys.stderr)
+    except ValueError as e:
+        print(f"report: error: '{args.readme}': {e}; nothing written", file=sys.stderr)
+    return None
+
+
+def _answers(s, args, argv, readme_text):
+    """--markdown and --readme: the verdict as Markdown, the README's block; 0, or 1 with one
+    line on stderr."""
     from . import render, verdict
-    if s.verdict is None:
+    if args.markdown and s.verdict is None:
         print(f"report: error: '{args.study}' has no /verdict group (a study written before stepbench computed "
               "one): nothing to write; run the study again", file=sys.stderr)
         return 1
-    if args.problem is not None:
+    if args.problem is not None and s is not None:
         s = replace(s, verdict=s.verdict.only(args.problem))
     command = _command(argv)
     try:
         if args.markdown:
             _write_text(args.markdown, render.markdown(verdict.results_doc(s, command)))
-        if args.readme:
-            try:
-                with open(args.readme) as f:
-                    text = f.read()
-                text = verdict.rewrite_block(text, verdict.readme_block(s, command))
-            except ValueError as e:
-                print(f"report: error: '{args.readme}': {e}; nothing written", file=sys.stderr)
-                return 1
-            _write_text(args.readme, text)
+        if readme_text is not None:
+            _write_text(args.readme, readme_text)
     except OSError as e:
         print(f"report: error: cannot write '{e.filename or args.markdown or args.readme}': {e.strerror}",
               file=sys.stderr)
@@ -107,17 +118,24 @@ def main(argv=None, start=None):
     ap.add_argument("--markdown", metavar="FILE", help="write the verdict tables, the findings and where the "
                     "study ran as Markdown to FILE (docs/results.md)")
     ap.add_argument("--readme", metavar="FILE", help="rewrite the block between <!-- results:begin --> and "
-                    "<!-- results:end --> in FILE (README.md) with the headline table")
+                    "<!-- results:end --> in FILE (README.md) with the answer table of the --summary file")
+    ap.add_argument("--summary", metavar="FILE", default="results/summary.json",
+                    help="the study's summary (`stepbench summary`) that --readme renders (default: %(default)s)")
     args = ap.parse_args(argv)
+    readme_text = None
+    if args.readme:
+        readme_text = _readme_text(args, argv)
+        if readme_text is None:
+            return 1
+        if not args.markdown and args.out is None:  # the block alone: the summary is all it reads
+            return _answers(None, args, argv, readme_text)
     try:
         s = study.load(args.study)
     except study.StudyError as e:
         print(f"report: error: {e}", file=sys.stderr)
         return 1
-    if s.scan_only and (args.markdown or args.readme):
-        which = " and ".join(o for o, v in (("--markdown", args.markdown), ("--readme", args.readme)) if v)
-        verb = "write" if " and " in which else "writes"
-        print(f"report: error: '{args.study}' is a scan file (only /scan, no problems): {which} {verb} the verdict "
+    if s.scan_only and args.markdown:
+        print(f"report: error: '{args.study}' is a scan file (only /scan, no problems): --markdown writes the verdict "
               "tables of a study file; nothing written", file=sys.stderr)
         return 1
     if s.scan_only and args.problem is not None:
@@ -129,7 +147,7 @@ def main(argv=None, start=None):
               f"{', '.join(p.name for p in s.problems)})", file=sys.stderr)
         return 2
     if args.markdown or args.readme:
-        status = _answers(s, args, argv)
+        status = _answers(s, args, argv, readme_text)
         if status or args.out is None:
             return status
     if args.out is None:

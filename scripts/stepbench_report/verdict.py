@@ -1,6 +1,6 @@
 """The answer first: /verdict as stored (docs/study-format.md), the tables the report
 opens on, each problem's share of them, summary.json, and the Markdown of --markdown
-and --readme. Every number is the study file's: the equal-error costs, the ratios and
+(the README's block is readme.py's, from `stepbench summary`). Every number is the study file's: the equal-error costs, the ratios and
 their verdicts, the frame-rate answers and the findings were computed by stepbench
 (judge/verdict.cpp). Nothing here interpolates, ranks or selects: rows are looked up
 by (problem, target) or (problem, hz) and formatted."""
@@ -23,9 +23,6 @@ VERDICT_CLASS = {"ahead": "ahead", "behind": "behind", "within spread": "within"
 # Names shortened in the frame-rate table, whose cells list several methods; the key is printed under it.
 SHORT = {"semi_implicit_euler": "sie", "velocity_verlet": "vv", "forest_ruth": "fr", "implicit_euler": "ie",
          "implicit_midpoint": "im"}
-# The README's headline: two typical error targets and a frame rate with its target.
-README_TARGETS = (1e-4, 1e-8)
-README_FRAME = (60.0, 1e-4)
 
 
 @dataclass
@@ -364,57 +361,6 @@ def results_doc(study, command):
             doc.h(3, f"Scan {name}")
             doc.pre(text)
     return doc
-
-
-# The README is a front page: no line of its block over this many characters (the whole
-# tables, the challenge, Small Steps, xpbd's findings and the scans' answers are in
-# docs/results.md, which --markdown writes from the same study).
-README_WIDTH = 160
-
-
-def readme_cell(r, kind):
-    """One (problem, target) of the README's table: our fastest method and its cost, and
-    that cost as a multiple of the fastest peer's ("rk4, 4.43 us (0.84x)"); the method's
-    dt or tolerance and the peer's name are in docs/results.md."""
-    if r is None:
-        return ""
-    if not r["ours_method"]:
-        return "peer only" if r["peer_method"] else "not reached"
-    cost = cost_text(kind, r["ours_cost"])
-    return f"{r['ours_method']}, {cost} ({ratio_text(r['ratio']) if r['peer_method'] else 'no peer'})"
-
-
-def readme_block(study, command):
-    """--readme: the headline table (per problem: the fastest of ours at two typical
-    targets and the cheapest at 60 Hz), what it means, where the rest is, and the line
-    naming the study; every line within README_WIDTH characters."""
-    import textwrap
-    v = study.verdict
-    kind = v.cost_kind
-    targets = [t for t in README_TARGETS if any(np.isclose(v.targets, t, rtol=1e-9, atol=0))]
-    hz, frame_target = README_FRAME
-    lines = ["| problem | " + " | ".join(f"error {target_text(t)}" for t in targets)
-             + f" | {hz:g} Hz, error {target_text(frame_target)} |",
-             "|---|" + "---|" * (len(targets) + 1)]
-    for p in v.problems:
-        cells = [f"{p} ({v.unit(p)})"] + [readme_cell(v.equal(p, t), kind) for t in targets]
-        a, rates = v.answer(p, hz, frame_target), v.rates(p, hz)
-        stable = f"{int(np.count_nonzero(rates['stable']))} of {len(rates)} stable"
-        cells.append(f"{a['method']} x{int(a['substeps'])}, {cost_text(kind, float(a['cost_per_frame']))}; {stable}"
-                     if a is not None and a["method"] else f"none within 64 substeps; {stable}")
-        lines.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
-    a = study.attrs
-    prose = [f"Error: `{v.attrs['metric']}`, the largest position error over the run, in the problem's unit. At an "
-             "error: the fastest of our methods and its cost, in brackets that cost as a multiple of the fastest "
-             f"library peer's at the same error. At {hz:g} Hz: the cheapest of our fixed-step methods with n substeps "
-             "a frame (x n), its cost a frame, and how many of them stay stable at one step a frame.",
-             "Each method's dt or tolerance, the peers, the findings, the pendulum challenge, Small Steps and the "
-             "scenes' range answers: [docs/results.md](docs/results.md), written from the same study."]
-    for para in prose:
-        lines += [""] + textwrap.wrap(para, README_WIDTH - 30, break_long_words=False, break_on_hyphens=False)
-    lines += ["", f"Study `{study.path}`, commit {a['git_commit']}, {a['cpu']}, {a['created_utc']};",
-              f"written by `{command}`."]
-    return "\n".join(lines)
 
 
 def _range_answers(study):

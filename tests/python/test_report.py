@@ -626,17 +626,21 @@ After.
 """
 
 
-def test_markdown_and_readme(reports, tmp_path):
+def test_markdown_and_readme(reports, stepbench, tmp_path):
     """--markdown writes the answer first as Markdown; --readme rewrites only the block
-    between the markers; neither writes a report folder (no --out)."""
+    between the markers, from the study's summary (`stepbench summary`); neither writes a
+    report folder (no --out)."""
     study, _ = reports["timed"]
     readme, results = tmp_path / "README.md", tmp_path / "docs" / "results.md"
+    summary = tmp_path / "summary.json"
     results.parent.mkdir()
     readme.write_text(README)
-    command = [PYTHON, REPORT, str(study), "--markdown", str(results), "--readme", str(readme)]
+    subprocess.run([stepbench, "summary", "--study", str(study), "--out", str(summary)], check=True, timeout=60)
+    command = [PYTHON, REPORT, str(study), "--markdown", str(results), "--readme", str(readme), "--summary",
+               str(summary)]
     p = subprocess.run(command, capture_output=True, text=True, timeout=60, cwd=tmp_path)
     assert p.returncode == 0, p.stderr
-    assert sorted(os.listdir(tmp_path)) == ["README.md", "docs"]  # no results/report
+    assert sorted(os.listdir(tmp_path)) == ["README.md", "docs", "summary.json"]  # no results/report
     with h5py.File(study, "r") as f:
         where = [text(f.attrs[k]) for k in ("git_commit", "cpu", "created_utc")]
     md = results.read_text()
@@ -649,13 +653,14 @@ def test_markdown_and_readme(reports, tmp_path):
     assert text_.endswith("<!-- results:end -->\n\nAfter.\n")
     block = text_[text_.index("<!-- results:begin -->"):text_.index("<!-- results:end -->")]
     assert "old table" not in block
-    assert "| problem | error 1e-4 | error 1e-8 | 60 Hz, error 1e-4 |" in block
-    assert "| pendulum (rad) | " in block
+    assert "| problem | 60 Hz, error 1e-2 | 60 Hz, error 1e-3 | 60 Hz, error 1e-4 | stable at one step a frame |" \
+        in block
+    assert "| pendulum (rad) | " in block and "spring_chain masses = 32, " in block
     assert all(w in block for w in where) and str(study) in block
     # A front page: the block's lines fit in 160 characters (the paths aside, here long
     # temporary ones); the rest is in docs/results.md, which the block names.
     short = [line.replace(str(study), "S").replace(str(readme), "R").replace(str(results), "M")
-             for line in block.splitlines()]
+             .replace(str(summary), "J") for line in block.splitlines()]
     assert all(len(line) <= 160 for line in short), [line for line in short if len(line) > 160]
     assert "[docs/results.md](docs/results.md)" in block
     # xpbd's stability and energy: the study's own finding, verbatim (judge/verdict.cpp), in
@@ -671,12 +676,13 @@ def test_markdown_and_readme(reports, tmp_path):
     assert readme.read_text() == before
 
 
-def test_readme_without_markers_is_refused(reports, tmp_path):
+def test_readme_without_markers_is_refused(reports, stepbench, tmp_path):
     study, _ = reports["plain"]
-    readme = tmp_path / "README.md"
+    readme, summary = tmp_path / "README.md", tmp_path / "summary.json"
     readme.write_text("# no markers\n")
-    p = subprocess.run([PYTHON, REPORT, str(study), "--readme", str(readme)], capture_output=True, text=True,
-                       timeout=60)
+    subprocess.run([stepbench, "summary", "--study", str(study), "--out", str(summary)], check=True, timeout=60)
+    p = subprocess.run([PYTHON, REPORT, "--readme", str(readme), "--summary", str(summary)], capture_output=True,
+                       text=True, timeout=60)
     assert p.returncode == 1 and len(p.stderr.splitlines()) == 1, p.stderr
     assert "results:begin" in p.stderr
     assert readme.read_text() == "# no markers\n"

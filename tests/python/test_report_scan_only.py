@@ -160,25 +160,27 @@ def test_the_first_failure_is_the_files(scan_reports):
     assert shown["rk4"] != "none" and shown["implicit_euler"] == "none"
 
 
-@pytest.mark.parametrize("options", [["--readme"], ["--markdown"], ["--markdown", "--readme"]])
-def test_readme_and_markdown_are_refused(scan_files, tmp_path, options):
-    """--readme and --markdown write the main study's verdict tables: on a scan file, one
-    line on stderr, a non-zero exit, and nothing written (not the README, not the
-    Markdown file, not the --out folder)."""
+@pytest.mark.parametrize("readme_too", [False, True])
+def test_markdown_is_refused(scan_files, tmp_path, readme_too):
+    """--markdown writes the main study's verdict tables: on a scan file, one line on
+    stderr, a non-zero exit, and nothing written (not the Markdown file, not the README
+    whose block --readme would render from a summary, not the --out folder)."""
     readme = tmp_path / "README.md"
     before = "# project\n\n<!-- results:begin -->\nold table\n<!-- results:end -->\n"
     readme.write_text(before)
-    args = []
-    for o in options:
-        args += [o, str(readme if o == "--readme" else tmp_path / "results.md")]
+    summary = tmp_path / "summary.json"
+    summary.write_text('{"study": {"path": "s.h5", "git_commit": "c", "cpu": "x", "created_utc": "t", '
+                       '"cost_kind": "force_evals"}, "hz": 60, "targets": [0.001], "problems": []}')
+    args = ["--markdown", str(tmp_path / "results.md")]
+    if readme_too:
+        args += ["--readme", str(readme), "--summary", str(summary)]
     p = run([PYTHON, REPORT, str(scan_files["partial"]), *args, "--out", str(tmp_path / "report")], timeout=60)
     assert p.returncode == 1 and p.stdout == "", p.stdout
     assert p.stderr.splitlines() == [
-        f"report: error: '{scan_files['partial']}' is a scan file (only /scan, no problems): "
-        f"{' and '.join(options)} {'write' if len(options) == 2 else 'writes'} the verdict tables of a study file; "
-        "nothing written"]
+        f"report: error: '{scan_files['partial']}' is a scan file (only /scan, no problems): --markdown writes the "
+        "verdict tables of a study file; nothing written"]
     assert readme.read_text() == before
-    assert sorted(os.listdir(tmp_path)) == ["README.md"]
+    assert sorted(os.listdir(tmp_path)) == ["README.md", "summary.json"]
 
 
 def test_problem_is_refused(scan_files, tmp_path):

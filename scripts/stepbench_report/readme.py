@@ -1,0 +1,79 @@
+"""The README's answer block, rendered from the summary `stepbench summary` writes
+(results/summary.json: per problem, the study's own frame-rate answers at 60 Hz). Nothing
+here ranks, selects or computes: it formats the file's values (tests/python/test_readme.py
+fails when README.md's block differs from this render of the committed summary)."""
+import json
+import math
+import textwrap
+
+from .verdict import cost_text, target_text
+
+# The README is a front page: no line of it over this many characters.
+README_WIDTH = 160
+
+
+class SummaryError(Exception):
+    """A summary file that is missing, not JSON, or lacks what the block needs."""
+
+
+def load(path):
+    try:
+        with open(path) as f:
+            summary = json.load(f)
+    except OSError as e:
+        raise SummaryError(f"cannot read summary '{path}': {e.strerror} (`stepbench summary` writes it)") from None
+    except json.JSONDecodeError as e:
+        raise SummaryError(f"{path}:{e.lineno}:{e.colno}: not JSON: {e.msg}") from None
+    try:
+        for key in ("study", "hz", "targets", "problems"):
+            summary[key]
+        for p in summary["problems"]:
+            for key in ("name", "unit", "scene", "answers", "stable_at_one_step", "methods_at_one_step"):
+                p[key]
+    except (KeyError, TypeError) as e:
+        raise SummaryError(f"summary '{path}' lacks {e} (written by another version of `stepbench summary`?)") \
+            from None
+    return summary
+
+
+def _answer_cell(answer, kind):
+    if answer is None:
+        return "-"
+    if answer["method"] is None:
+        return "none within 64 substeps"
+    return f"{answer['method']} x{answer['substeps']}, {cost_text(kind, answer['cost_per_frame'])}"
+
+
+def block(summary, command):
+    """The table (per problem: at the summary's rate, the cheapest of our fixed-step methods
+    and substeps a frame at each error, its cost a frame; how many stay stable at one step a
+    frame), what it means, the scenes as the study ran them, and the lines naming the study."""
+    s, hz = summary["study"], summary["hz"]
+    kind = s["cost_kind"]
+    targets = summary["targets"]
+    lines = ["| problem | " + " | ".join(f"{hz:g} Hz, error {target_text(t)}" for t in targets)
+             + " | stable at one step a frame |",
+             "|---|" + "---|" * (len(targets) + 1)]
+    for p in summary["problems"]:
+        by_target = {a["target"]: a for a in p["answers"]}
+        cells = [f"{p['name']} ({p['unit']})"]
+        cells += [_answer_cell(next((a for t, a in by_target.items() if math.isclose(t, target, rel_tol=1e-9)),
+                                    None), kind) for target in targets]
+        cells.append(f"{p['stable_at_one_step']} of {p['methods_at_one_step']}")
+        lines.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
+    cost = ("the benchmark's median time a step of the method on the problem x the steps of a frame"
+            if kind == "time_ns" else "its force evaluations (an untimed study)")
+    prose = [f"At {hz:g} frames a second and an error: the cheapest of our fixed-step methods with n substeps a "
+             f"frame (x n) whose `err_pos_max` (the worst body's largest position error, measured at the frame "
+             f"ends against the truth, in the problem's unit) stays within it, and its cost a frame: {cost}. "
+             "`stepbench advise --problem P --hz H --tol X` gives the same answer and runs any other rate or "
+             "scene (`--set`).",
+             "The scenes as the study ran them: " + "; ".join(f"{p['name']} {p['scene']}" for p in
+                                                             summary["problems"]) + "."]
+    for para in prose:
+        lines += [""] + textwrap.wrap(para, README_WIDTH - 30, break_long_words=False, break_on_hyphens=False)
+    lines += ["", "Against the library peers at equal error, the findings, the pendulum challenge and the scans' "
+              "range answers:", "[docs/results.md](docs/results.md), written from the same study.",
+              "", f"Study `{s['path']}`, commit {s['git_commit']}, {s['cpu']}, {s['created_utc']}; summary by "
+              "`stepbench summary`,", f"block by `{command}`."]
+    return "\n".join(lines)

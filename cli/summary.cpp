@@ -42,22 +42,21 @@ bool same_target(double a, double b) { return std::abs(a / b - 1.0) < 1e-9; }
 
 ordered summarize(const study& s, const std::string& path) {
   const auto* v = s.results.find<verdict_tables>();
-  if (!v)
-    throw std::runtime_error(fmt::format("'{}' has no verdict tables (a study without its verdict part)", path));
+  if (!v) throw std::runtime_error(fmt::format("'{}' has no verdict tables (a study without its verdict part)", path));
   const auto meta = [&](const char* key) {
     const auto it = s.record->meta.find(key);
     return it == s.record->meta.end() ? std::string() : it->second;
   };
   ordered out = {{"study",
-               {{"path", path},
-                {"git_commit", meta("git_commit")},
-                {"cpu", meta("cpu")},
-                {"created_utc", meta("created_utc")},
-                {"timed", s.timed.has_value()},
-                {"cost_kind", v->cost_kind}}},
-              {"hz", summary_hz},
-              {"targets", summary_targets},
-              {"problems", ordered::array()}};
+                  {{"path", path},
+                   {"git_commit", meta("git_commit")},
+                   {"cpu", meta("cpu")},
+                   {"created_utc", meta("created_utc")},
+                   {"timed", s.timed.has_value()},
+                   {"cost_kind", v->cost_kind}}},
+                 {"hz", summary_hz},
+                 {"targets", summary_targets},
+                 {"problems", ordered::array()}};
   // In the registry's order (`stepbench list`), as the report's tables are; the file's
   // groups come back in name order.
   std::vector<const problem_study*> order;
@@ -67,10 +66,8 @@ ordered summarize(const study& s, const std::string& path) {
     if (std::find(order.begin(), order.end(), &ps) == order.end()) order.push_back(&ps);
   for (const problem_study* ps_ptr : order) {
     const problem_study& ps = *ps_ptr;
-    ordered p = {{"name", ps.name},
-              {"unit", ps.unit},
-              {"scene", scene_text(ps.name, ps.params)},
-              {"answers", ordered::array()}};
+    ordered p = {
+        {"name", ps.name}, {"unit", ps.unit}, {"scene", scene_text(ps.name, ps.params)}, {"answers", ordered::array()}};
     for (double target : summary_targets)
       for (const auto& a : v->frame_answers)
         if (a.problem == ps.name && a.hz == summary_hz && same_target(a.target, target))

@@ -326,5 +326,28 @@ if [ -x "$bench" ]; then
     bad "stepbench_bench --benchmark_format=xml exited $rc: $(cat "$work/err")"
 fi
 
+# Extreme rates, counts and horizons, each command under a 3 GB address-space limit (the
+# budget of any process): refused before the work in one line, exit 2, never an allocation.
+extreme() {
+  local want=$1; shift
+  (ulimit -v 3000000; "$bin" "$@") >"$work/out" 2>"$work/err"
+  local rc=$?
+  [ "$rc" -eq 2 ] && [ "$(wc -l <"$work/err")" -eq 1 ] && grep -q -- "$want" "$work/err" && ok ||
+    bad "extreme value: $* exited $rc: $(head -c 300 "$work/err")"
+}
+extreme "frame ends (1e+09 Hz over 0.533 s); the limit is 1e+07" scan --problem stiff_spring --hz 1e9 --out "$work/x.h5"
+extreme "frame ends (1e+09 Hz over 5.51 s); the limit is 1e+07" advise --problem pendulum --hz 1e9 --tol 1e-3 \
+  --study "$work/none.h5"
+extreme "coordinates (60 Hz over 0.533 s) = 1.01e+08; the limit is 2e+07" scan --problem spring_chain \
+  --set spring_chain.masses=1048576 --hz 60 --out "$work/x.h5"
+extreme "needs more than 1e9 steps" run --problem pendulum --integrator rk4 --dt 1e-300
+extreme "needs more than 1e9 steps to reach 1e+300" run --problem pendulum --integrator rk4 --dt 1e-3 --horizon 1e300
+extreme "periods must be a whole number from 1 to 1e7" energy --periods 1000000000000
+extreme "the limit is 1e+07" loop --problem pendulum --integrator rk4 --set pendulum.periods=1e9 --design fixed
+extreme "max levels must be between" sweep --max-levels 1000 --out "$work/x.h5"
+extreme "substeps 2.09715e+06 is not a whole number from 1 to 2^20" scan --problem pendulum --substeps 2097152 \
+  --out "$work/x.h5"
+[ ! -e "$work/x.h5" ] && ok || bad "an extreme value left a file behind"
+
 echo "cli: $passes passed, $fails failed"
 [ "$fails" -eq 0 ]

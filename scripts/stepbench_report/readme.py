@@ -68,8 +68,8 @@ def block(summary, command):
              f"ends against the truth, in the problem's unit) stays within it, and its cost a frame: {cost}. "
              "`stepbench advise --problem P --hz H --tol X` gives the same answer and runs any other rate or "
              "scene (`--set`).",
-             "The scenes as the study ran them: " + "; ".join(f"{p['name']} {p['scene']}" for p in
-                                                             summary["problems"]) + "."]
+             "The scenes as the study ran them (`stepbench list` says what each parameter is): "
+             + "; ".join(f"`{p['name']}`: {p['scene']}" for p in summary["problems"]) + "."]
     for para in prose:
         lines += [""] + textwrap.wrap(para, README_WIDTH - 30, break_long_words=False, break_on_hyphens=False)
     lines += ["", "Against the library peers at equal error, the findings, the pendulum challenge and the scans' "

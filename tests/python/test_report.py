@@ -655,7 +655,7 @@ def test_markdown_and_readme(reports, stepbench, tmp_path):
     assert "old table" not in block
     assert "| problem | 60 Hz, error 1e-2 | 60 Hz, error 1e-3 | 60 Hz, error 1e-4 | stable at one step a frame |" \
         in block
-    assert "| pendulum (rad) | " in block and "spring_chain masses = 32, " in block
+    assert "| pendulum (rad) | " in block and "`spring_chain`: masses = 32, " in block
     assert all(w in block for w in where) and str(study) in block
     # A front page: the block's lines fit in 160 characters (the paths aside, here long
     # temporary ones); the rest is in docs/results.md, which the block names.

@@ -34,6 +34,7 @@ nlohmann::json scan_answer_json(const scan_answer& a) {
                         {"cost_kind", a.cost_kind},
                         {"cost_source", a.cost_source},
                         {"ns_per_force_eval", a.ns_per_force_eval},
+                        {"uncosted", a.uncosted},
                         {"choices", nlohmann::json::array()},
                         {"one_step_a_frame", nlohmann::json::array()}};
   for (const auto& c : a.choices)

@@ -75,6 +75,9 @@ scan_answer answer_scan(const scan_result& s, double tol) {
   a.cost_kind = s.options.ns_per_force_eval.empty() ? "force_evals" : "time_ns";
   a.cost_source = s.options.cost_source;
   a.ns_per_force_eval = s.options.ns_per_force_eval;
+  if (!a.ns_per_force_eval.empty())
+    for (const auto& m : s.options.methods)
+      if (!a.ns_per_force_eval.count(m)) a.uncosted.push_back(m);
   a.points = s.points.size();
   a.grid_points = s.grid_points;
   for (const auto& p : s.points) a.untrusted += p.trusted ? 0 : 1;
@@ -107,7 +110,9 @@ scan_answer answer_scan(const scan_result& s, double tol) {
     c.worst = m.completed() ? std::max(c.worst, m.err_pos_max) : std::numeric_limits<double>::infinity();
     const double evals = static_cast<double>(r.row.work.force_evals) / (p.horizon * r.hz);
     c.evals = std::max(c.evals, evals);
-    c.cost = std::max(c.cost, scan_cost(s.options, r.method, evals));  // NaN stays NaN: not ranked
+    // A method without a measured cost is not ranked: its NaN stays (std::max would drop it).
+    const double cost = scan_cost(s.options, r.method, evals);
+    c.cost = std::isnan(cost) || std::isnan(c.cost) ? nan : std::max(c.cost, cost);
   }
   const std::size_t trusted = a.points - a.untrusted;
   for (double hz : s.options.hz) {

@@ -42,6 +42,9 @@ std::string format_scan_answer(const scan_answer& a) {
         "cost a frame: force evaluations x the method's ns per evaluation, measured on {} by the benchmark in "
         "'{}'{}\n",
         a.problem, a.cost_source, chosen.empty() ? "" : fmt::format(" ({})", fmt::join(chosen, ", ")));
+    if (!a.uncosted.empty())
+      out += fmt::format("not ranked: '{}' has no timed rows of {} on {}\n", a.cost_source, fmt::join(a.uncosted, ", "),
+                         a.problem);
   } else
     out += fmt::format("cost a frame: force evaluations (no timed study of {} given: `--costs FILE` ranks by time)\n",
                        a.problem);

@@ -144,6 +144,7 @@ struct scan_answer {
   std::string problem, unit, range;                    // range: "over k_s 10 .. 1e7 (25 points, log)"
   std::string cost_kind = "force_evals", cost_source;  // cost_kind: time_ns with measured costs
   std::map<std::string, double> ns_per_force_eval;
+  std::vector<std::string> uncosted;  // methods run that the measured costs lack: not ranked
   double tol = 0.0;
   std::size_t points = 0, grid_points = 0, untrusted = 0;
   std::vector<scan_choice> choices;

@@ -5,8 +5,9 @@
 # runs, at the same cost a frame; a rate or a scene the study lacks is run by `advise`
 # itself, by the same rule, and says so.
 set -u
-bin=${1:?usage: one_answer_test.sh path/to/stepbench path/to/timed-study.h5}
-timed=${2:?usage: one_answer_test.sh path/to/stepbench path/to/timed-study.h5}
+bin=${1:?usage: one_answer_test.sh path/to/stepbench path/to/timed-study.h5 [path/to/stepbench_bench]}
+timed=${2:?usage: one_answer_test.sh path/to/stepbench path/to/timed-study.h5 [path/to/stepbench_bench]}
+bench=${3:-}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 fails=0 passes=0
@@ -85,6 +86,21 @@ with h5py.File(sys.argv[2]) as f:
     assert run["substeps"] == 16 and run["err_pos_max"] > 1e-3, run  # the default's answer misses it here
 assert (c["method"], c["substeps"]) != ("velocity_verlet", 16), c
 PY
+
+# A timed study that timed rk4 alone on the stiff spring: the scan ranks rk4 by it and names
+# the methods it cannot rank (no measured cost), instead of dropping them unseen.
+if [ -n "$bench" ]; then
+  "$bench" --quick --problem=stiff_spring --benchmark_filter='^stiff_spring/rk4/' --study_out="$work/rk4.h5" \
+    >/dev/null 2>&1 || bad "the rk4-only timed study exited $?"
+  "$bin" scan --problem stiff_spring --hz 60 --tol 1e-3 --costs "$work/rk4.h5" --quiet --json --out "$work/k.h5" |
+    /usr/bin/python3 -c '
+import json, sys
+d = json.load(sys.stdin)
+assert list(d["ns_per_force_eval"]) == ["rk4"] and d["cost_kind"] == "time_ns", d
+assert "velocity_verlet" in d["uncosted"] and "rk4" not in d["uncosted"], d["uncosted"]
+assert d["choices"][0]["method"] in (None, "rk4"), d["choices"]
+' && ok || bad "scan --costs with rk4 alone timed"
+fi
 
 echo "one_answer: $passes passed, $fails failed"
 [ "$fails" -eq 0 ]

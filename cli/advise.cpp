@@ -104,7 +104,8 @@ int advise_frame_here(const advise_args& args, const std::map<std::string, doubl
   o.fixed = fixed;
   validate(o);
   if (costs) take_costs(o, *costs, args.study);
-  fmt::print(stderr, "{}: running {}'s frame-rate runs at {:g} Hz here (untimed)\n", why, args.problem, hz);
+  fmt::print(stderr, "{}: running {}'s frame-rate runs at {:g} Hz here (untimed; ranked by {})\n", why, args.problem,
+             hz, o.cost_source.empty() ? "force evaluations" : "the study's measured time a force evaluation");
   const scan_answer a = answer_scan(run_scan(o), tol);
   print_answer(args.json, scan_answer_json(a), format_scan_answer(a));
   return a.choices.front().method.empty() ? advise_exit_no_method : 0;

@@ -25,16 +25,28 @@ loop_cost cost_verdict(const loop_config& config, double step_cost_ns, std::stri
   return out;
 }
 
+namespace {
+// The median over `method`'s timed rows that completed of time / count(row); NaN when it
+// has none (the study untimed, or the method not run).
+template <class Count>
+double median_time_per(const problem_study& ps, std::string_view method, Count count) {
+  const method_study* ms = ps.find(method);
+  if (!ms) return nan;
+  std::vector<double> per;
+  for (const auto& r : ms->rows)
+    if (const double n = count(r);
+        r.metrics.completed() && n > 0 && std::isfinite(r.time.time_ns) && r.time.time_ns > 0.0)
+      per.push_back(r.time.time_ns / n);
+  return median(per);
+}
+}  // namespace
+
 double measured_step_cost_ns(const problem_study& ps, std::string_view method) {
-  for (const auto& ms : ps.methods) {
-    if (ms.info.name != method) continue;
-    std::vector<double> per_step;
-    for (const auto& r : ms.rows)
-      if (r.metrics.completed() && r.steps > 0 && std::isfinite(r.time.time_ns) && r.time.time_ns > 0.0)
-        per_step.push_back(r.time.time_ns / static_cast<double>(r.steps));
-    return median(per_step);
-  }
-  return nan;
+  return median_time_per(ps, method, [](const method_row& r) { return static_cast<double>(r.steps); });
+}
+
+double measured_eval_cost_ns(const problem_study& ps, std::string_view method) {
+  return median_time_per(ps, method, [](const method_row& r) { return static_cast<double>(r.work.force_evals); });
 }
 
 std::vector<loop_cheapest> cheapest_designs(const loop_method& m, const loop_options& opts) {

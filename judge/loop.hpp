@@ -22,6 +22,8 @@ loop_cost cost_verdict(const loop_config& config, double step_cost_ns, std::stri
 // The benchmark's median ns per step of `method` on the problem (its timed rows that
 // completed); NaN when the study has no timing for it.
 double measured_step_cost_ns(const problem_study& ps, std::string_view method);
+// The same per force evaluation: a scan's ranking cost (judge/scan.hpp measured_eval_costs).
+double measured_eval_cost_ns(const problem_study& ps, std::string_view method);
 
 // The cheapest design at a constant display rate whose shown error stays at or under
 // the target: fewest physics steps per frame, then the smaller error, then the designs

@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "core/number.hpp"
-#include "core/statistics.hpp"
+#include "judge/loop.hpp"
 #include "registry/registry.hpp"
 
 namespace stepbench {
@@ -57,11 +57,7 @@ std::map<std::string, double> measured_eval_costs(const study& s, const std::str
   if (!s.timed || !ps) return out;
   for (const auto& ms : ps->methods) {
     if (ms.info.origin != method_origin::ours || ms.info.kind != method_kind::fixed_step) continue;
-    std::vector<double> per_eval;
-    for (const auto& r : ms.rows)
-      if (r.metrics.completed() && r.work.force_evals > 0 && std::isfinite(r.time.time_ns) && r.time.time_ns > 0.0)
-        per_eval.push_back(r.time.time_ns / static_cast<double>(r.work.force_evals));
-    if (!per_eval.empty()) out[ms.info.name] = median(per_eval);
+    if (const double ns = measured_eval_cost_ns(*ps, ms.info.name); std::isfinite(ns)) out[ms.info.name] = ns;
   }
   return out;
 }

@@ -127,7 +127,7 @@ inline bool all_finite(const Vec& x, const Vec& v) {
 template <class Vec>
 inline bool stop_on_underflow(drive_result<Vec>& out, double h, double t, double horizon) {
   if (h > 4.0 * std::numeric_limits<double>::epsilon() * std::max(std::abs(t), horizon)) return false;
-  out.stop_reason = "step size underflow at t = " + std::to_string(t);
+  out_of_line([&] { out.stop_reason = "step size underflow at t = " + std::to_string(t); });
   return true;
 }
 // A run that has taken its `max_steps` accepted steps short of the horizon is stopped as
@@ -135,8 +135,10 @@ inline bool stop_on_underflow(drive_result<Vec>& out, double h, double t, double
 template <class Vec>
 inline bool stop_at_step_budget(drive_result<Vec>& out, long max_steps, double t, double horizon) {
   if (out.steps < max_steps || !(t < horizon)) return false;
-  out.skipped = true;
-  out.stop_reason = "over the step budget of " + std::to_string(max_steps) + " steps at t = " + std::to_string(t);
+  out_of_line([&] {
+    out.skipped = true;
+    out.stop_reason = "over the step budget of " + std::to_string(max_steps) + " steps at t = " + std::to_string(t);
+  });
   return true;
 }
 
@@ -394,7 +396,7 @@ STEPBENCH_FLATTEN drive_result<typename P::vec> drive_adaptive(const P& problem,
   Vec x_dense = s.x, v_dense = s.v;  // interpolated states (workspace)
   auto next = times.begin();
   double t = 0.0;
-  double h = stepper.initial_dt(sys, t, s, horizon);
+  double h = out_of_line([&] { return stepper.initial_dt(sys, t, s, horizon); });
   while (t < horizon) {
     const double target = dense || next == times.end() ? horizon : *next;
     // Land on the target when the proposed step reaches it or nearly does (a sliver of a
@@ -406,9 +408,12 @@ STEPBENCH_FLATTEN drive_result<typename P::vec> drive_adaptive(const P& problem,
     const step_attempt a = stepper.try_step(sys, t, s, h_try);
     h = a.dt_next;
     if ((horizon - t) / h > 10.0 * static_cast<double>(max_steps - out.steps)) {
-      out.skipped = true;
-      out.stop_reason = "over the step budget of " + std::to_string(max_steps) + " steps: at t = " + std::to_string(t) +
-                        " the step size " + fmt_g(h) + " would need about " + fmt_g((horizon - t) / h) + " more";
+      out_of_line([&] {
+        out.skipped = true;
+        out.stop_reason = "over the step budget of " + std::to_string(max_steps) +
+                          " steps: at t = " + std::to_string(t) + " the step size " + fmt_g(h) + " would need about " +
+                          fmt_g((horizon - t) / h) + " more";
+      });
       break;
     }
     if (!a.accepted) {
@@ -428,7 +433,9 @@ STEPBENCH_FLATTEN drive_result<typename P::vec> drive_adaptive(const P& problem,
     // at the end of its step, as end_of_step does.
     if constexpr (has_contacts<P>) {
       if (problem.locate_contacts() && problem.contact_gap(t, s.x, s.v) < 0.0) {
-        if constexpr (dense) t = locate_on_dense_output(problem, stepper, t_old, t_step_end, s, x_dense, v_dense);
+        if constexpr (dense)
+          t = out_of_line(
+              [&] { return locate_on_dense_output(problem, stepper, t_old, t_step_end, s, x_dense, v_dense); });
         resolve_here(problem, t, s, out);
       }
     }

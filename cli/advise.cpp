@@ -6,6 +6,7 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -41,6 +42,7 @@ struct advise_args {
   std::string scan, scan_name;    // set: the range question, from a scan (study/scan.hpp)
   std::vector<std::string> sets;  // P.name=value: a scene the study did not run, run here
   bool json = false;
+  bool time = false;  // --hz: rank the runs made here by times measured here
 };
 
 json pick_json(const advice& a, const wp_pick& p) {
@@ -103,9 +105,20 @@ int advise_frame_here(const advise_args& args, const std::map<std::string, doubl
   o.tol = tol;
   o.fixed = fixed;
   validate(o);
-  if (costs) take_costs(o, *costs, args.study);
-  fmt::print(stderr, "{}: running {}'s frame-rate runs at {:g} Hz here (untimed; ranked by {})\n", why, args.problem,
-             hz, o.cost_source.empty() ? "force evaluations" : "the study's measured time a force evaluation");
+  if (args.time) {
+    const auto start = std::chrono::steady_clock::now();
+    o.ns_per_force_eval = eval_costs_timed_here(o);
+    o.cost_source = cost_timed_here;
+    fmt::print(stderr, "{}: timed each method's force evaluation on this scene here ({:.1f} s)\n", why,
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  } else if (costs) {
+    take_costs(o, *costs, args.study);
+  }
+  fmt::print(stderr, "{}: running {}'s frame-rate runs at {:g} Hz here ({}ranked by {})\n", why, args.problem, hz,
+             args.time ? "" : "untimed; ",
+             args.time               ? "the time a force evaluation measured here"
+             : o.cost_source.empty() ? "force evaluations"
+                                     : "the study's measured time a force evaluation");
   const scan_answer a = answer_scan(run_scan(o), tol);
   print_answer(args.json, scan_answer_json(a), format_scan_answer(a));
   return a.choices.front().method.empty() ? advise_exit_no_method : 0;
@@ -127,6 +140,7 @@ int run_advise(const advise_args& args) {
   if (!args.scan.empty()) {
     if (!args.hz_text.empty()) throw std::invalid_argument("--scan answers at the scan's frame rates; drop --hz");
     if (!args.sets.empty()) throw std::invalid_argument("--scan answers for the scan's scenes; drop --set");
+    if (args.time) throw std::invalid_argument("--scan answers from the scan's runs; drop --time");
     const scan_result s = read_scan(args.scan, args.scan_name);
     if (!args.problem.empty() && args.problem != s.options.problem)
       throw std::invalid_argument(
@@ -138,6 +152,9 @@ int run_advise(const advise_args& args) {
     return advise_exit_no_method;
   }
   if (args.problem.empty()) throw std::invalid_argument("--problem is required (or --scan FILE)");
+  if (args.time && args.hz_text.empty())
+    throw std::invalid_argument(
+        "--time times the frame-rate runs of --hz; give --hz (the study's timings answer the rest)");
   parameter_overrides sets;
   for (const auto& text : args.sets) add_override(sets, text, std::vector<std::string>{args.problem});
   const auto fixed = sets.count(args.problem) ? sets.at(args.problem) : std::map<std::string, double>{};
@@ -148,7 +165,8 @@ int run_advise(const advise_args& args) {
     // A scene or rate the study lacks is run here, ranked by the study's costs if it has them.
     std::optional<study> s;
     if (std::filesystem::exists(args.study)) s = study_not_scan(args.study);
-    const std::string missing = !s               ? fmt::format("there is no study file '{}'", args.study)
+    const std::string missing = args.time        ? "--time"
+                                : !s             ? fmt::format("there is no study file '{}'", args.study)
                                 : !fixed.empty() ? "--set makes a scene the study did not run"
                                                  : frame_runs_missing(*s, args.problem, hz);
     if (!missing.empty()) return advise_frame_here(args, fixed, hz, tol, missing, s ? &*s : nullptr);
@@ -182,6 +200,9 @@ command add_advise(CLI::App& app) {
                   "a file written by `stepbench scan`: the cheapest method and substeps that hold over the whole "
                   "range at each rate, and where each method breaks at one step a frame");
   sub->add_option("--name", a->scan_name, "the scan in that file (when it holds more than one)");
+  sub->add_flag("--time", a->time,
+                "with --hz: run the frame-rate runs here and rank them by each method's time a force evaluation "
+                "measured here on this scene (about a second more), not by the study's");
   sub->add_flag("--json", a->json, "print JSON");
   sub->footer("exit codes: 0 answer, 1 study file unreadable, 2 bad usage, 3 no method meets the tolerance\n");
   return {sub, [a] { return run_advise(*a); }};

@@ -38,10 +38,11 @@ std::string format_scan_answer(const scan_answer& a) {
           fmt::format("{} {:.3g} ns", c.method, c.method.empty() ? 0.0 : a.ns_per_force_eval.at(c.method));
       if (!c.method.empty() && std::find(chosen.begin(), chosen.end(), text) == chosen.end()) chosen.push_back(text);
     }
-    out += fmt::format(
-        "cost a frame: force evaluations x the method's ns per evaluation, measured on {} by the benchmark in "
-        "'{}'{}\n",
-        a.problem, a.cost_source, chosen.empty() ? "" : fmt::format(" ({})", fmt::join(chosen, ", ")));
+    out += fmt::format("cost a frame: force evaluations x the method's ns per evaluation, {}{}\n",
+                       a.cost_source == cost_timed_here
+                           ? std::string(cost_timed_here)
+                           : fmt::format("measured on {} by the benchmark in '{}'", a.problem, a.cost_source),
+                       chosen.empty() ? "" : fmt::format(" ({})", fmt::join(chosen, ", ")));
     if (!a.uncosted.empty())
       out += fmt::format("not ranked: '{}' has no timed rows of {} on {}\n", a.cost_source, fmt::join(a.uncosted, ", "),
                          a.problem);

@@ -9,6 +9,7 @@
 
 #include "core/measure.hpp"
 #include "core/number.hpp"
+#include "core/statistics.hpp"
 #include "core/text.hpp"
 #include "registry/registry.hpp"
 #include "run/balanced_share.hpp"
@@ -305,6 +306,44 @@ scan_result run_scan(const scan_options& opts) {
   }
   compute_best(out);
   out.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+std::map<std::string, double> eval_costs_timed_here(const scan_options& opts) {
+  validate(opts);
+  auto problem = make_problem(opts.problem);
+  for (const auto& [name, value] : opts.fixed) problem->set(name, value);
+  if (auto why = problem->validate(); !why.empty()) throw std::invalid_argument(why);
+  const double hz = *std::max_element(opts.hz.begin(), opts.hz.end());
+  const double dt = 1.0 / (hz * *std::max_element(opts.substeps.begin(), opts.substeps.end()));
+  constexpr double frames_timed = 8;
+  const double horizon = std::min(problem->horizon(), frames_timed / hz);
+  const std::vector<double> times{horizon};
+  std::map<std::string, double> out;
+  for (const auto& m : problem->methods()) {
+    if (m.kind != method_kind::fixed_step ||
+        (opts.methods.empty() ? m.origin != method_origin::ours
+                              : std::find(opts.methods.begin(), opts.methods.end(), m.name) == opts.methods.end()))
+      continue;
+    const double evals = static_cast<double>(problem->run(m.name, dt, horizon, times, opts.limits).work.force_evals);
+    if (!(evals > 0)) continue;
+    const auto run = problem->timed_run(m.name, dt, horizon, times, opts.limits);
+    volatile double keep = run();  // warm: the first call pays for the caches and the page faults
+    std::vector<double> per_eval;
+    for (int batch = 0; batch < 5; ++batch) {
+      long calls = 0;
+      const auto start = std::chrono::steady_clock::now();
+      double ns = 0.0;
+      do {
+        keep = run();
+        ++calls;
+        ns = std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - start).count();
+      } while (ns < 1e7);
+      per_eval.push_back(ns / static_cast<double>(calls) / evals);
+    }
+    (void)keep;
+    out[m.name] = median(per_eval);
+  }
   return out;
 }
 

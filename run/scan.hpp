@@ -1,6 +1,7 @@
 #pragma once
 // A scan's runs (study/scan.hpp says what it answers): its axes parsed and checked, its
 // grid, its shards and their merge.
+#include <map>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -24,6 +25,14 @@ void validate(const scan_options& opts);
 std::vector<scan_options> default_scans(bool quick = false);
 
 scan_result run_scan(const scan_options& opts);
+
+// `advise --hz H --time`: each of the scan's methods' ns per force evaluation, timed here on
+// the scan's scene (its problem and --set values, no axes) rather than read from a timed
+// study: the median over five batches of whole runs of a few frames at the finest dt the
+// scan runs (hz x the most substeps), each batch at least 10 ms, divided by the run's counted
+// force evaluations. A method whose run does not complete is timed on what it ran. About a
+// second on a default scene.
+std::map<std::string, double> eval_costs_timed_here(const scan_options& opts);
 
 // The grid points in order: the first axis varies slowest.
 std::vector<std::vector<double>> scan_grid(const std::vector<scan_axis>& axes);

@@ -13,6 +13,7 @@
 #include <functional>
 #include <map>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/method.hpp"
@@ -38,6 +39,9 @@ struct frame_rate_options {
   std::vector<int> substeps{1, 2, 4, 8, 16, 32, 64};
 };
 
+// scan_options::cost_source of costs timed on the scene itself (`advise --hz H --time`).
+inline constexpr std::string_view cost_timed_here = "timed here on this scene (advise --time)";
+
 struct scan_options : frame_rate_options {  // its rates and substeps (`scan --dt X` is hz 1/X)
   std::string problem;
   std::string name;  // the group under /scan ("" : the problem's name)
@@ -51,7 +55,7 @@ struct scan_options : frame_rate_options {  // its rates and substeps (`scan --d
   // so a scan and `advise --hz` rank one scene alike: a frame's cost is its evaluations x
   // its method's. Empty: the evaluations alone. `cost_source` names where they come from.
   std::map<std::string, double> ns_per_force_eval;
-  std::string cost_source;
+  std::string cost_source;  // the timed study's path, or cost_timed_here
   reference_tolerances ref_tol{};
   // At a point whose references' predicted work (core/measure.hpp predicted_reference_work:
   // coordinates x w_max T) is over this, the references are not run: the point has no

@@ -87,6 +87,28 @@ with h5py.File(sys.argv[2]) as f:
 assert (c["method"], c["substeps"]) != ("velocity_verlet", 16), c
 PY
 
+# --time: the rope of 64 masses at 144 Hz, ranked by each method's time a force evaluation
+# measured on that rope here (a longer rope's evaluation costs more than the study's 32-mass
+# one: the cost is of this scene), and said so; without --hz, --time is refused.
+"$bin" advise --study "$timed" --problem spring_chain --hz 144 --tol 1e-3 --set spring_chain.masses=64 --time --json \
+  >"$work/time.json" 2>"$work/time.err" || bad "advise --time exited $?: $(cat "$work/time.err")"
+grep -q "^--time: timed each method's force evaluation on this scene here" "$work/time.err" && ok ||
+  bad "advise --time stderr: $(cat "$work/time.err")"
+/usr/bin/python3 - "$work/time.json" "$work/64.json" <<'PY' && ok || bad "advise --time answer"
+import json, sys
+d, untimed = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+assert d["cost_kind"] == "time_ns" and d["cost_source"] == "timed here on this scene (advise --time)", d
+c = d["choices"][0]
+assert c["hz"] == 144 and c["method"] and 0 < c["worst_err_pos_max"] <= 1e-3, c
+ns = d["ns_per_force_eval"]
+assert set(ns) >= {"rk4", "velocity_verlet", "semi_implicit_euler"} and all(v > 0 for v in ns.values()), ns
+# The cost a frame is the counted evaluations times the evaluation's measured time.
+assert abs(c["max_cost_per_frame"] - c["max_force_evals_per_frame"] * ns[c["method"]]) <= 1e-9 * c["max_cost_per_frame"], c
+PY
+"$bin" advise --study "$timed" --problem pendulum --tol 1e-3 --time >/dev/null 2>"$work/t.err"
+[ $? -eq 2 ] && [ "$(wc -l <"$work/t.err")" -eq 1 ] && grep -q "give --hz" "$work/t.err" && ok ||
+  bad "advise --time without --hz: $(cat "$work/t.err")"
+
 # A timed study that timed rk4 alone on the stiff spring: the scan ranks rk4 by it and names
 # the methods it cannot rank (no measured cost), instead of dropping them unseen.
 if [ -n "$bench" ]; then

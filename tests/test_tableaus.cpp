@@ -259,6 +259,8 @@ TEST(tableaus, row_sums_equal_nodes) {
   expect_row_sums("rk4", rk4_tableau);
   expect_row_sums("dopri5", dopri5_tableau);
   expect_row_sums("dop853 (16 stages)", dop853_extended);
+  expect_row_sums("vern7", vern7_tableau);
+  expect_row_sums("vern9", vern9_tableau);
 }
 
 TEST(tableaus, order_conditions_hold_to_the_declared_order_exactly) {
@@ -269,10 +271,19 @@ TEST(tableaus, order_conditions_hold_to_the_declared_order_exactly) {
   expect_exact_order("dop853 b", dop853_tableau, dop853_tableau.b, dop853_tableau.order);
   expect_exact_order("dop853 b_hat5 = b - er", dop853_tableau, dop853_tableau.b_hat, dop853_tableau.embedded_order);
   expect_exact_order("dop853 b_hat3 = bhh", dop853_tableau, dop853_b_hat3, dop853_b_hat3_order);
+  // Verner's pairs: order 10 (for vern9 b) is the last order of the generated trees.
+  expect_exact_order("vern7 b", vern7_tableau, vern7_tableau.b, vern7_tableau.order);
+  expect_exact_order("vern7 b_hat", vern7_tableau, vern7_tableau.b_hat, vern7_tableau.embedded_order);
+  expect_exact_order("vern9 b", vern9_tableau, vern9_tableau.b, vern9_tableau.order);
+  expect_exact_order("vern9 b_hat", vern9_tableau, vern9_tableau.b_hat, vern9_tableau.embedded_order);
   EXPECT_EQ(midpoint_tableau.order, 2);
   EXPECT_EQ(rk4_tableau.order, 4);
   EXPECT_EQ(dopri5_tableau.order, 5);
   EXPECT_EQ(dop853_tableau.order, 8);
+  EXPECT_EQ(vern7_tableau.order, 7);
+  EXPECT_EQ(vern7_tableau.embedded_order, 6);
+  EXPECT_EQ(vern9_tableau.order, 9);
+  EXPECT_EQ(vern9_tableau.embedded_order, 8);
 }
 
 TEST(tableaus, fsal_and_stored_error_weights) {
@@ -295,6 +306,23 @@ TEST(tableaus, fsal_and_stored_error_weights) {
   }
   EXPECT_NEAR(s5, 0.0, 1e-15);
   EXPECT_NEAR(s3, 1.0, 1e-15);
+}
+
+// Verner's pairs are not FSAL: the last stage is at t + h but not at y_1 (its row of A
+// is not b), and it enters only b_hat, so a fixed step can leave it out.
+namespace {
+template <int S>
+void expect_last_stage_only_embedded(const char* what, const explicit_tableau<S>& tab) {
+  EXPECT_EQ(tab.c[S - 1], 1.0) << what;
+  EXPECT_EQ(tab.b[S - 1], 0.0) << what;
+  EXPECT_NE(tab.b_hat[S - 1], 0.0) << what;
+  EXPECT_NE(tab.a[S - 1], tab.b) << what << ": the last stage would be f(t + h, y_1)";
+}
+}  // namespace
+
+TEST(tableaus, verner_last_stage_enters_only_the_embedded_weights) {
+  expect_last_stage_only_embedded("vern7", vern7_tableau);
+  expect_last_stage_only_embedded("vern9", vern9_tableau);
 }
 
 TEST(dense_output, equals_the_step_at_theta_one_and_zero_at_theta_zero) {

@@ -87,19 +87,25 @@ std::vector<rooted_tree> rooted_trees(int max_order) {
   return trees;
 }
 
-const std::vector<rooted_tree>& trees_to_9() {
-  static const std::vector<rooted_tree> trees = rooted_trees(9);
+// Order 10 is the first order that must fail for a 9th-order method (1205 trees in all,
+// generated once).
+constexpr int max_tree_order = 10;
+
+const std::vector<rooted_tree>& all_trees() {
+  static const std::vector<rooted_tree> trees = rooted_trees(max_tree_order);
   return trees;
 }
 
 // Stage weights Phi_i(t) = prod_k (A Phi(t_k))_i (Phi_i(tau) = 1), so that the
 // elementary weight of t under weights w is w^T Phi(t). With absolute = true, A is
-// replaced by |A| (for the round-off scale).
+// replaced by |A| (for the round-off scale). Only the trees up to max_order: the list
+// is in non-decreasing order, so they are a prefix of it.
 template <int S>
 std::vector<std::array<double, S>> stage_weights(const explicit_tableau<S>& tab, const std::vector<rooted_tree>& trees,
-                                                 bool absolute) {
-  std::vector<std::array<double, S>> phi(trees.size());
-  for (size_t t = 0; t < trees.size(); ++t) {
+                                                 bool absolute, int max_order) {
+  std::vector<std::array<double, S>> phi;
+  for (size_t t = 0; t < trees.size() && trees[t].order <= max_order; ++t) {
+    phi.emplace_back();
     phi[t].fill(1.0);
     for (int k : trees[t].children)
       for (int i = 0; i < S; ++i) {
@@ -121,8 +127,9 @@ struct residuals {
 template <int S, std::size_t W>
 residuals order_residuals(const explicit_tableau<S>& tab, const std::array<double, W>& w, double theta, int max_order) {
   static_assert(W == S);
-  const auto& trees = trees_to_9();
-  const auto phi = stage_weights(tab, trees, false), phi_abs = stage_weights(tab, trees, true);
+  if (max_order > max_tree_order) ADD_FAILURE() << "order " << max_order << " needs trees beyond " << max_tree_order;
+  const auto& trees = all_trees();
+  const auto phi = stage_weights(tab, trees, false, max_order), phi_abs = stage_weights(tab, trees, true, max_order);
   residuals r{std::vector<double>(max_order + 1, 0.0)};
   for (size_t t = 0; t < trees.size(); ++t) {
     const int rho = trees[t].order;
@@ -221,17 +228,17 @@ double real_axis_limit(const explicit_tableau<S>& tab, double dx = 1e-3) {
 
 // ---------------------------------------------------------------------------------
 TEST(rooted_trees, counts_per_order_match_oeis_a000081) {
-  const auto& trees = trees_to_9();
-  const std::array<int, 10> expected = {0, 1, 1, 2, 4, 9, 20, 48, 115, 286};
-  std::array<int, 10> count{};
-  std::array<double, 10> labellings{};
+  const auto& trees = all_trees();
+  const std::array<int, max_tree_order + 1> expected = {0, 1, 1, 2, 4, 9, 20, 48, 115, 286, 719};
+  std::array<int, max_tree_order + 1> count{};
+  std::array<double, max_tree_order + 1> labellings{};
   for (const auto& t : trees) {
     ++count[t.order];
     // alpha(t) = rho! / (sigma gamma) monotonic labellings (HNW I, sec. II.2); summed
     // over the trees of order n they count (n - 1)!, which checks gamma and sigma.
     labellings[t.order] += std::tgamma(t.order + 1.0) / (t.sigma * t.gamma);
   }
-  for (int n = 1; n <= 9; ++n) {
+  for (int n = 1; n <= max_tree_order; ++n) {
     EXPECT_EQ(count[n], expected[n]) << "order " << n;
     EXPECT_NEAR(labellings[n], std::tgamma(n), 1e-9 * std::tgamma(n)) << "order " << n;
   }
@@ -252,6 +259,8 @@ TEST(tableaus, row_sums_equal_nodes) {
   expect_row_sums("rk4", rk4_tableau);
   expect_row_sums("dopri5", dopri5_tableau);
   expect_row_sums("dop853 (16 stages)", dop853_extended);
+  expect_row_sums("vern7", vern7_tableau);
+  expect_row_sums("vern9", vern9_tableau);
 }
 
 TEST(tableaus, order_conditions_hold_to_the_declared_order_exactly) {
@@ -262,10 +271,19 @@ TEST(tableaus, order_conditions_hold_to_the_declared_order_exactly) {
   expect_exact_order("dop853 b", dop853_tableau, dop853_tableau.b, dop853_tableau.order);
   expect_exact_order("dop853 b_hat5 = b - er", dop853_tableau, dop853_tableau.b_hat, dop853_tableau.embedded_order);
   expect_exact_order("dop853 b_hat3 = bhh", dop853_tableau, dop853_b_hat3, dop853_b_hat3_order);
+  // Verner's pairs: order 10 (for vern9 b) is the last order of the generated trees.
+  expect_exact_order("vern7 b", vern7_tableau, vern7_tableau.b, vern7_tableau.order);
+  expect_exact_order("vern7 b_hat", vern7_tableau, vern7_tableau.b_hat, vern7_tableau.embedded_order);
+  expect_exact_order("vern9 b", vern9_tableau, vern9_tableau.b, vern9_tableau.order);
+  expect_exact_order("vern9 b_hat", vern9_tableau, vern9_tableau.b_hat, vern9_tableau.embedded_order);
   EXPECT_EQ(midpoint_tableau.order, 2);
   EXPECT_EQ(rk4_tableau.order, 4);
   EXPECT_EQ(dopri5_tableau.order, 5);
   EXPECT_EQ(dop853_tableau.order, 8);
+  EXPECT_EQ(vern7_tableau.order, 7);
+  EXPECT_EQ(vern7_tableau.embedded_order, 6);
+  EXPECT_EQ(vern9_tableau.order, 9);
+  EXPECT_EQ(vern9_tableau.embedded_order, 8);
 }
 
 TEST(tableaus, fsal_and_stored_error_weights) {
@@ -288,6 +306,23 @@ TEST(tableaus, fsal_and_stored_error_weights) {
   }
   EXPECT_NEAR(s5, 0.0, 1e-15);
   EXPECT_NEAR(s3, 1.0, 1e-15);
+}
+
+// Verner's pairs are not FSAL: the last stage is at t + h but not at y_1 (its row of A
+// is not b), and it enters only b_hat, so a fixed step can leave it out.
+namespace {
+template <int S>
+void expect_last_stage_only_embedded(const char* what, const explicit_tableau<S>& tab) {
+  EXPECT_EQ(tab.c[S - 1], 1.0) << what;
+  EXPECT_EQ(tab.b[S - 1], 0.0) << what;
+  EXPECT_NE(tab.b_hat[S - 1], 0.0) << what;
+  EXPECT_NE(tab.a[S - 1], tab.b) << what << ": the last stage would be f(t + h, y_1)";
+}
+}  // namespace
+
+TEST(tableaus, verner_last_stage_enters_only_the_embedded_weights) {
+  expect_last_stage_only_embedded("vern7", vern7_tableau);
+  expect_last_stage_only_embedded("vern9", vern9_tableau);
 }
 
 TEST(dense_output, equals_the_step_at_theta_one_and_zero_at_theta_zero) {

@@ -384,6 +384,7 @@ def _problem(doc, study, p, figs):
     if study.verdict is not None:
         verdict_section.problem_section(doc, study.verdict, p.name)
     doc.fold(f"{p.name}: every method of the figure, the front run by run, the adaptive methods")
+    doc.h(4, f"{p.name}: every method of the work-precision figure")
     doc.table(*tables.method_rows(p, figures.work_curves(p, primary, study.timed), figures.labelled(p, primary),
                                   primary))
     doc.h(4, f"{p.name}: Pareto front")

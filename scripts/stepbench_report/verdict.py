@@ -237,15 +237,16 @@ class ChoiceError(ValueError):
     """A --hz or --tol the study's verdict does not hold; its text names what it holds."""
 
 
-def held(wanted, have, what, flag):
+def held(wanted, have, what, flag, text):
     """The values of `have` (the study's rates or targets) equal to each of `wanted`, in the
-    order asked; ChoiceError naming what the study has when one is not there."""
+    order asked; ChoiceError naming what the study has when one is not there. `text`: a
+    value as the message writes it."""
     out = []
     for w in wanted:
         match = next((h for h in have if math.isclose(h, w, rel_tol=1e-9)), None)
         if match is None:
-            raise ChoiceError(f"{flag} {w:g}: the study holds per-frame answers at the {what} "
-                              f"{', '.join(f'{h:g}' for h in have)} only")
+            raise ChoiceError(f"{flag} {text(w)}: the study holds per-frame answers at the {what} "
+                              f"{', '.join(text(h) for h in have)} only")
         out.append(match)
     return out
 
@@ -254,10 +255,10 @@ def frame_choice(verdict, hz=None, targets=None):
     """(rate, targets) the index answers: those asked (ChoiceError when the study lacks one),
     else 60 Hz and 1e-2, 1e-3, 1e-4 where the study has them (else its first rate, and its
     first three targets)."""
-    rate = held([hz], verdict.frame_hz, "rates", "--hz")[0] if hz is not None else next(
+    rate = held([hz], verdict.frame_hz, "rates", "--hz", lambda h: f"{h:g}")[0] if hz is not None else next(
         (h for h in verdict.frame_hz if math.isclose(h, FRAME_HZ)), verdict.frame_hz[0])
     if targets:
-        return rate, held(targets, verdict.targets, "targets", "--tol")
+        return rate, held(targets, verdict.targets, "targets", "--tol", target_text)
     default = [t for t in verdict.targets if any(math.isclose(t, d, rel_tol=1e-9) for d in FRAME_TARGETS)]
     return rate, default or verdict.targets[:3]
 

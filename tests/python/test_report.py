@@ -54,6 +54,11 @@ def report_text(folder):
     return (folder / "REPORT.md").read_text()
 
 
+def site_pages(folder):
+    """{path in the folder: HTML} of every page of the report's site."""
+    return {str(p.relative_to(folder)): p.read_text() for p in sorted(folder.rglob("*.html"))}
+
+
 def text(v):
     return v.decode() if isinstance(v, bytes) else v
 
@@ -74,19 +79,19 @@ def snapshot(folder):
 def test_outputs_exist_and_images_resolve(reports, shape):
     study, folder = reports[shape]
     md = report_text(folder)
-    html = (folder / "index.html").read_text()
-    assert len(md) > 1000 and len(html) > 1000
+    pages = site_pages(folder)
+    html = "\n".join(pages.values())
+    assert len(md) > 1000 and len(pages["index.html"]) > 1000
     images = re.findall(r"!\[[^\]]*\]\((fig/[^)]+\.png)\)", md)
     for img in images:
         path = folder / img
         assert path.is_file() and path.stat().st_size > 10_000, img
-        assert f'src="{img}"' in html, img
+        assert f'src="{img}"' in html or f'src="../{img}"' in html, img
     assert sorted(os.listdir(folder / "fig")) == sorted(os.path.basename(i) for i in images)
     # Opens offline: nothing is fetched from the network.
     assert not re.search(r"(src|href)=\"(https?:)?//", html)
-    # The tables are HTML tables, and the contents link to the sections, a section a problem.
+    # The tables are HTML tables (REPORT.md holds every page's), and the index links to a page a problem.
     assert html.count("<table") == md.count("\n|---")
-    assert '<a href="#fastest-at-equal-error">' in html
     with h5py.File(study, "r") as f:
         problems = list(f["problems"])
         energy = {p for p in problems if f["problems"][p].attrs["has_energy"] == 1}
@@ -100,7 +105,8 @@ def test_outputs_exist_and_images_resolve(reports, shape):
         challenge = {"pendulum_challenge.png"} if "challenge" in f else set()  # a full sweep of n_pendulum
     assert "kepler" in problems and "bouncing_balls" in problems
     for p in problems:
-        assert f'<a href="#{p}">' in html, p
+        assert f'<a href="problems/{p}.html">' in pages["index.html"], p
+        assert f'problems/{p}.html' in pages
     # One work-precision and one convergence figure a problem, the energy drift where
     # the problem has an energy, then the study-wide figures.
     expected = {f"convergence_{p}.png" for p in problems} | {f"work_precision_{p}.png" for p in problems} | {
@@ -415,14 +421,16 @@ def param_value(cell_text):
 
 
 @pytest.mark.parametrize("shape", ["plain", "timed"])
-def test_the_report_opens_on_the_verdict(reports, shape):
-    """The first table of index.html is the verdict table, before any figure; the
-    build metadata come after every problem."""
+def test_the_report_opens_on_the_answer(reports, shape):
+    """index.html: the per-frame answer, the verdict table, the frame-rate table, and no
+    figure (they are on the problems' pages); the build metadata on the appendix's page."""
     _, folder = reports[shape]
     page = (folder / "index.html").read_text()
-    assert page.index('<table class="verdict">') == page.index("<table")
-    assert page.index('<table class="verdict">') < page.index("<img")
-    assert page.index('<table class="frames">') < page.index("<img")
+    assert page.index('<table class="answer">') == page.index("<table")
+    assert page.index('<table class="answer">') < page.index('<table class="verdict">') < \
+        page.index('<table class="frames">')
+    assert "<img" not in page
+    assert "Build and machine" in (folder / "about.html").read_text()
 
 
 @pytest.mark.parametrize("shape", ["plain", "timed"])
@@ -554,7 +562,7 @@ def test_work_precision_labels_the_front_and_the_lecture(reports, shape):
     front = "front_time" if shape == "timed" else "front_force_evals"
     with h5py.File(study, "r") as f:
         for pname, g in f["problems"].items():
-            table = md_dict(md, f"### {pname}: work-precision")
+            table = md_dict(md, f"#### {pname}: every method of the work-precision figure")
             methods = {label(n, text(m.attrs["origin"])): n for n, m in g["methods"].items()}
             assert set(table) == set(methods), pname
             on_front = {text(m) for m in g[front]["method"]}
@@ -594,8 +602,9 @@ def test_one_problem(reports, tmp_path):
     assert [r[0] for r in rows] == ["pendulum [rad]"]
     assert sorted(os.listdir(out / "fig")) == ["convergence_pendulum.png", "energy_drift_pendulum.png",
                                                "work_precision_pendulum.png"]
-    page = (out / "index.html").read_text()
-    assert 'src="fig/' not in page and page.count('src="data:image/png;base64,') == 3
+    assert sorted(site_pages(out)) == ["about.html", "index.html", "problems/pendulum.html"]
+    page = (out / "problems" / "pendulum.html").read_text()
+    assert 'src="../fig/' not in page and page.count('src="data:image/png;base64,') == 3
     summary = json.loads((out / "summary.json").read_text())
     assert {r["problem"] for r in summary["verdict"]["equal_error"]} == {"pendulum"}
 

@@ -50,8 +50,9 @@ def _figure_jobs(study, figdir, whole, scans=None):
     jobs = []
     for p in study.problems:
         jobs += [("wp", p.name, os.path.join(figdir, f"work_precision_{p.name}.png")),
-                 ("convergence", p.name, os.path.join(figdir, f"convergence_{p.name}.png")),
-                 ("energy", p.name, os.path.join(figdir, f"energy_drift_{p.name}.png"))]
+                 ("convergence", p.name, os.path.join(figdir, f"convergence_{p.name}.png"))]
+        if figures.energy_drifts(p):
+            jobs.append(("energy", p.name, os.path.join(figdir, f"energy_drift_{p.name}.png")))
     if not whole:
         return jobs
     if study.energy_runs is not None:
@@ -107,14 +108,20 @@ def _draw(job):
     return path
 
 
-def draw_figures(study, figdir, workers, names, whole=True, scans=None):
+def draw_figures(study, figdir, workers, names, whole=True, scans=None, meanwhile=lambda figures: None):
+    """Draws every figure (_figure_jobs) in `workers` processes; returns the paths drawn and
+    what meanwhile(the names of the figures asked for) returned: it runs while the workers
+    draw, where the main process would wait."""
     jobs = _figure_jobs(study, figdir, whole, scans)
+    asked = {os.path.basename(job[2]) for job in jobs}
     if workers <= 1:
         _init_worker(study, names, scans)
-        return [p for p in map(_draw, jobs) if p]
+        return [p for p in map(_draw, jobs) if p], meanwhile(asked)
     ex = ProcessPoolExecutor(max_workers=workers, initializer=_init_worker, initargs=(study, names, scans))
     try:
-        drawn = [p for p in ex.map(_draw, jobs) if p]
+        drawing = ex.map(_draw, jobs)
+        early = meanwhile(asked)
+        drawn = [p for p in drawing if p]
     except BaseException:
         # An interruption (SIGINT, or SIGTERM as cli.py raises it) can come before the
         # executor's manager thread has started, and then nothing tells the workers to stop:
@@ -125,7 +132,7 @@ def draw_figures(study, figdir, workers, names, whole=True, scans=None):
             worker.kill()  # not SIGTERM: the handler they inherited from cli.py would run in them
         raise
     ex.shutdown()
-    return drawn
+    return drawn, early
 
 
 def in_verdict_order(study):
@@ -161,12 +168,22 @@ def build(study, outdir, workers=2, problem=None, self_contained=False, hz=None,
         names = scan_section.method_names(scans)
     figdir = os.path.join(outdir, "fig")
     os.makedirs(figdir, exist_ok=True)
-    made = set(os.path.basename(p) for p in draw_figures(study, figdir, workers, names, whole, scans))
-    doc = scan_file_document(study, made, scans) if study.scan_only else document(study, made, whole, scans, hz,
-                                                                                  targets)
+
+    def pages(figs):
+        """The document and its pages, with the figures `figs`."""
+        doc = scan_file_document(study, figs, scans) if study.scan_only else document(study, figs, whole, scans, hz,
+                                                                                      targets)
+        return doc, render.site(doc, figdir if self_contained else None)
+
+    # The pages are made while the figures are drawn (from the names asked for), and made again
+    # in the rare case a figure had nothing to draw. --self-contained reads the figures: after.
+    early_pages = (lambda asked: None) if self_contained else (lambda asked: (asked, pages(asked)))
+    drawn, early = draw_figures(study, figdir, workers, names, whole, scans, meanwhile=early_pages)
+    made = set(os.path.basename(p) for p in drawn)
+    doc, site = early[1] if early and early[0] == made else pages(made)
     with open(os.path.join(outdir, "REPORT.md"), "w") as f:
         f.write(render.markdown(doc))
-    for page, text in render.site(doc, figdir if self_contained else None).items():
+    for page, text in site.items():
         path = os.path.join(outdir, page)
         os.makedirs(os.path.dirname(path), exist_ok=True)
         with open(path, "w") as f:

@@ -7,6 +7,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
+from matplotlib.ticker import LogLocator  # noqa: E402
 from matplotlib.transforms import blended_transform_factory  # noqa: E402
 from PIL import Image  # noqa: E402  (matplotlib's own PNG writer)
 
@@ -95,11 +96,13 @@ def _power_of_ten(value, _pos=None):
 
 
 def _log_axes(ax):
-    """Both axes logarithmic, their decades labelled in plain text (_power_of_ten)."""
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.xaxis.set_major_formatter(_power_of_ten)
-    ax.yaxis.set_major_formatter(_power_of_ten)
+    """Both axes logarithmic, their decades labelled in plain text (_power_of_ten), minor
+    ticks at 2 and 5 times a power of ten: matplotlib's eight a decade, each an object of
+    its own, took a quarter of the report's drawing time."""
+    for axis, scale in ((ax.xaxis, ax.set_xscale), (ax.yaxis, ax.set_yscale)):
+        scale("log")
+        axis.set_major_formatter(_power_of_ten)
+        axis.set_minor_locator(LogLocator(subs=(2.0, 5.0)))
 
 
 def error_label(metric, unit):

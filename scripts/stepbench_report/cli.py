@@ -149,8 +149,8 @@ def main(argv=None, start=None):
         description="Turn a stepbench study file into a report folder, a small site that opens offline: "
                     "index.html (the answer a frame at --hz and each --tol first, then the verdict at equal error, "
                     "a line per problem), a page per problem (problems/*.html), a page per study-wide section, "
-                    "about.html; REPORT.md (all of it in one document), summary.json and fig/*.png. The folder is replaced whole: it is built beside "
-                    "the target and renamed into place. --markdown and --readme write only the verdict tables "
+                    "about.html; REPORT.md (all of it in one document), summary.json and fig/*.png. The folder "
+                    "is replaced whole: it is built beside the target and renamed into place. --markdown and --readme write only the verdict tables "
                     "(and the folder too when --out is given). A scan file (`stepbench scan --out`, `stepbench "
                     "merge`: /scan and no problems) gets a report of its scans alone.")
     ap.add_argument("study", nargs="?", default="results/study.h5",

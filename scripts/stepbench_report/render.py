@@ -1,9 +1,10 @@
 """A small document model written out as Markdown (REPORT.md, --markdown, --readme)
 and as a small site through python3-markdown (inline CSS, images beside it in fig/ or
 inlined, no network): what comes before the first page() is index.html, each page() a
-page of its own (REPORT.md is the whole document, in the same order). A table whose cells carry their own HTML (Cell) or a class is
-written into the HTML as an HTML table (python3-markdown passes a raw HTML block
-through as it is), and into the Markdown as a Markdown table of the cells' text."""
+page of its own (REPORT.md is the whole document, in the same order). A table whose
+cells carry their own HTML (Cell) or a class is written into the HTML as an HTML table
+(python3-markdown passes a raw HTML block through as it is), and into the Markdown as a
+Markdown table of the cells' text."""
 import base64
 import html
 import os

@@ -291,8 +291,8 @@ def page_of(problem):
 
 def scene_cell(problem, unit, scene):
     """The problem's name, linked to its page, and its scene as the study ran it."""
-    return Cell(f"{problem} [{unit}]",
-                f'<a href="{esc(page_of(problem))}">{esc(problem)}</a> [{esc(unit)}]<br><span class="small">{esc(scene)}</span>')
+    return Cell(f"{problem} [{unit}]", f'<a href="{esc(page_of(problem))}">{esc(problem)}</a> [{esc(unit)}]'
+                f'<br><span class="small">{esc(scene)}</span>')
 
 
 def frame_answer(doc, verdict, hz, targets, scenes):
@@ -307,7 +307,7 @@ def frame_answer(doc, verdict, hz, targets, scenes):
           + ("(the benchmark's median time a step on the scene, times the steps of a frame)" if kind == "time_ns"
              else "(force evaluations: this study is untimed)")
           + "; under it, the error it keeps: the worst body's largest position error over the run, in the "
-          "problem's unit.", cls="lead")
+          "problem's unit (rad for the angles: 1e-3 is 1 mrad).", cls="lead")
     head = ["problem [unit], scene as run"] + [f"{target_text(t)} ({target_words(t)})" for t in targets] \
         + ["stable at one step a frame"]
     rows = [[scene_cell(p, verdict.unit(p), scenes.get(p, ""))]

@@ -217,8 +217,8 @@ def _challenge_panel(ax, c, styles, figures):
         ax.plot([x], [y], linestyle="none", marker=st["marker"], color=st["color"], markersize=10,
                 markeredgecolor="black", markeredgewidth=0.6, zorder=5)
         points.append((x, y, entry_label(r) + ("" if r["stable"] else " (unstable)"), st["color"]))
-    ax.set_xscale("log")
-    ax.set_yscale("log")
+    figures.log_scale(ax, "x")
+    figures.log_scale(ax, "y")
     lo, hi = figures._log_limits([p[1] for p in points] + [xerr], pad=8.0)
     ax.set_ylim(lo, hi)
     if xs:
@@ -248,7 +248,7 @@ def _small_steps_panel(ax, c, problem, letter, styles, figures):
     if band:
         hi = hi * (hi / lo) ** (band / (1 - band))
     ax.set_xscale("log", base=2)
-    ax.set_yscale("log")
+    figures.log_scale(ax, "y")
     ax.set_ylim(lo, hi)
     ns = counts(c)
     ax.set_xlim(min(ns) / 1.4, max(ns) * 1.4)

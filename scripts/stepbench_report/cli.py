@@ -1,5 +1,5 @@
-"""scripts/report [study.h5 | scan.h5] [--out results/report] [--problem P] [--self-contained] [--jobs N]
-[--markdown FILE] [--readme FILE [--summary results/summary.json]]"""
+"""scripts/report [study.h5 | scan.h5] [--out results/report] [--problem P] [--hz H] [--tol X ...]
+[--self-contained] [--jobs N] [--markdown FILE] [--readme FILE [--summary results/summary.json]]"""
 import argparse
 import os
 import shlex
@@ -24,6 +24,50 @@ def _positive_int(text):
     if value < 1:
         raise argparse.ArgumentTypeError(f"must be a positive integer, not '{text}'")
     return value
+
+
+def _tolerances(text):
+    """--tol 1e-3 or --tol 1e-2,1e-3: positive numbers."""
+    out = []
+    for part in text.split(","):
+        try:
+            value = float(part)
+        except ValueError:
+            value = 0.0
+        if not value > 0 or value == float("inf"):
+            raise argparse.ArgumentTypeError(f"must be positive numbers (1e-3, or 1e-2,1e-3), not '{text}'")
+        out.append(value)
+    return out
+
+
+def _rate(text):
+    try:
+        value = float(text)
+    except ValueError:
+        value = 0.0
+    if not value > 0 or value == float("inf"):
+        raise argparse.ArgumentTypeError(f"must be a positive rate in Hz, not '{text}'")
+    return value
+
+
+def _frame_choice(s, args):
+    """--hz and --tol checked against what the study's verdict holds (the per-frame answers are
+    the study's, never computed here): None, or 2 after one line on stderr."""
+    asked = args.hz is not None or args.tol
+    if not asked:
+        return None
+    if s.scan_only or s.verdict is None:
+        what = "is a scan file (only /scan)" if s.scan_only else "has no /verdict group"
+        print(f"report: error: --hz, --tol: '{args.study}' {what}: it holds no per-frame answers; nothing written",
+              file=sys.stderr)
+        return 2
+    from . import verdict
+    try:
+        verdict.frame_choice(s.verdict, args.hz, args.tol)
+    except verdict.ChoiceError as e:
+        print(f"report: error: {e}; nothing written", file=sys.stderr)
+        return 2
+    return None
 
 
 def _write_text(path, text):
@@ -102,17 +146,24 @@ def main(argv=None, start=None):
     argv = sys.argv[1:] if argv is None else list(argv)
     ap = argparse.ArgumentParser(
         prog="report",
-        description="Turn a stepbench study file into a report folder: index.html (opens offline; the verdict "
-                    "first), REPORT.md, summary.json and fig/*.png. The folder is replaced whole: it is built beside "
-                    "the target and renamed into place. --markdown and --readme write only the verdict tables "
+        description="Turn a stepbench study file into a report folder, a small site that opens offline: "
+                    "index.html (the answer a frame at --hz and each --tol first, then the verdict at equal error, "
+                    "a line per problem), a page per problem (problems/*.html), a page per study-wide section, "
+                    "about.html; REPORT.md (all of it in one document), summary.json and fig/*.png. The folder "
+                    "is replaced whole: it is built beside the target and renamed into place. --markdown and --readme write only the verdict tables "
                     "(and the folder too when --out is given). A scan file (`stepbench scan --out`, `stepbench "
                     "merge`: /scan and no problems) gets a report of its scans alone.")
     ap.add_argument("study", nargs="?", default="results/study.h5",
                     help="study file, or scan file (default: %(default)s)")
     ap.add_argument("--out", default=None, help="report folder (default: results/report)")
     ap.add_argument("--problem", metavar="P", help="a report (or --markdown, --readme) of this problem only")
+    ap.add_argument("--hz", type=_rate, default=None, metavar="H",
+                    help="the frame rate the index answers for, one the study ran (default: 60 where it ran it)")
+    ap.add_argument("--tol", type=_tolerances, action="extend", default=None, metavar="X",
+                    help="an error the index answers for, in the problem's unit, one of the study's targets; "
+                         "repeat it or give a comma list (default: 1e-2, 1e-3 and 1e-4)")
     ap.add_argument("--self-contained", action="store_true",
-                    help="index.html carries its figures (data: URIs): one file to send")
+                    help="every page carries its figures (data: URIs): no fig/ folder needed")
     ap.add_argument("--jobs", type=_positive_int, default=min(2, os.cpu_count() or 1),
                     help="processes drawing the figures, a positive integer (default: %(default)s)")
     ap.add_argument("--markdown", metavar="FILE", help="write the verdict tables, the findings and where the "
@@ -146,6 +197,8 @@ def main(argv=None, start=None):
         print(f"report: error: unknown problem '{args.problem}' (the study has "
               f"{', '.join(p.name for p in s.problems)})", file=sys.stderr)
         return 2
+    if (status := _frame_choice(s, args)) is not None:
+        return status
     if args.markdown or args.readme:
         status = _answers(s, args, argv, readme_text)
         if status or args.out is None:
@@ -181,7 +234,8 @@ def main(argv=None, start=None):
     try:
         # matplotlib is imported only now: a file the report refuses is refused at once.
         from . import report
-        report.build(s, tmp, workers=args.jobs, problem=args.problem, self_contained=args.self_contained)
+        report.build(s, tmp, workers=args.jobs, problem=args.problem, self_contained=args.self_contained,
+                     hz=args.hz, targets=args.tol)
         with open(os.path.join(tmp, MARKER), "w") as f:
             f.write("This folder is generated by scripts/report and is replaced whole on the next run.\n")
         os.chmod(tmp, 0o755)  # mkdtemp makes it 0700

@@ -99,8 +99,8 @@ def figure(energy, styles, path):
             ax.plot(t[loss & idx] / period, -e[loss & idx], linestyle="none", marker=st["marker"], color=st["color"],
                     markerfacecolor="white", markersize=4.5)
             seen.setdefault(method, Line2D([], [], color=st["color"], marker=st["marker"]))
-        ax.set_xscale("log")
-        ax.set_yscale("log")
+        figures.log_scale(ax, "x")
+        figures.log_scale(ax, "y")
         ax.set_ylim(lo, hi)
         ax.set_xlabel("time [periods]")
         ax.set_ylabel("|E - E0| / |E0|")

@@ -119,7 +119,7 @@ def figure(loop, styles, path):
                             ("-", "--", ":", "-.")[k % 4], marker=RATE_MARKERS[k % len(RATE_MARKERS)], markersize=5,
                             linewidth=1.1)
             ax.axhline(target, color="grey", linewidth=0.8, linestyle=":")
-            ax.set_yscale("log")
+            figures.log_scale(ax, "y")
             ax.set_ylim(lo, hi)
             ax.set_xticks(loop.display_rates)
             ax.set_xticklabels([f"{x:g}" for x in loop.display_rates], fontsize=8)

@@ -1,8 +1,10 @@
 """A small document model written out as Markdown (REPORT.md, --markdown, --readme)
-and as index.html through python3-markdown (inline CSS, images beside it in fig/ or
-inlined, no network). A table whose cells carry their own HTML (Cell) or a class is
-written into the HTML as an HTML table (python3-markdown passes a raw HTML block
-through as it is), and into the Markdown as a Markdown table of the cells' text."""
+and as a small site through python3-markdown (inline CSS, images beside it in fig/ or
+inlined, no network): what comes before the first page() is index.html, each page() a
+page of its own (REPORT.md is the whole document, in the same order). A table whose
+cells carry their own HTML (Cell) or a class is written into the HTML as an HTML table
+(python3-markdown passes a raw HTML block through as it is), and into the Markdown as a
+Markdown table of the cells' text."""
 import base64
 import html
 import os
@@ -67,6 +69,24 @@ class Doc:
     def toc(self):
         """Where the contents go in index.html (REPORT.md has none: its viewer lists the headings)."""
         self.blocks.append(("toc",))
+
+    def page(self, path, title=None):
+        """What follows, up to the next page(), is the page `path` of the site (relative to
+        its folder: `problems/pendulum.html`), titled `title` or, without one, by its first
+        second-level heading (which the page shows as its title). REPORT.md runs on."""
+        self.blocks.append(("page", path, title))
+
+    def pages(self):
+        """[(path, Doc)]: index.html (what comes before the first page()), then each page."""
+        out = [("index.html", Doc(self.title))]
+        for b in self.blocks:
+            if b[0] == "page":
+                out.append((b[1], Doc(b[2])))
+            elif out[-1][1].title is None and b[0] == "h" and b[1] == 2:
+                out[-1][1].title = b[2]
+            else:
+                out[-1][1].blocks.append(b)
+        return out
 
 
 def _inline(text):
@@ -143,6 +163,7 @@ h1 { font-size: 1.4em; margin: 0.2em 0 0.1em; }
 h1 + p { margin: 0 0 0.3em; color: #555; font-size: 0.88em; }
 h2 { border-bottom: 2px solid #ddd; padding-bottom: 0.15em; margin-top: 1.8em; font-size: 1.3em; }
 h1 + p + h2 { margin-top: 0.4em; font-size: 1.1em; }
+h1 + h2 { margin-top: 0.5em; }
 h3 { margin-top: 1.5em; font-size: 1.1em; }
 p, ul, blockquote { max-width: 78em; }
 table { border-collapse: collapse; margin: 0.5em 0 1.1em; font-size: 0.88em; max-width: 100%; }
@@ -155,6 +176,14 @@ table.verdict, table.frames { width: 100%; table-layout: fixed; font-size: 12px;
                                margin: 0.3em 0; }
 table.verdict th:first-child, table.frames th:first-child { width: 11.5em; }
 table.verdict td, table.frames td { padding: 0.15em 0.35em; }
+table.answer { width: 100%; table-layout: fixed; font-size: 13px; line-height: 1.3; margin: 0.3em 0 0.6em; }
+table.answer th:first-child { width: 34%; }
+table.answer th:last-child { width: 14%; }
+table.answer td { padding: 0.2em 0.4em; }
+table.answer td:last-child, table.answer .small { font-size: 11px; }
+table.answer td.none { color: #999; }
+p.lead { margin: 0.3em 0 0.2em; }
+p.nav { margin: 0.6em 0 0; font-size: 0.88em; }
 table.verdict td.ahead { background: #e4f3e0; }
 table.verdict td.behind { background: #fbe4e1; }
 table.verdict td.within { background: #efefef; color: #555; }
@@ -172,11 +201,31 @@ code { font-family: "DejaVu Sans Mono", monospace; font-size: 0.92em; }
 """
 
 
-def to_html(doc, figdir=None):
-    """index.html: the document converted by python3-markdown (its tables, its toc
-    extension for the heading ids and the contents, second-level headings, and md_in_html
-    for the folded parts). `figdir`:
-    the folder holding the figures, to inline each as a data: URI (one file to send)."""
+def _from_folder(body, depth):
+    """The page's links and images, written relative to the site's folder, relative to a
+    page `depth` folders down."""
+    if not depth:
+        return body
+    up = "../" * depth
+    return re.sub(r'(href|src)="(?![a-z]+:|#|/)', lambda m: f'{m.group(1)}="{up}', body)
+
+
+def site(doc, figdir=None):
+    """{path: HTML} of every page of `doc` (Doc.pages), each with a line back to the index."""
+    out = {}
+    for path, page in doc.pages():
+        depth = path.count("/")
+        nav = "" if path == "index.html" else f'<p class="nav"><a href="index.html">{esc(doc.title)}</a></p>'
+        out[path] = to_html(page, figdir, depth=depth, nav=nav)
+    return out
+
+
+def to_html(doc, figdir=None, depth=0, nav=""):
+    """A page: the document converted by python3-markdown (its tables, its toc extension
+    for the heading ids and the contents, second-level headings, and md_in_html for the
+    folded parts). `figdir`: the folder holding the figures, to inline each as a data: URI;
+    `depth`: how many folders down the page lies (its links are written from the top);
+    `nav`: HTML above the title."""
     converter = md_lib.Markdown(extensions=["tables", "toc", "md_in_html"],
                                 extension_configs={"toc": {"toc_depth": "2-2", "title": "Contents"}})
     body = converter.convert(markdown(doc, for_html=True))
@@ -188,4 +237,4 @@ def to_html(doc, figdir=None):
     return "\n".join(["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
                       '<meta name="viewport" content="width=device-width, initial-scale=1">',
                       f"<title>{html.escape(doc.title)}</title>", f"<style>{CSS}</style></head><body>",
-                      body, "</body></html>"]) + "\n"
+                      _from_folder(nav + body, depth), "</body></html>"]) + "\n"

@@ -1,6 +1,8 @@
-"""The report: figures into <dir>/fig, the same document as REPORT.md and index.html,
-and the verdict as summary.json. It opens on the answer (verdict.opening), then one
-section per problem, the study-wide sections, and the study's metadata last."""
+"""The report: figures into <dir>/fig, one document written as REPORT.md and as a small
+site (index.html, a page per problem, a page per study-wide section, about.html), and
+the verdict as summary.json. The index opens on the answer: per frame at the chosen rate
+and tolerances (verdict.frame_answer), then at equal error (verdict.opening), a line per
+problem linking to its page; the study's metadata last."""
 import json
 import multiprocessing
 import os
@@ -48,8 +50,9 @@ def _figure_jobs(study, figdir, whole, scans=None):
     jobs = []
     for p in study.problems:
         jobs += [("wp", p.name, os.path.join(figdir, f"work_precision_{p.name}.png")),
-                 ("convergence", p.name, os.path.join(figdir, f"convergence_{p.name}.png")),
-                 ("energy", p.name, os.path.join(figdir, f"energy_drift_{p.name}.png"))]
+                 ("convergence", p.name, os.path.join(figdir, f"convergence_{p.name}.png"))]
+        if figures.energy_drifts(p):
+            jobs.append(("energy", p.name, os.path.join(figdir, f"energy_drift_{p.name}.png")))
     if not whole:
         return jobs
     if study.energy_runs is not None:
@@ -105,14 +108,20 @@ def _draw(job):
     return path
 
 
-def draw_figures(study, figdir, workers, names, whole=True, scans=None):
+def draw_figures(study, figdir, workers, names, whole=True, scans=None, meanwhile=lambda figures: None):
+    """Draws every figure (_figure_jobs) in `workers` processes; returns the paths drawn and
+    what meanwhile(the names of the figures asked for) returned: it runs while the workers
+    draw, where the main process would wait."""
     jobs = _figure_jobs(study, figdir, whole, scans)
+    asked = {os.path.basename(job[2]) for job in jobs}
     if workers <= 1:
         _init_worker(study, names, scans)
-        return [p for p in map(_draw, jobs) if p]
+        return [p for p in map(_draw, jobs) if p], meanwhile(asked)
     ex = ProcessPoolExecutor(max_workers=workers, initializer=_init_worker, initargs=(study, names, scans))
     try:
-        drawn = [p for p in ex.map(_draw, jobs) if p]
+        drawing = ex.map(_draw, jobs)
+        early = meanwhile(asked)
+        drawn = [p for p in drawing if p]
     except BaseException:
         # An interruption (SIGINT, or SIGTERM as cli.py raises it) can come before the
         # executor's manager thread has started, and then nothing tells the workers to stop:
@@ -123,7 +132,7 @@ def draw_figures(study, figdir, workers, names, whole=True, scans=None):
             worker.kill()  # not SIGTERM: the handler they inherited from cli.py would run in them
         raise
     ex.shutdown()
-    return drawn
+    return drawn, early
 
 
 def in_verdict_order(study):
@@ -142,10 +151,11 @@ def one_problem(study, name):
                    gaps=[g for g in study.gaps if g.startswith(f"{name}:")])
 
 
-def build(study, outdir, workers=2, problem=None, self_contained=False):
-    """Writes fig/*.png, REPORT.md, index.html and summary.json into outdir (which
-    exists): of the whole study, or of the one problem named. `self_contained`: the
-    figures inlined into index.html as well."""
+def build(study, outdir, workers=2, problem=None, self_contained=False, hz=None, targets=None):
+    """Writes fig/*.png, REPORT.md, the site (index.html, problems/*.html, a page per
+    study-wide section, about.html) and summary.json into outdir (which exists): of the
+    whole study, or of the one problem named. `self_contained`: the figures inlined into
+    the pages as well; `hz`, `targets`: the index's per-frame answer (verdict.frame_choice)."""
     names = figures.method_names(study)  # of the whole study: the same colours in a report of one problem
     study = in_verdict_order(study)
     whole = problem is None
@@ -158,12 +168,26 @@ def build(study, outdir, workers=2, problem=None, self_contained=False):
         names = scan_section.method_names(scans)
     figdir = os.path.join(outdir, "fig")
     os.makedirs(figdir, exist_ok=True)
-    made = set(os.path.basename(p) for p in draw_figures(study, figdir, workers, names, whole, scans))
-    doc = scan_file_document(study, made, scans) if study.scan_only else document(study, made, whole, scans)
+
+    def pages(figs):
+        """The document and its pages, with the figures `figs`."""
+        doc = scan_file_document(study, figs, scans) if study.scan_only else document(study, figs, whole, scans, hz,
+                                                                                      targets)
+        return doc, render.site(doc, figdir if self_contained else None)
+
+    # The pages are made while the figures are drawn (from the names asked for), and made again
+    # in the rare case a figure had nothing to draw. --self-contained reads the figures: after.
+    early_pages = (lambda asked: None) if self_contained else (lambda asked: (asked, pages(asked)))
+    drawn, early = draw_figures(study, figdir, workers, names, whole, scans, meanwhile=early_pages)
+    made = set(os.path.basename(p) for p in drawn)
+    doc, site = early[1] if early and early[0] == made else pages(made)
     with open(os.path.join(outdir, "REPORT.md"), "w") as f:
         f.write(render.markdown(doc))
-    with open(os.path.join(outdir, "index.html"), "w") as f:
-        f.write(render.to_html(doc, figdir if self_contained else None))
+    for page, text in site.items():
+        path = os.path.join(outdir, page)
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        with open(path, "w") as f:
+            f.write(text)
     summary = verdict_section.summary(study)
     if study.scan_only:
         summary["scans"] = scan_section.summary(scans)
@@ -197,27 +221,73 @@ def headline(study):
             f"{a['git_commit']}; build and machine in the appendix.{partial}")
 
 
-def document(study, figs, whole=True, scans=None):
+def scenes(study):
+    """{problem: its parameters as the study ran it}, the scene each answer is for."""
+    return {p.name: ", ".join(_parameter(q) for q in p.parameters) for p in study.problems}
+
+
+def _study_pages(study, figs, scans):
+    """[(page, Doc)] of the study-wide sections the file holds, each a page of the site, in the
+    order of its parts (a section draws nothing for a part the file lacks: no page)."""
+    out = []
+    for part in study_section_order(study):
+        section = render.Doc(part)
+        STUDY_SECTIONS[part](section, study, figs, scans)
+        if section.blocks:
+            out.append((f"{part}.html", section))
+    return out
+
+
+def _contents(doc, study, study_pages):
+    """The index's list of the site's pages: a line per problem (its verdict is the tables' row),
+    a line per study-wide section, the appendix."""
+    doc.h(2, "Pages")
+    doc.p("One page per problem (its work-precision figure first, then its tables): "
+          + ", ".join(f"[{p.name}]({verdict_section.page_of(p.name)})" for p in study.problems) + ".")
+    if study_pages:
+        doc.p("The study-wide sections: " + ", ".join(f"[{_first_heading(section)}]({page})"
+                                                        for page, section in study_pages) + ".")
+    doc.p(f"How the tables and figures are made, and the study's build and machine: [the appendix]({ABOUT}).")
+
+
+ABOUT = "about.html"
+
+
+def _first_heading(doc):
+    return next((b[2] for b in doc.blocks if b[0] == "h"), doc.title)
+
+
+def document(study, figs, whole=True, scans=None, hz=None, targets=None):
+    """The report as one document (REPORT.md) and a small site (render.site): the index opens on
+    the per-frame answer at `hz` and `targets` (verdict.frame_choice), then the equal-error
+    verdict, the frame rates and the findings, a list of the pages and the study's line; then a
+    page per problem, a page per study-wide section, and the appendix."""
     doc = render.Doc(TITLE)
-    doc.p(headline(study))
     if study.verdict is not None:
+        rate, shown = verdict_section.frame_choice(study.verdict, hz, targets)
+        verdict_section.frame_answer(doc, study.verdict, rate, shown, scenes(study))
         verdict_section.opening(doc, study.verdict)
     else:
         _absent(doc, study)
     for gap in study.gaps:
-        doc.note(f"Incomplete study file: {gap}. The tables below rank only what the file holds.")
+        doc.note(f"Incomplete study file: {gap}. The tables rank only what the file holds.")
     if not whole:
         doc.note(f"One problem only ({study.problems[0].name}): the study-wide sections (stability, small steps, "
                  "the pendulum challenge, energy over long runs, game loop) are in the report of the whole study.")
-    doc.toc()
+    study_pages = _study_pages(study, figs, scans) if whole else []
+    _contents(doc, study, study_pages)
+    if whole and study.attrs.get("parts") and (
+            skipped := [p for p in STUDY_SECTIONS if p not in study.attrs["parts"]]):
+        doc.note(f"Not in this study (it ran the parts {', '.join(study.attrs['parts'])}): "
+                 f"{', '.join(skipped)}; `stepbench list` names every part, `--parts` selects them.")
+    doc.p(headline(study), cls="small")
     for p in study.problems:
+        doc.page(verdict_section.page_of(p.name))
         _problem(doc, study, p, figs)
-    if whole:
-        if study.attrs.get("parts") and (skipped := [p for p in STUDY_SECTIONS if p not in study.attrs["parts"]]):
-            doc.note(f"Not in this study (it ran the parts {', '.join(study.attrs['parts'])}): "
-                     f"{', '.join(skipped)}; `stepbench list` names every part, `--parts` selects them.")
-        for part in study_section_order(study):
-            STUDY_SECTIONS[part](doc, study, figs, scans)  # each draws nothing for a part the file lacks
+    for page, section in study_pages:
+        doc.page(page)
+        doc.blocks += section.blocks
+    doc.page(ABOUT, "How the report is made, and the study")
     _how_made(doc, study)
     _metadata(doc, study)
     return doc
@@ -301,8 +371,14 @@ def _absent(doc, study):
 
 
 def _problem(doc, study, p, figs):
-    """Everything about one problem: the scene, its verdict, its figures and tables."""
+    """Everything about one problem (its page): its work-precision figure first (the legend
+    beside it), the scene in a line, its verdict, the figure's tables and the other figures."""
     doc.h(2, p.name)
+    primary = "time" if study.timed else "force_evals"
+    doc.h(3, f"{p.name}: work-precision")
+    name = f"work_precision_{p.name}.png"
+    if name in figs:
+        doc.img(f"fig/{name}", f"work-precision on {p.name}")
     pa = p.attrs
     truth = pa["truth_source"] if int(pa["truth_trusted"]) else f"none trusted: {pa['truth_note']}"
     params = ", ".join(_parameter(q) for q in p.parameters)
@@ -315,13 +391,6 @@ def _problem(doc, study, p, figs):
     if not int(pa["truth_trusted"]):
         doc.note(f"{p.name} has no trusted truth ({pa['truth_note']}): every error on it is NaN, every run is "
                  "marked failed, and it has no cheapest method or front.")
-    if study.verdict is not None:
-        verdict_section.problem_section(doc, study.verdict, p.name)
-    primary = "time" if study.timed else "force_evals"
-    doc.h(3, f"{p.name}: work-precision")
-    name = f"work_precision_{p.name}.png"
-    if name in figs:
-        doc.img(f"fig/{name}", f"work-precision on {p.name}")
     methods = tables.front_methods(p, primary)
     text = (f"Methods on the front by {'time' if study.timed else 'force evaluations'}: "
             + (", ".join(methods) if methods else "none") + ".")
@@ -329,7 +398,10 @@ def _problem(doc, study, p, figs):
         by_evals = tables.front_methods(p, "force_evals")
         text += " By force evaluations: " + (", ".join(by_evals) if by_evals else "none") + "."
     doc.p(text)
+    if study.verdict is not None:
+        verdict_section.problem_section(doc, study.verdict, p.name)
     doc.fold(f"{p.name}: every method of the figure, the front run by run, the adaptive methods")
+    doc.h(4, f"{p.name}: every method of the work-precision figure")
     doc.table(*tables.method_rows(p, figures.work_curves(p, primary, study.timed), figures.labelled(p, primary),
                                   primary))
     doc.h(4, f"{p.name}: Pareto front")

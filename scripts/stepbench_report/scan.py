@@ -672,7 +672,7 @@ def one_step_figure(scan, stability, mass, path):
                     ax.plot([x_edges[-1] if right else x_edges[0]], [k], marker=">" if right else "<",
                             color="#e8003a", markersize=7, clip_on=False, zorder=5)
         if scan.log[0]:
-            ax.set_xscale("log")
+            figures.log_scale(ax, "x")
         ax.set_xlim(x_edges[0], x_edges[-1])
         ax.set_ylim(len(methods) - 0.5, -0.5)
         ax.set_yticks(range(len(methods)))
@@ -772,9 +772,9 @@ def maps_figure(scan, hz, path):
         for i, j in zip(*np.nonzero(np.isin(st, tuple(HATCHED)))):
             _hatched_cell(ax, x_edges[i], x_edges[i + 1], y_edges[j], y_edges[j + 1], st[i, j])
         if scan.log[0]:
-            ax.set_xscale("log")
+            figures.log_scale(ax, "x")
         if scan.log[1]:
-            ax.set_yscale("log")
+            figures.log_scale(ax, "y")
         ax.set_xlim(x_edges[0], x_edges[-1])
         ax.set_ylim(y_edges[0], y_edges[-1])
         _value_ticks(ax.xaxis, scan.values[0])
@@ -879,12 +879,12 @@ def best_figure(scan, styles, path):
                             color=ink, bbox=dict(facecolor=HATCHED[st][0], edgecolor="none", pad=0.6)
                             if st in HATCHED else None)
             if scan.log[1]:
-                ax.set_yscale("log")
+                figures.log_scale(ax, "y")
             ax.set_ylim(y_edges[0], y_edges[-1])
             ax.set_ylabel(scan.axes[1])
             ax.set_title(f"{hz:g} Hz")
         if scan.log[0]:
-            ax.set_xscale("log")
+            figures.log_scale(ax, "x")
         ax.set_xlim(x_edges[0], x_edges[-1])
         ax.set_xlabel(scan.axes[0])
         ax.grid(False)

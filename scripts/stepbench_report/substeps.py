@@ -174,8 +174,8 @@ def _panel(ax, s, kind, styles, handles, figures):
     band = 0.07 * len(diverging)
     if band:
         hi = hi * (hi / lo) ** (band / (1 - band))
-    ax.set_xscale("log")
-    ax.set_yscale("log")
+    figures.log_scale(ax, "x")
+    figures.log_scale(ax, "y")
     ax.set_ylim(lo, hi)
     if costs:
         ax.set_xlim(min(costs) / 1.6, max(costs) * 1.6)

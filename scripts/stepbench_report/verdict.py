@@ -158,7 +158,7 @@ def problem_cell(verdict, problem):
     best = verdict.equal(problem, verdict.targets[0])
     best_error = float(best["best_error"]) if best is not None else float("nan")
     unit = verdict.unit(problem)
-    return Cell(f"{problem} [{unit}]", f'<a href="#{esc(problem)}">{esc(problem)}</a> [{esc(unit)}]'
+    return Cell(f"{problem} [{unit}]", f'<a href="{esc(page_of(problem))}">{esc(problem)}</a> [{esc(unit)}]'
                 f'<br><span class="small">best {esc(fmt_sci(best_error))}</span>')
 
 
@@ -225,8 +225,100 @@ def frame_cost_text(kind, row):
 
 # --- the opening of the report -------------------------------------------------------------------
 
+# The game programmer's question as the index asks it by default (scripts/report --hz, --tol):
+# a frame at 60 Hz, within 1 cm, 1 mm and 0.1 mm (the README's, `stepbench summary`'s).
+FRAME_HZ = 60.0
+FRAME_TARGETS = (1e-2, 1e-3, 1e-4)
+# A target in plain words, for the problems in metres (the angles' in rad read the same way: 1 mrad).
+METRES = {-2: "1 cm", -3: "1 mm", -4: "0.1 mm", -5: "10 um", -6: "1 um"}
+
+
+class ChoiceError(ValueError):
+    """A --hz or --tol the study's verdict does not hold; its text names what it holds."""
+
+
+def held(wanted, have, what, flag, text):
+    """The values of `have` (the study's rates or targets) equal to each of `wanted`, in the
+    order asked; ChoiceError naming what the study has when one is not there. `text`: a
+    value as the message writes it."""
+    out = []
+    for w in wanted:
+        match = next((h for h in have if math.isclose(h, w, rel_tol=1e-9)), None)
+        if match is None:
+            raise ChoiceError(f"{flag} {text(w)}: the study holds per-frame answers at the {what} "
+                              f"{', '.join(text(h) for h in have)} only")
+        out.append(match)
+    return out
+
+
+def frame_choice(verdict, hz=None, targets=None):
+    """(rate, targets) the index answers: those asked (ChoiceError when the study lacks one),
+    else 60 Hz and 1e-2, 1e-3, 1e-4 where the study has them (else its first rate, and its
+    first three targets)."""
+    rate = held([hz], verdict.frame_hz, "rates", "--hz", lambda h: f"{h:g}")[0] if hz is not None else next(
+        (h for h in verdict.frame_hz if math.isclose(h, FRAME_HZ)), verdict.frame_hz[0])
+    if targets:
+        return rate, held(targets, verdict.targets, "targets", "--tol", target_text)
+    default = [t for t in verdict.targets if any(math.isclose(t, d, rel_tol=1e-9) for d in FRAME_TARGETS)]
+    return rate, default or verdict.targets[:3]
+
+
+def target_words(t):
+    """1e-3 as a reader says it: "1 mm"; the plain number where no short word fits."""
+    return METRES.get(round(math.log10(t)), target_text(t)) if math.isclose(
+        10 ** round(math.log10(t)), t, rel_tol=1e-9) else target_text(t)
+
+
+def answer_cell(kind, row):
+    """One (problem, rate, target) of the per-frame answer: method x substeps, its cost a
+    frame; under it the error it keeps (the study's `frame_answer` row, as stored)."""
+    if row is None:
+        return Cell("-", "&ndash;", "none")
+    if not row["method"]:
+        return Cell("none within 64 substeps", '<span class="small">none within 64 substeps</span>', "none")
+    method, n = row["method"], int(row["substeps"])
+    cost = cost_text(kind, float(row["cost_per_frame"]))
+    error = fmt_sci(float(row["err_pos_max"]))
+    return Cell(f"{method} x{n}, {cost} a frame (error {error})",
+                f"<b>{esc(method)}</b> x{n} &middot; {esc(cost)}"
+                f'<br><span class="small">error {esc(error)}</span>')
+
+
+def page_of(problem):
+    """A problem's page in the report's folder."""
+    return f"problems/{problem}.html"
+
+
+def scene_cell(problem, unit, scene):
+    """The problem's name, linked to its page, and its scene as the study ran it."""
+    return Cell(f"{problem} [{unit}]", f'<a href="{esc(page_of(problem))}">{esc(problem)}</a> [{esc(unit)}]'
+                f'<br><span class="small">{esc(scene)}</span>')
+
+
+def frame_answer(doc, verdict, hz, targets, scenes):
+    """The index's first table: per problem, at `hz`, the cheapest of our methods and substeps a
+    frame within each of `targets`, and its cost a frame. `scenes`: {problem: its parameters as
+    run}."""
+    kind = verdict.cost_kind
+    words = ", ".join(f"{target_text(t)} ({target_words(t)})" for t in targets)
+    doc.h(2, f"At {hz:g} Hz: which method, how many substeps, what a frame costs")
+    doc.p(f"At {hz:g} frames a second, within {words} of the truth: the cheapest of our fixed-step methods, "
+          "how many substeps a frame it takes (x n) and what a frame costs "
+          + ("(the benchmark's median time a step on the scene, times the steps of a frame)" if kind == "time_ns"
+             else "(force evaluations: this study is untimed)")
+          + "; under it, the error it keeps: the worst body's largest position error over the run, in the "
+          "problem's unit (rad for the angles: 1e-3 is 1 mrad).", cls="lead")
+    head = ["problem [unit], scene as run"] + [f"{target_text(t)} ({target_words(t)})" for t in targets] \
+        + ["stable at one step a frame"]
+    rows = [[scene_cell(p, verdict.unit(p), scenes.get(p, ""))]
+            + [answer_cell(kind, verdict.answer(p, hz, t)) for t in targets]
+            + [stable_text(verdict.rates(p, hz), shorten=False)] for p in verdict.problems]
+    doc.table(head, rows, cls="answer")
+
+
 def opening(doc, verdict):
-    """The two tables and the findings the report opens on."""
+    """The equal-error table, the frame-rate table and the findings (the index has the
+    per-frame answer, frame_answer, above them)."""
     kind = verdict.cost_kind
     by = "measured time" if kind == "time_ns" else "counted force evaluations"
     doc.h(2, "Fastest at equal error")

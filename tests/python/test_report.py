@@ -11,6 +11,7 @@ import os
 import re
 import shutil
 import subprocess
+from html.parser import HTMLParser
 
 import h5py
 import numpy as np
@@ -23,11 +24,15 @@ with open(os.path.join(ROOT, "scripts", "stepbench_report", "schema.json")) as _
 METRIC_TITLES = {"err_pos_final": "by final error", "err_pos_max": "by max error over the run"}
 
 
-def run_report(study, out, jobs=2, cwd=None):
+def run_report(study, out, jobs=2, cwd=None, extra=()):
     """scripts/report of `study` into `out`; two figure processes, as the report's own
-    default on two cores: most of a whole report's 20 s is its figures."""
-    return subprocess.run([PYTHON, REPORT, str(study), "--out", str(out), "--jobs", str(jobs)], capture_output=True,
-                          text=True, cwd=cwd, timeout=120)
+    default on two cores: most of a whole report's 20 s is its figures (a test that reads
+    what does not depend on them draws the report of one problem: `extra`)."""
+    return subprocess.run([PYTHON, REPORT, str(study), "--out", str(out), "--jobs", str(jobs), *extra],
+                          capture_output=True, text=True, cwd=cwd, timeout=120)
+
+
+ONE_PROBLEM = ("--problem", "pendulum")  # three figures, not a whole study's
 
 
 # --- reading the outputs ----------------------------------------------------------------------
@@ -54,6 +59,11 @@ def report_text(folder):
     return (folder / "REPORT.md").read_text()
 
 
+def site_pages(folder):
+    """{path in the folder: HTML} of every page of the report's site."""
+    return {str(p.relative_to(folder)): p.read_text() for p in sorted(folder.rglob("*.html"))}
+
+
 def text(v):
     return v.decode() if isinstance(v, bytes) else v
 
@@ -74,19 +84,19 @@ def snapshot(folder):
 def test_outputs_exist_and_images_resolve(reports, shape):
     study, folder = reports[shape]
     md = report_text(folder)
-    html = (folder / "index.html").read_text()
-    assert len(md) > 1000 and len(html) > 1000
+    pages = site_pages(folder)
+    html = "\n".join(pages.values())
+    assert len(md) > 1000 and len(pages["index.html"]) > 1000
     images = re.findall(r"!\[[^\]]*\]\((fig/[^)]+\.png)\)", md)
     for img in images:
         path = folder / img
         assert path.is_file() and path.stat().st_size > 10_000, img
-        assert f'src="{img}"' in html, img
+        assert f'src="{img}"' in html or f'src="../{img}"' in html, img
     assert sorted(os.listdir(folder / "fig")) == sorted(os.path.basename(i) for i in images)
     # Opens offline: nothing is fetched from the network.
     assert not re.search(r"(src|href)=\"(https?:)?//", html)
-    # The tables are HTML tables, and the contents link to the sections, a section a problem.
+    # The tables are HTML tables (REPORT.md holds every page's), and the index links to a page a problem.
     assert html.count("<table") == md.count("\n|---")
-    assert '<a href="#fastest-at-equal-error">' in html
     with h5py.File(study, "r") as f:
         problems = list(f["problems"])
         energy = {p for p in problems if f["problems"][p].attrs["has_energy"] == 1}
@@ -100,7 +110,8 @@ def test_outputs_exist_and_images_resolve(reports, shape):
         challenge = {"pendulum_challenge.png"} if "challenge" in f else set()  # a full sweep of n_pendulum
     assert "kepler" in problems and "bouncing_balls" in problems
     for p in problems:
-        assert f'<a href="#{p}">' in html, p
+        assert f'<a href="problems/{p}.html">' in pages["index.html"], p
+        assert f'problems/{p}.html' in pages
     # One work-precision and one convergence figure a problem, the energy drift where
     # the problem has an energy, then the study-wide figures.
     expected = {f"convergence_{p}.png" for p in problems} | {f"work_precision_{p}.png" for p in problems} | {
@@ -415,14 +426,16 @@ def param_value(cell_text):
 
 
 @pytest.mark.parametrize("shape", ["plain", "timed"])
-def test_the_report_opens_on_the_verdict(reports, shape):
-    """The first table of index.html is the verdict table, before any figure; the
-    build metadata come after every problem."""
+def test_the_report_opens_on_the_answer(reports, shape):
+    """index.html: the per-frame answer, the verdict table, the frame-rate table, and no
+    figure (they are on the problems' pages); the build metadata on the appendix's page."""
     _, folder = reports[shape]
     page = (folder / "index.html").read_text()
-    assert page.index('<table class="verdict">') == page.index("<table")
-    assert page.index('<table class="verdict">') < page.index("<img")
-    assert page.index('<table class="frames">') < page.index("<img")
+    assert page.index('<table class="answer">') == page.index("<table")
+    assert page.index('<table class="answer">') < page.index('<table class="verdict">') < \
+        page.index('<table class="frames">')
+    assert "<img" not in page
+    assert "Build and machine" in (folder / "about.html").read_text()
 
 
 @pytest.mark.parametrize("shape", ["plain", "timed"])
@@ -554,7 +567,7 @@ def test_work_precision_labels_the_front_and_the_lecture(reports, shape):
     front = "front_time" if shape == "timed" else "front_force_evals"
     with h5py.File(study, "r") as f:
         for pname, g in f["problems"].items():
-            table = md_dict(md, f"### {pname}: work-precision")
+            table = md_dict(md, f"#### {pname}: every method of the work-precision figure")
             methods = {label(n, text(m.attrs["origin"])): n for n, m in g["methods"].items()}
             assert set(table) == set(methods), pname
             on_front = {text(m) for m in g[front]["method"]}
@@ -594,8 +607,9 @@ def test_one_problem(reports, tmp_path):
     assert [r[0] for r in rows] == ["pendulum [rad]"]
     assert sorted(os.listdir(out / "fig")) == ["convergence_pendulum.png", "energy_drift_pendulum.png",
                                                "work_precision_pendulum.png"]
-    page = (out / "index.html").read_text()
-    assert 'src="fig/' not in page and page.count('src="data:image/png;base64,') == 3
+    assert sorted(site_pages(out)) == ["about.html", "index.html", "problems/pendulum.html"]
+    page = (out / "problems" / "pendulum.html").read_text()
+    assert 'src="../fig/' not in page and page.count('src="data:image/png;base64,') == 3
     summary = json.loads((out / "summary.json").read_text())
     assert {r["problem"] for r in summary["verdict"]["equal_error"]} == {"pendulum"}
 
@@ -731,7 +745,7 @@ def test_a_format_3_study_is_read(small_study, tmp_path):
             g.create_dataset("equal_error", data=new)
         f.attrs["format_version"] = 3
     edit(small_study, old, change)
-    p = run_report(old, tmp_path / "report")
+    p = run_report(old, tmp_path / "report", extra=ONE_PROBLEM)
     assert p.returncode == 0, p.stderr
     assert "has no /verdict group" in report_text(tmp_path / "report")
 
@@ -847,7 +861,7 @@ def test_an_incomplete_study_is_reported_as_such(small_study, tmp_path):
             f.create_dataset(f"problems/pendulum/{table}", data=rows[rows["method"].astype(str) != "odeint_rk4"])
     edit(small_study, cut, change)
     out = tmp_path / "report"
-    p = run_report(cut, out)
+    p = run_report(cut, out, extra=ONE_PROBLEM)  # the warnings name the whole file's gaps
     assert p.returncode == 0, p.stderr
     assert "warning: incomplete study file: pendulum: no runs for odeint_rk4" in p.stderr
     assert "warning: incomplete study file: damped_spring: no reference solutions" in p.stderr
@@ -870,10 +884,159 @@ def test_never_replaces_a_folder_it_did_not_write(reports, small_study, tmp_path
         assert sorted(os.listdir(precious)) == ["notes.txt"]
     report = tmp_path / "report"
     shutil.copytree(reports["timed"][1], report)  # a report this script wrote
-    p = run_report(small_study, report)
+    p = run_report(small_study, report, extra=ONE_PROBLEM)
     assert p.returncode == 0, p.stderr
     assert (report / ".stepbench-report").exists() and "Timings: absent" in report_text(report)
     assert sorted(os.listdir(tmp_path)) == ["report", "results"]  # no temporary folder left
+
+
+# --- the site: index.html answers a frame first, a page per problem -------------------------------
+# The index opens on the per-frame answer at the chosen rate and tolerances (1e-3 among them
+# by default), then the equal-error verdict, each problem's name linking to its page; --hz
+# and --tol set the first table, and a value the study does not hold is one line naming what
+# it holds, exit 2, nothing written. The reports are conftest.py's where the flags are the
+# defaults; the others are of one problem (three figures).
+
+class Outline(HTMLParser):
+    """A page's headings and tables in order (("h2", text) and ("table", class)), its
+    links, and the text of its first table's header and first column."""
+
+    def __init__(self):
+        super().__init__()
+        self.order, self.links, self.head, self.first_column = [], [], [], []
+        self._in, self._tables, self._text, self._cell = None, 0, "", 0
+
+    def handle_starttag(self, tag, attrs):
+        a = dict(attrs)
+        if tag in ("h1", "h2", "h3"):
+            self._in, self._text = tag, ""
+        elif tag == "table":
+            self._tables += 1
+            self.order.append(("table", a.get("class", "")))
+        elif tag == "a" and "href" in a:
+            self.links.append(a["href"])
+        elif tag in ("th", "td") and self._tables == 1:
+            self._in, self._text = tag, ""
+        elif tag == "tr":
+            self._cell = 0
+
+    def handle_data(self, data):
+        if self._in:
+            self._text += data
+
+    def handle_endtag(self, tag):
+        if tag != self._in:
+            return
+        if tag in ("h1", "h2", "h3"):
+            self.order.append((tag, self._text.strip()))
+        elif tag == "th":
+            self.head.append(self._text.strip())
+        elif tag == "td":
+            if self._cell == 0:
+                self.first_column.append(self._text.strip())
+            self._cell += 1
+        self._in = None
+
+
+def outline(path):
+    o = Outline()
+    o.feed(path.read_text())
+    return o
+
+
+def frame_answers_of(study):
+    with h5py.File(study, "r") as f:
+        return f["verdict/frame_answer"][()], f["verdict"].attrs["frame_hz"], f["verdict"].attrs["targets"]
+
+
+@pytest.mark.parametrize("shape", ["plain", "timed"])
+def test_the_index_opens_on_the_answer_a_frame(reports, shape):
+    """Title, then the per-frame answer (a 1e-3 column by default), then the equal-error
+    verdict, before anything else; no figure on the index."""
+    _, folder = reports[shape]
+    o = outline(folder / "index.html")
+    assert o.order[0][0] == "h1"
+    assert o.order[1] == ("h2", "At 60 Hz: which method, how many substeps, what a frame costs")
+    assert o.order[2] == ("table", "answer")
+    assert o.order[3] == ("h2", "Fastest at equal error") and o.order[4] == ("table", "verdict")
+    assert [h.split(" ")[0] for h in o.head[1:4]] == ["1e-2", "1e-3", "1e-4"]
+    assert "<img" not in (folder / "index.html").read_text()
+
+
+@pytest.mark.parametrize("shape", ["plain", "timed"])
+def test_the_answer_is_the_files(reports, shape):
+    """Each cell is /verdict/frame_answer's row at 60 Hz: method, substeps, error."""
+    study, folder = reports[shape]
+    fa, _, _ = frame_answers_of(study)
+    page = (folder / "index.html").read_text()
+    table = page[page.index('<table class="answer">'):]
+    table = table[:table.index("</table>")]
+    rows = re.findall(r"<tr>(.*?)</tr>", table, re.S)[1:]
+    names = [re.search(r'<a href="problems/(\w+)\.html">', r).group(1) for r in rows]
+    assert names and len(names) == len(set(fa["problem"]))
+    for name, row in zip(names, rows):
+        cells = re.findall(r"<td[^>]*>(.*?)</td>", row, re.S)[1:4]
+        for t, cell in zip((1e-2, 1e-3, 1e-4), cells):
+            a = fa[(fa["problem"].astype(str) == name) & (fa["hz"] == 60) & np.isclose(fa["target"], t)][0]
+            method = a["method"].decode() if isinstance(a["method"], bytes) else a["method"]
+            if method:
+                assert cell.startswith(f"<b>{method}</b> x{int(a['substeps'])} "), (name, t, cell)
+                error = float(re.search(r"error ([0-9.e+-]+)", cell).group(1))
+                assert error == pytest.approx(a["err_pos_max"], rel=0.06), (name, t, cell)
+            else:
+                assert "none within 64 substeps" in cell, (name, t, cell)
+
+
+def test_every_link_resolves(reports):
+    """The index's problem names link to their pages, and every page's links and images
+    resolve inside the folder."""
+    study, folder = reports["timed"]
+    with h5py.File(study, "r") as f:
+        problems = set(f["problems"])
+    index = outline(folder / "index.html")
+    assert {f"problems/{p}.html" for p in problems} <= set(index.links)
+    for page in folder.rglob("*.html"):
+        text = page.read_text()
+        for target in re.findall(r'(?:href|src)="([^"#]+)"', text):
+            assert (page.parent / target).resolve().is_file(), (page.name, target)
+    pendulum = outline(folder / "problems" / "pendulum.html")
+    assert pendulum.order[0] == ("h1", "pendulum")
+    # The work-precision figure first, then the tables.
+    text = (folder / "problems" / "pendulum.html").read_text()
+    assert text.index('src="../fig/work_precision_pendulum.png"') < text.index("<table")
+
+
+def test_hz_and_tol_set_the_first_table(plain_study, tmp_path):
+    out = tmp_path / "r"
+    _, rates, _ = frame_answers_of(plain_study)
+    hz = next(h for h in rates if h != 60)
+    p = run_report(plain_study, out, extra=("--problem", "pendulum", "--hz", f"{hz:g}", "--tol", "1e-5,1e-3",
+                                             "--tol", "1e-7"))
+    assert p.returncode == 0, p.stderr
+    o = outline(out / "index.html")
+    assert o.order[1] == ("h2", f"At {hz:g} Hz: which method, how many substeps, what a frame costs")
+    assert [h.split(" ")[0] for h in o.head[1:4]] == ["1e-5", "1e-3", "1e-7"]
+    assert o.first_column[0].startswith("pendulum [rad]")
+
+
+@pytest.mark.parametrize("args, needle", [
+    (["--hz", "144"], "--hz 144: the study holds per-frame answers at the rates 30, 60, 120, 240 only"),
+    (["--tol", "3e-3"], "--tol 3e-3: the study holds per-frame answers at the targets 1e-2, 1e-3, 1e-4,"),
+    (["--tol", "1e-3,abc"], "--tol: must be positive numbers"),
+    (["--hz", "-60"], "--hz: must be a positive rate")])
+def test_a_bad_hz_or_tol_is_one_line(plain_study, tmp_path, args, needle):
+    out = tmp_path / "r"
+    out.mkdir()
+    (out / ".stepbench-report").write_text("")
+    (out / "index.html").write_text("old")
+    p = run_report(plain_study, out, extra=args)
+    assert p.returncode == 2, p.stderr
+    assert needle in p.stderr.splitlines()[-1]
+    if "study holds" in needle:
+        assert len(p.stderr.splitlines()) == 1 and p.stdout == ""
+    assert sorted(x.name for x in out.iterdir()) == [".stepbench-report", "index.html"]
+    assert (out / "index.html").read_text() == "old"
+    assert [x for x in tmp_path.iterdir() if x.name != "r"] == []
 
 
 # --- stepbench advise -------------------------------------------------------------------------

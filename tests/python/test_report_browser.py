@@ -1,6 +1,8 @@
-"""The report as a reader meets it: index.html rendered by headless Chromium in a
-1400 x 900 window. The first screen holds the whole verdict table, every image loads,
-and no table, folded or not (and so the page), is wider than the window. A copy of
+"""The report as a reader meets it: index.html and a problem's page rendered by headless
+Chromium in a 1400 x 900 window. The index's first screen opens on the per-frame answer,
+the equal-error verdict right under it; the index is at most 10 screens tall (9000 px);
+every image of a problem's page loads, and no table, folded or not (and so no page), is
+wider than the window. A copy of
 index.html beside it carries a script that measures the page once everything has
 loaded and writes the measurements into the DOM, which Chromium dumps (--dump-dom).
 
@@ -22,10 +24,13 @@ MEASURE = """
 window.addEventListener("load", function () {
   var page = document.documentElement.clientWidth;
   var verdict = document.querySelector("table.verdict");
+  var answer = document.querySelector("table.answer");
   var out = {
     page: page, inner: [window.innerWidth, window.innerHeight],
     scroll_width: document.documentElement.scrollWidth,
+    height: document.documentElement.scrollHeight,
     verdict: verdict ? verdict.getBoundingClientRect().toJSON() : null,
+    answer: answer ? answer.getBoundingClientRect().toJSON() : null,
     images: [], tables: []
   };
   // The folded tables too: open every <details> before measuring the tables.
@@ -63,53 +68,60 @@ def measure(index):
 
 
 @pytest.fixture(scope="module")
-def pages(plain_study, timed_study, tmp_path_factory, request):
-    """The measurements of the report of each study, the timed one with its figures
-    inlined (--self-contained), and of a report of one problem. The plain study's is
-    conftest.py's report, drawn once a session (measured in a copy: measure writes beside
-    index.html)."""
+def pages(plain_study, tmp_path_factory, request):
+    """The measurements of the index and of pendulum's page of the report of each study
+    (conftest.py's, drawn once a session, measured in a copy: measure writes beside the
+    page), and of a report of one problem with its figures inlined (--self-contained)."""
     if CHROMIUM is None:
         pytest.skip("Chromium is not installed (scripts/install-deps.sh installs it)")
     d = tmp_path_factory.mktemp("browser")
-    out = {}
-    plain = d / "plain"
-    shutil.copytree(request.getfixturevalue("reports")["plain"][1], plain)
-    out["plain"] = measure(plain / "index.html")
-    for shape, study, extra in (("timed", timed_study[0], ["--self-contained"]),
-                                ("one problem", plain_study, ["--problem", "pendulum"])):
-        folder = d / shape.replace(" ", "_")
-        p = subprocess.run([PYTHON, REPORT, str(study), "--out", str(folder), "--jobs", "2"] + extra,
-                           capture_output=True, text=True, timeout=300)
-        assert p.returncode == 0, p.stderr
-        out[shape] = measure(folder / "index.html")
-    return out
+    folders = {}
+    for shape in ("plain", "timed"):
+        folders[shape] = d / shape
+        shutil.copytree(request.getfixturevalue("reports")[shape][1], folders[shape])
+    folders["one problem"] = d / "one_problem"
+    p = subprocess.run([PYTHON, REPORT, str(plain_study), "--out", str(folders["one problem"]), "--jobs", "1",
+                        "--problem", "pendulum", "--self-contained"], capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    return {shape: {"index": measure(folder / "index.html"), "problem": measure(folder / "problems" / "pendulum.html")}
+            for shape, folder in folders.items()}
 
 
-@pytest.mark.parametrize("shape", ["plain", "timed", "one problem"])
-def test_the_first_screen_holds_the_verdict_table(pages, shape):
-    m = pages[shape]
+SHAPES = ["plain", "timed", "one problem"]
+
+
+@pytest.mark.parametrize("shape", SHAPES)
+def test_the_first_screen_opens_on_the_answer_a_frame(pages, shape):
+    m = pages[shape]["index"]
     # The layout depends on the width alone; Chromium's headless window keeps some of
     # its height for itself (a viewport of 813 px in a 900 px window), so the fold is
     # measured against the screen's height, from the top of the page.
     assert m["inner"][0] == WIDTH, m["inner"]
-    v = m["verdict"]
-    assert v is not None, "no table.verdict"
-    assert 0 <= v["top"] and v["bottom"] <= HEIGHT, v
+    a, v = m["answer"], m["verdict"]
+    assert a is not None and v is not None, "no table.answer or table.verdict"
+    assert 0 <= a["top"] < HEIGHT / 4 and a["right"] <= m["page"] + 0.5, a
+    assert a["bottom"] <= v["top"], (a, v)
     assert v["right"] <= m["page"] + 0.5, v
 
 
-@pytest.mark.parametrize("shape", ["plain", "timed", "one problem"])
+@pytest.mark.parametrize("shape", SHAPES)
+def test_the_index_fits_in_ten_screens(pages, shape):
+    assert pages[shape]["index"]["height"] <= 10 * HEIGHT
+
+
+@pytest.mark.parametrize("shape", SHAPES)
 def test_every_image_loads(pages, shape):
-    images = pages[shape]["images"]
+    images = pages[shape]["problem"]["images"]
     assert len(images) >= 3
     assert [i["src"] for i in images if not i["ok"]] == []
-    if shape == "timed":  # --self-contained: the figures are in the page
+    if shape == "one problem":  # --self-contained: the figures are in the page
         assert all(i["src"].startswith("data:image/png;base64,") for i in images)
 
 
-@pytest.mark.parametrize("shape", ["plain", "timed", "one problem"])
-def test_no_table_is_wider_than_the_page(pages, shape):
-    m = pages[shape]
+@pytest.mark.parametrize("shape", SHAPES)
+@pytest.mark.parametrize("page", ["index", "problem"])
+def test_no_table_is_wider_than_the_page(pages, shape, page):
+    m = pages[shape][page]
     wide = [t for t in m["tables"] if t["scroll_width"] > m["page"] or t["right"] > m["page"] + 0.5]
     assert wide == [], wide
     assert m["scroll_width"] <= m["page"], "the page scrolls sideways"

@@ -133,7 +133,8 @@ def verdicts(study, criterion):
 
 def test_the_section_opens_on_the_verdicts(challenge_report):
     """The section's first lines are the accuracy, stability and speed lines as stepbench
-    wrote them, in index.html too; the Small Steps lines follow under their heading."""
+    wrote them, on its page too (challenge.html, the section's heading its title); the Small
+    Steps lines follow under their heading."""
     study, folder = challenge_report
     md = report_text(folder)
     answer = [line for c in ("accuracy", "stability", "speed") for line in verdicts(study, c)]
@@ -144,10 +145,10 @@ def test_the_section_opens_on_the_verdicts(challenge_report):
     assert [s.split(":")[0] for s in small] == ["n_pendulum", "spring_chain"]
     sub = section(md)[section(md).index("\n### Small Steps: substeps against iterations\n"):]
     assert [x for x in sub.splitlines()[2:] if x.strip()][:2] == small
-    page = html.unescape((folder / "index.html").read_text())
+    page = html.unescape((folder / "challenge.html").read_text())
     for line in answer + small:
         assert f">{line}</p>" in page, line
-    head = page.index('<h2 id="the-pendulum-challenge-xpbd-50-substeps-and-small-steps">')
+    head = page.index('<h1 id="the-pendulum-challenge-xpbd-50-substeps-and-small-steps">')
     assert head < page.index(answer[0]) < page.index(answer[1]) < page.index(answer[2]) < page.index("<table", head)
 
 
@@ -155,7 +156,7 @@ def test_the_section_is_placed_and_listed(challenge_report):
     _, folder = challenge_report
     md = report_text(folder)
     assert md.index("\n## Small steps or one implicit step?") < md.index(f"\n{TITLE}\n") < md.index("\n## Energy\n")
-    assert '<a href="#the-pendulum-challenge-xpbd-50-substeps-and-small-steps">' in (folder / "index.html").read_text()
+    assert '<a href="challenge.html">' in (folder / "index.html").read_text()  # the index's list of pages
 
 
 def number(cell):
@@ -298,7 +299,7 @@ def test_the_figure_exists_and_fits(challenge_report):
     pixels = image.imread(folder / FIGURE)
     assert pixels.ndim == 3 and 800 <= pixels.shape[1] <= 1400 and pixels.shape[0] > 300, pixels.shape
     assert pixels[..., :3].std() > 0.05  # not blank
-    assert f'src="{FIGURE}"' in (folder / "index.html").read_text()
+    assert f'src="{FIGURE}"' in (folder / "challenge.html").read_text()
     # The caption letters the Small Steps panels as the figure does.
     assert "(b, c) Small Steps (Macklin et al., SCA 2019), (b) on n_pendulum and (c) on spring_chain: " in sec
     assert "(b) Small Steps (" not in sec
@@ -400,7 +401,7 @@ def test_a_study_without_challenge_has_no_such_section(plain_study, reports):
     md = report_text(out)
     assert "pendulum challenge (XPBD" not in md and "Small Steps: substeps against iterations" not in md
     assert not (out / FIGURE).exists()
-    assert "pendulum-challenge" not in (out / "index.html").read_text()
+    assert "challenge.html" not in (out / "index.html").read_text() and not (out / "challenge.html").exists()
 
 
 @pytest.mark.parametrize("path, field", [("challenge/entries", "err_pos_max"), ("challenge/entries", "tolerance"),

@@ -44,7 +44,8 @@ def test_the_scan_section_is_placed_and_listed(scan_report):
     html = (folder / "index.html").read_text()
     assert md.index("\n## Small steps or one implicit step?") < md.index("\n## Parameter scans\n") \
         < md.index("\n## Appendix: how the problem sections are made") < md.index("\n## Appendix: the study")
-    assert '<a href="#parameter-scans">' in html  # the contents' entry
+    assert '<a href="scans.html">' in html  # the index's list of pages
+    assert (folder / "scans.html").is_file()
     assert "### Scan stiff_spring: stiff_spring over k_s" in section(md)
 
 
@@ -158,6 +159,7 @@ def test_a_study_without_scan_has_no_section(gaps_report, tmp_path):
     with_scan = report_text(folder)
     cut = with_scan[:with_scan.index("\n## Parameter scans\n")] + \
         with_scan[with_scan.index("\n## Appendix: how the problem sections are made"):]
+    cut = cut.replace(", [Parameter scans](scans.html)", "")  # the index's list of pages
     assert cut.replace(str(study), "S").replace(os.path.basename(str(study)), "S") == \
         md.replace(str(old), "S").replace("old.h5", "S")
 

@@ -26,26 +26,26 @@ def _positive_int(text):
     return value
 
 
+def _positive(text):
+    """A finite number > 0, or None."""
+    try:
+        value = float(text)
+    except ValueError:
+        return None
+    return value if 0 < value < float("inf") else None
+
+
 def _tolerances(text):
     """--tol 1e-3 or --tol 1e-2,1e-3: positive numbers."""
-    out = []
-    for part in text.split(","):
-        try:
-            value = float(part)
-        except ValueError:
-            value = 0.0
-        if not value > 0 or value == float("inf"):
-            raise argparse.ArgumentTypeError(f"must be positive numbers (1e-3, or 1e-2,1e-3), not '{text}'")
-        out.append(value)
+    out = [_positive(part) for part in text.split(",")]
+    if None in out:
+        raise argparse.ArgumentTypeError(f"must be positive numbers (1e-3, or 1e-2,1e-3), not '{text}'")
     return out
 
 
 def _rate(text):
-    try:
-        value = float(text)
-    except ValueError:
-        value = 0.0
-    if not value > 0 or value == float("inf"):
+    value = _positive(text)
+    if value is None:
         raise argparse.ArgumentTypeError(f"must be a positive rate in Hz, not '{text}'")
     return value
 

@@ -200,6 +200,19 @@ std::vector<scan_options> default_scans(bool quick) {
   return {spring, pendulum, chain};
 }
 
+namespace {
+// The methods a scan runs: the named ones, or our fixed-step methods on the problem.
+std::vector<method_info> scan_methods(const problem_instance& problem, const scan_options& opts) {
+  std::vector<method_info> out;
+  for (const auto& m : problem.methods())
+    if (m.kind == method_kind::fixed_step &&
+        (opts.methods.empty() ? m.origin == method_origin::ours
+                              : std::find(opts.methods.begin(), opts.methods.end(), m.name) != opts.methods.end()))
+      out.push_back(m);
+  return out;
+}
+}  // namespace
+
 scan_result run_scan(const scan_options& opts) {
   validate(opts);
   const auto start = std::chrono::steady_clock::now();
@@ -207,12 +220,7 @@ scan_result run_scan(const scan_options& opts) {
   out.options = opts;
   auto proto = make_problem(opts.problem);
   out.unit = std::string(proto->position_unit());
-  std::vector<method_info> methods;
-  for (const auto& m : proto->methods())
-    if (m.kind == method_kind::fixed_step &&
-        (opts.methods.empty() ? m.origin == method_origin::ours
-                              : std::find(opts.methods.begin(), opts.methods.end(), m.name) != opts.methods.end()))
-      methods.push_back(m);
+  const std::vector<method_info> methods = scan_methods(*proto, opts);
   out.options.methods.clear();  // the file records the methods run, which merge compares
   for (const auto& m : methods) out.options.methods.push_back(m.name);
   const auto grid = scan_grid(opts.axes);
@@ -320,11 +328,7 @@ std::map<std::string, double> eval_costs_timed_here(const scan_options& opts) {
   const double horizon = std::min(problem->horizon(), frames_timed / hz);
   const std::vector<double> times{horizon};
   std::map<std::string, double> out;
-  for (const auto& m : problem->methods()) {
-    if (m.kind != method_kind::fixed_step ||
-        (opts.methods.empty() ? m.origin != method_origin::ours
-                              : std::find(opts.methods.begin(), opts.methods.end(), m.name) == opts.methods.end()))
-      continue;
+  for (const auto& m : scan_methods(*problem, opts)) {
     const double evals = static_cast<double>(problem->run(m.name, dt, horizon, times, opts.limits).work.force_evals);
     if (!(evals > 0)) continue;
     const auto run = problem->timed_run(m.name, dt, horizon, times, opts.limits);

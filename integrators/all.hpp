@@ -7,11 +7,13 @@
 #include "integrators/group_constraint.hpp"
 #include "integrators/group_explicit.hpp"
 #include "integrators/group_implicit.hpp"
+#include "integrators/group_verner.hpp"
 
 namespace stepbench {
 
 // The force-based integrators (the stability study steps each on its test equations).
-using all_integrators = type_list_cat_t<explicit_integrators, implicit_integrators, adaptive_high_order_integrators>;
+using all_integrators =
+    type_list_cat_t<explicit_integrators, implicit_integrators, adaptive_high_order_integrators, verner_integrators>;
 
 // Every method of ours: the force-based ones, then the position-based ones, which step a
 // problem's constraint view (core/constraints.hpp), not its forces.

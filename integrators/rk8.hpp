@@ -4,36 +4,23 @@
 // its 12 stages and eighth-order weights b, without the error estimate. 12 force
 // evaluations a step: f(t + h, y_1), DOP853's 13th evaluation, is the next step's first
 // stage. Coefficients from integrators/tableaus.hpp (dop853_tableau), proved in
-// tests/test_tableaus.cpp; the stages are integrators/unrolled_rk.hpp's (1/m folded,
-// sums unrolled with the newest term last, the Nystrom form for a position-only force).
-#include "core/concepts.hpp"
+// tests/test_tableaus.cpp; the step is integrators/tableau_method.hpp's fixed_tableau (the
+// stages of integrators/unrolled_rk.hpp: 1/m folded, sums unrolled with the newest term
+// last, the Nystrom form for a position-only force).
+#include <string_view>
+
+#include "integrators/tableau_method.hpp"
 #include "integrators/tableaus.hpp"
-#include "integrators/unrolled_rk.hpp"
 
 namespace stepbench {
 
-struct rk8 {
+namespace rk8_detail {
+struct descriptor {
   static constexpr std::string_view name = "rk8";
   static constexpr std::string_view description = "eighth-order Runge-Kutta: the 12-stage DOP853 step at fixed dt";
-  static constexpr int order = 8;
-  static constexpr capabilities traits{};
-  static constexpr int force_evals_per_step = 12;
-
-  template <class Sys>
-  struct stepper {
-    using Vec = typename Sys::vec;
-    unrolled_rk<dop853_tableau, Sys> k;
-    explicit stepper(const rk8&) {}
-    void resize(const Sys&, const Vec& like) { k.resize(like); }
-
-    void step(const Sys& sys, double t, step_state<Vec>& s, double dt) {
-      const double h_im = dt * inverse_mass(sys);
-      k.F[0] = current_force(sys, t, s);
-      k.template compute<1, 12>(sys, t, s.x, s.v, dt, h_im);
-      k.template combine<dop853_tableau.b>(s.x, s.v, s.x, s.v, dt, h_im);
-      s.f_current = false;
-    }
-  };
 };
+}  // namespace rk8_detail
+
+using rk8 = fixed_tableau<dop853_tableau, rk8_detail::descriptor>;
 
 }  // namespace stepbench

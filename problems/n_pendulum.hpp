@@ -71,7 +71,10 @@ struct n_pendulum {
   // theta'' = M^{-1} r (the header's equations; l^2 divided out of both sides).
   // The angle differences from each angle's sine and cosine (2N calls, not 2N^2):
   // cos(a - b) = cos a cos b + sin a sin b, sin(a - b) = sin a cos b - cos a sin b.
-  void force(double, const vec& x, const vec& v, vec& f) const {
+  // Out of line: 2N sines and cosines and a Cholesky solve cost far more than a call,
+  // and the flattened loops (core/flatten.hpp) inlined this body into every stage of
+  // every method, a third of this problem's unit (the largest of the build).
+  [[gnu::noinline]] void force(double, const vec& x, const vec& v, vec& f) const {
     const int n = count();
     small_vector sn(n), cs(n), r(n);
     for (int i = 0; i < n; ++i) sn[i] = std::sin(x[i]), cs[i] = std::cos(x[i]);

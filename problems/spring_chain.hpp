@@ -72,7 +72,10 @@ struct spring_chain {
 
   // One pass over the masses: each spring is computed once, its force added to the mass
   // before it and carried (negated) to the mass after it; f is written once per mass.
-  void force(double, const vec& x, const vec& v, vec& f) const {
+  // Out of line: a pass over 32 masses (a square root and a division each) costs far
+  // more than a call, and the flattened loops (core/flatten.hpp) inlined it into every
+  // stage of every method.
+  [[gnu::noinline]] void force(double, const vec& x, const vec& v, vec& f) const {
     const double weight = mass() * gravity, l0 = rest_length();
     const int n = count();
     Eigen::Vector3d carry = Eigen::Vector3d::Zero();  // force of the spring before mass i

@@ -39,6 +39,8 @@ template <integrator I>
 struct ours_fixed {
   using integrator_type = I;
   static constexpr bool resolves_contacts = true;  // our loops do (runs_on, below)
+  template <class P>
+  static constexpr bool applies = method_applies<I, P>();
   static method_info info() { return ours_info<I>(method_kind::fixed_step); }
   template <problem P>
   static auto prepare(const P& p, double dt, double horizon, std::span<const double> times, const run_limits&) {
@@ -49,6 +51,8 @@ struct ours_fixed {
 template <adaptive_integrator I>
 struct ours_adaptive {
   static constexpr bool resolves_contacts = true;
+  template <class P>
+  static constexpr bool applies = method_applies<I, P>();
   static method_info info() { return ours_info<I>(method_kind::adaptive); }
   template <problem P>
   static auto prepare(const P& p, double tol, double horizon, std::span<const double> times, const run_limits& limits) {

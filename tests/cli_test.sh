@@ -42,10 +42,10 @@ assert names == {"constant_acceleration", "projectile", "damped_spring", "pendul
                  "bouncing_ball_locate", "bouncing_balls"}, names
 orders = {m["name"]: m["declared_order"] for m in d["methods"] if m["origin"] == "ours" and m["kind"] == "fixed_step"}
 assert orders == {"euler": 1, "semi_implicit_euler": 1, "midpoint": 2, "rk4": 4, "momentum": 1, "velocity_verlet": 2,
-                  "forest_ruth": 4, "implicit_euler": 1, "implicit_midpoint": 2, "rk8": 8, "xpbd": 1,
-                  "xpbd_iterations": 1}, orders
+                  "forest_ruth": 4, "implicit_euler": 1, "implicit_midpoint": 2, "rk8": 8, "vern7_fixed": 7,
+                  "vern9_fixed": 9, "xpbd": 1, "xpbd_iterations": 1}, orders
 adaptive = {m["name"]: m["declared_order"] for m in d["methods"] if m["origin"] == "ours" and m["kind"] == "adaptive"}
-assert adaptive == {"adaptive_euler": 1, "rk45": 5, "dop853": 8}, adaptive
+assert adaptive == {"adaptive_euler": 1, "rk45": 5, "dop853": 8, "vern7": 7, "vern9": 9}, adaptive
 origins = {m["name"]: m["origin"] for m in d["methods"]}
 assert origins["baseline_rk4"] == "baseline" and origins["gsl_rk4"] == "peer" and origins["cvode_bdf"] == "peer", origins
 caps = {m["name"]: m["capabilities"] for m in d["methods"]}

@@ -242,7 +242,7 @@ TEST(energy, symplectic_bounded_others_drift) {
 // The verdict does not depend on the run's length: on the pendulum, at 10^2, 10^3 and
 // 10^4 periods, every method gets the same verdict, the symplectic ones (and implicit
 // midpoint) "bounded"; and the drift figure over the run, |drift a period| x periods,
-// never exceeds the largest error measured.
+// stays within what a least-squares fit to the errors measured can give (3 x the largest).
 TEST(energy, verdict_independent_of_run_length) {
   std::map<std::string, std::string> first_verdict;
   for (const double periods : {1e2, 1e3, 1e4}) {
@@ -256,7 +256,10 @@ TEST(energy, verdict_independent_of_run_length) {
       ASSERT_TRUE(r.completed) << r.info.name << ": " << r.note;
       const auto it = first_verdict.emplace(r.info.name, r.verdict).first;
       EXPECT_EQ(r.verdict, it->second) << r.info.name << " at " << periods << " periods";
-      EXPECT_LE(std::abs(r.drift_per_period) * periods, r.max_rel_err)
+      // A least-squares slope of n values within +-M reaches at most 3 M / n: a steady
+      // drift from 0 stays within M, but peaks that wander at round-off (vern9_fixed's,
+      // 6e-13 over 100 periods) can fit a slope beyond M / n.
+      EXPECT_LE(std::abs(r.drift_per_period) * periods, 3.0 * r.max_rel_err)
           << r.info.name << " at " << periods << " periods: drift " << r.drift_per_period;
     }
   }

@@ -5,9 +5,12 @@
 #include <gtest/gtest.h>
 #include <sundials/sundials_config.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <utility>
 
 #include "core/drive.hpp"
 #include "generic_rk.hpp"
@@ -340,4 +343,212 @@ TEST(arkode, default_tables) {
   EXPECT_EQ(t5.stages, 6);
   EXPECT_EQ(t5.name, "ARKODE_CASH_KARP_6_4_5");
   EXPECT_THROW(arkode_erk_default_table(7), std::invalid_argument);
+}
+
+// ---------------------------------------------------------------------------------
+// Verner's pairs (integrators/verner.hpp), on the templates of integrators/tableau_method.hpp.
+
+namespace {
+
+// One fixed step of the method against the generic stages of its tableau (tests/generic_rk.hpp).
+template <class M, const auto& T, class P>
+void expect_fixed_step_equals_generic(const P& p, const char* what) {
+  using Sys = counted_system<P>;
+  constexpr int S = std::remove_cvref_t<decltype(T)>::stages;
+  Sys sys(p);
+  for (double h : {0.2, 0.01}) {
+    auto s = mid_motion(p);
+    rk_stages<S, Sys> k;
+    k.resize(s.x);
+    typename P::vec f0 = s.x, x1 = s.x, v1 = s.v;
+    sys.force(0.0, s.x, s.v, f0);
+    k.compute(T, sys, 0.0, s.x, s.v, f0, h);
+    k.combine(T.b, h, h * inverse_mass(sys), s.x, s.v, x1, v1);
+    const double sx = s.x.norm() + h * s.v.norm() + h * h * f0.norm() / p.mass();
+    const double sv = s.v.norm() + h * f0.norm() / p.mass();
+    stepper_t<M, Sys> st{M{}};
+    prepare_stepper(st, sys, s.x);
+    st.step(sys, 0.0, s, h);
+    const double slack = P::force_depends_on_velocity ? 16.0 : 1e3;  // as for rk8 above
+    EXPECT_LE((s.x - x1).norm(), slack * eps * sx) << M::name << " " << what << " h " << h;
+    EXPECT_LE((s.v - v1).norm(), slack * eps * sv) << M::name << " " << what << " h " << h;
+  }
+}
+
+}  // namespace
+
+TEST(verner, fixed_steps_equal_the_generic_tableau_steps) {
+  spring_chain chain;
+  chain.masses = 8;
+  expect_fixed_step_equals_generic<vern7_fixed, vern7_tableau>(pendulum{}, "pendulum (Nystrom form)");
+  expect_fixed_step_equals_generic<vern7_fixed, vern7_tableau>(damped_spring{}, "damped_spring (velocity form)");
+  expect_fixed_step_equals_generic<vern7_fixed, vern7_tableau>(chain, "spring_chain (dynamic size)");
+  expect_fixed_step_equals_generic<vern9_fixed, vern9_tableau>(pendulum{}, "pendulum (Nystrom form)");
+  expect_fixed_step_equals_generic<vern9_fixed, vern9_tableau>(damped_spring{}, "damped_spring (velocity form)");
+  expect_fixed_step_equals_generic<vern9_fixed, vern9_tableau>(chain, "spring_chain (dynamic size)");
+}
+
+// The work: a fixed step evaluates the stages b weighs (9 and 15); an adaptive run, the
+// starting step's two evaluations, S - 1 new stages an attempt (the first stage is the
+// force at the step's start, kept across a rejection) and the force at each accepted
+// state that starts another step (no pair is FSAL: stage S is not at y_1).
+TEST(verner, force_evaluations) {
+  const pendulum pend;
+  const damped_spring spring;
+  const long n = 64;
+  EXPECT_EQ(drive(pend, vern7_fixed{}, pend.horizon() / n, pend.horizon(), {}).work.force_evals, 9 * n);
+  EXPECT_EQ(drive(spring, vern9_fixed{}, spring.horizon() / n, spring.horizon(), {}).work.force_evals, 15 * n);
+  EXPECT_EQ(vern7::force_evals_per_step, 10);
+  EXPECT_EQ(vern9::force_evals_per_step, 16);
+  EXPECT_FALSE(vern7::traits.reuses_last_force);
+  const std::vector<double> only_end{spring.horizon()};
+  const auto r7 = drive_adaptive(spring, vern7(1e-9), spring.horizon(), only_end, 1L << 20);
+  EXPECT_EQ(r7.work.force_evals, 2 + 9 * (r7.steps + r7.rejected_steps) + (r7.steps - 1));
+  const auto r9 = drive_adaptive(pend, vern9(1e-11), pend.horizon(), only_end, 1L << 20);
+  EXPECT_EQ(r9.work.force_evals, 2 + 15 * (r9.steps + r9.rejected_steps) + (r9.steps - 1));
+}
+
+// The step-size controller on a linear problem, x'' = -x (damped_spring without damping,
+// k = m = 1): a Runge-Kutta step is the matrix polynomial y_1 = R(Z) y_0, Z = h [0 1; -1 0],
+// R(z) = sum_k gamma_k z^k with gamma_0 = 1, gamma_k = b^T A^(k-1) 1, and the embedded
+// solution the same with b_hat. So every attempt's error estimate is known in closed
+// form, and with it the whole sequence of steps the controller must choose: Hairer's
+// controller with Gustafsson's PI term (HNW I, sec. IV.2, eq. 2.43c; its rejection rule,
+// sec. II.4), written out here in long double, against the stepper's own choices.
+TEST(verner, pi_controller_steps_a_known_sequence_on_a_linear_problem) {
+  auto check = []<class M, const auto & T>(double tol, double h0) {
+    constexpr int S = std::remove_cvref_t<decltype(T)>::stages;
+    using LD = long double;
+    std::array<LD, S + 1> gamma{}, gamma_hat{};
+    gamma[0] = gamma_hat[0] = 1;
+    std::array<LD, S> g;
+    g.fill(1);
+    for (int k = 1; k <= S; ++k) {
+      LD bg = 0, bhg = 0;
+      for (int i = 0; i < S; ++i) {
+        bg += static_cast<LD>(T.b[i]) * g[i];
+        bhg += static_cast<LD>(T.b_hat[i]) * g[i];
+      }
+      gamma[k] = bg;
+      gamma_hat[k] = bhg;
+      std::array<LD, S> ag{};
+      for (int i = 0; i < S; ++i)
+        for (int j = 0; j < i; ++j) ag[i] += static_cast<LD>(T.a[i][j]) * g[j];
+      g = ag;
+    }
+    damped_spring p;
+    p.k_s = 1.0;
+    p.k_d = 0.0;
+    p.mass_kg = 1.0;
+    using Sys = counted_system<damped_spring>;
+    Sys sys(p);
+    step_state<damped_spring::vec> s{p.initial().x, p.initial().v, p.initial().x, false};
+    stepper_t<M, Sys> st{M(tol)};
+    prepare_stepper(st, sys, s.x);
+    const LD q1 = T.order;  // the error exponent's q + 1 (q the embedded order)
+    const LD beta = 2.0L / (5.0L * q1);
+    LD x = s.x[0], v = s.v[0], h = h0, err_old = 1e-4L;
+    bool rejected_last = false;
+    int accepted = 0, rejected = 0;
+    for (int attempt = 0; attempt < 60; ++attempt) {
+      // y_1 = R(Z) y and e = (R - R_hat)(Z) y; Z [x; v] = h [v; -x].
+      LD zx = x, zv = v, x1 = 0, v1 = 0, ex = 0, ev = 0;
+      for (int k = 0; k <= S; ++k) {
+        x1 += gamma[k] * zx;
+        v1 += gamma[k] * zv;
+        ex += (gamma[k] - gamma_hat[k]) * zx;
+        ev += (gamma[k] - gamma_hat[k]) * zv;
+        const LD nx = h * zv, nv = -h * zx;
+        zx = nx;
+        zv = nv;
+      }
+      const LD sx = tol + tol * std::max(std::abs(x), std::abs(x1)),
+               sv = tol + tol * std::max(std::abs(v), std::abs(v1));
+      const LD err = std::sqrt(((ex / sx) * (ex / sx) + (ev / sv) * (ev / sv)) / 2);
+      LD h_next;
+      if (err <= 1) {
+        const LD fac = 0.9L * std::pow(err, -(1 / q1 - 0.75L * beta)) * std::pow(err_old, beta);
+        h_next = h * std::clamp(fac, 0.2L, rejected_last ? 1.0L : 10.0L);
+        err_old = std::max(err, 1e-4L);
+      } else {
+        h_next = h * std::clamp(0.9L * std::pow(err, -1 / q1), 0.2L, 1.0L);
+      }
+      const step_attempt a = st.try_step(sys, 0.0, s, static_cast<double>(h));
+      ASSERT_EQ(a.accepted, err <= 1) << M::name << " attempt " << attempt << " err " << static_cast<double>(err);
+      // The stepper's estimate is a sum of stages of size 1 that cancels to about
+      // 0.1 tol: rounded to eps / (0.1 tol) of itself (2e-9 at tol 1e-6), which moves h by
+      // that over q + 1. A wrong exponent or beta moves it by percents.
+      EXPECT_NEAR(a.dt_next, static_cast<double>(h_next), 1e-7 * static_cast<double>(h_next))
+          << M::name << " attempt " << attempt;
+      if (a.accepted) {
+        ++accepted;
+        x = x1;
+        v = v1;
+        EXPECT_NEAR(s.x[0], static_cast<double>(x), 1e-13) << M::name << " attempt " << attempt;
+      } else {
+        ++rejected;
+      }
+      rejected_last = !a.accepted;
+      h = a.dt_next;  // the stepper's own step, so that rounding does not accumulate
+    }
+    // The sequence holds both kinds of attempt (the start is far too long a step), and
+    // then settles where the PI controller's fixed point puts the error:
+    // 0.9 err^-(1/(q+1) - 1.75 beta) = 1.
+    EXPECT_GE(rejected, 1) << M::name;
+    EXPECT_GE(accepted, 40) << M::name;
+    std::printf("  %s on x'' = -x at tol %.0e: %d accepted, %d rejected, last h %.4g\n", std::string(M::name).c_str(),
+                tol, accepted, rejected, static_cast<double>(h));
+  };
+  check.template operator()<vern7, vern7_tableau>(1e-6, 2.0);
+  check.template operator()<vern9, vern9_tableau>(1e-6, 3.0);
+}
+
+// Observed orders of the fixed steps on the damped spring: every local slope above
+// round-off at least the order minus 0.3 (as for rk8 on the pendulum above).
+TEST(observed_order, verner_fixed_steps) {
+  sweep_options opts;
+  opts.problems = {"damped_spring"};
+  opts.methods = {"vern7_fixed", "vern9_fixed"};
+  opts.base_steps =
+      4;  // from T/4 (4 samples): the default ladder (from T/32) is at round-off a level after vern9's first
+  opts.sample_count = 4;
+  opts.levels = 8;
+  opts.parts = {"sweep"};
+  const study s = run_sweep(opts);
+  const auto& spring = find(s, "damped_spring");
+  for (const auto& [name, order] : {std::pair{"vern7_fixed", 7.0}, std::pair{"vern9_fixed", 9.0}}) {
+    const auto* m = find(spring, name);
+    ASSERT_NE(m, nullptr) << name;
+    const auto slopes = local_slopes(*m, spring.truth.pos_scale, true);
+    std::printf("  damped_spring %-12s local slopes:", name);
+    for (double sl : slopes) std::printf(" %.2f", sl);
+    std::printf("  (fit: %.3f)\n", m->fit.order);
+    ASSERT_GE(slopes.size(), 2u) << name;
+    for (double sl : slopes) EXPECT_GE(sl, order - 0.3) << name;
+  }
+}
+
+// The eccentric orbit (kepler, e = 0.9) at the study's tolerance ladder (1e-2 .. 1e-14):
+// both pairs reach the equal-error ladder's last target, 1e-12 (measured: vern7 6.6e-13
+// and vern9 1.5e-13 at tol 1e-14; dop853 stops at 3e-12), with fewer evaluations for the
+// ninth order than for the seventh there.
+TEST(verner, reach_1e_12_on_the_eccentric_orbit) {
+  sweep_options opts;
+  opts.problems = {"kepler"};
+  opts.methods = {"vern7", "vern9"};
+  opts.parts = {"sweep"};
+  const study s = run_sweep(opts);
+  const auto& orbit = find(s, "kepler");
+  long evals[2] = {0, 0};
+  int i = 0;
+  for (const char* name : {"vern7", "vern9"}) {
+    const auto* m = find(orbit, name);
+    ASSERT_NE(m, nullptr) << name;
+    ASSERT_FALSE(m->rows.empty()) << name;
+    const auto& last = m->rows.back();
+    EXPECT_DOUBLE_EQ(last.param, 1e-14) << name;
+    EXPECT_LT(last.metrics.err_pos_max, 1e-12) << name;
+    evals[i++] = last.work.force_evals;
+  }
+  EXPECT_LT(evals[1], evals[0]);
 }

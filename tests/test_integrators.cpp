@@ -54,10 +54,16 @@ TEST(integrators, one_step_matches_taylor_series_to_order) {
         EXPECT_LT(err, 2.0 * std::pow(dt, I::order + 1)) << I::name;
         EXPECT_GT(err, 1e-3 * std::pow(dt, I::order + 2)) << I::name << " is suspiciously better than its order";
       } else {
-        // An eighth-order step is at round-off by dt = 0.1 on this problem; the local
-        // order shows as the slope between two large steps instead.
-        const double e1 = one_step_error.template operator()<I>(0.8), e2 = one_step_error.template operator()<I>(0.4);
-        EXPECT_NEAR(std::log2(e1 / e2), I::order + 1, 0.5) << I::name << ": " << e1 << " " << e2;
+        // A seventh- or eighth-order step is at round-off by dt = 0.1 on this problem; the
+        // local order shows as the slope between two large steps instead (measured for
+        // dt = 0.4 and 0.2: rk8 9.1, vern7_fixed 8.2). Verner's 9(8) pair minimises its
+        // leading error term, so the next term dominates down to round-off (slope 11.1
+        // there, 10.5 from 0.6 to 0.3): its error falls at least as fast as dt^10.
+        const double e1 = one_step_error.template operator()<I>(0.4), e2 = one_step_error.template operator()<I>(0.2);
+        if constexpr (I::order <= 8)
+          EXPECT_NEAR(std::log2(e1 / e2), I::order + 1, 0.5) << I::name << ": " << e1 << " " << e2;
+        else
+          EXPECT_GE(std::log2(e1 / e2), I::order + 1 - 0.5) << I::name << ": " << e1 << " " << e2;
       }
     }
   });

@@ -96,7 +96,15 @@ TEST(stability, amplification_and_long_runs_agree) {
     EXPECT_FALSE(l.unstable_for_all_dt && l.unconditionally_stable);
     if (std::isfinite(l.theory)) {
       ASSERT_TRUE(std::isfinite(l.measured));
-      EXPECT_NEAR(l.measured / l.theory, 1.0, 0.01);
+      if (l.measured > 1.01 * l.theory) {
+        // A growth too weak for the runs to show (run/stability.cpp measured_limit):
+        // rho - 1 at the runs' limit below 1.01^(2 / 10000) - 1.
+        const double rho = spectral_radius(amplification_matrix(l.integrator, l.test, l.measured));
+        EXPECT_LT(rho - 1.0, std::pow(1.01, 2.0 / 10000) - 1.0);
+        EXPECT_NE(l.note.find("below what"), std::string::npos);
+      } else {
+        EXPECT_NEAR(l.measured / l.theory, 1.0, 0.01);
+      }
     } else {
       EXPECT_TRUE(l.unstable_for_all_dt || l.unconditionally_stable);
       EXPECT_TRUE(std::isnan(l.measured));

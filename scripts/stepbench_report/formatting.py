@@ -63,4 +63,4 @@ def fmt_count(n):
 
 def label(method):
     """The method's name as every table and legend shows it: peers and the baseline marked."""
-    return method.name + {"ours": "", "peer": " (peer)", "baseline": " (baseline, for scale)"}[method.origin]
+    return method.name + {"ours": "", "peer": " (peer)", "baseline": " (baseline, for scale)", "plugin": " (plugin)"}[method.origin]

@@ -32,7 +32,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> plugins;
   bool isolate = false;
   for (const auto& c : commands)
-    for (const char* name : {"run", "sweep", "scan", "advise", "energy"})
+    for (const char* name : {"list", "run", "sweep", "scan", "advise", "energy"})
       if (c.app->get_name() == name) {
         c.app
             ->add_option("--plugin", plugins,

@@ -146,6 +146,34 @@ TEST(plugins, a_bad_step_fails_its_run_with_the_reason) {
             "plugin method bad_greedy stopped at t = 0.19: over twice the work budget: 2000000 force evaluations");
 }
 
+// An adaptive plugin (tests/plugins/adaptive.c, Heun-Euler) through drive_adaptive: it
+// meets the tolerance's scale, its attempts are counted (two evaluations each, and two
+// for the host's starting step), a rejected attempt's scribbles are undone by the host,
+// and a NaN proposal fails the run with its reason.
+TEST(plugins, an_adaptive_plugin_runs_in_drive_adaptive) {
+  const auto p = make_problem("pendulum");
+  const double horizon = p->horizon();
+  const auto times = sample_times(horizon, 8);
+  ensure_loaded(plugin_path("bad/libheun_euler.so"));
+  const run_result r = p->run("heun_euler", 1e-6, horizon, times, run_limits{});
+  ASSERT_TRUE(r.stop_reason.empty()) << r.stop_reason;
+  ASSERT_EQ(r.sample_y.size(), times.size());
+  EXPECT_GT(r.steps, 100);
+  EXPECT_GT(r.rejected_steps, 0);
+  EXPECT_EQ(r.work.force_evals, 2 * (r.steps + r.rejected_steps) + 2);
+  double e = 0.0;
+  for (std::size_t j = 0; j < times.size(); ++j) e = std::max(e, std::abs(r.sample_y[j][0] - p->exact(times[j])[0]));
+  EXPECT_LT(e, 1e-3);  // a local tolerance of 1e-6 over two periods: within 1e-3 rad
+  EXPECT_GT(e, 1e-8);  // and not exact: the step is Heun's
+  ensure_loaded(plugin_path("bad/libheun_euler_dirty.so"));
+  const run_result dirty = p->run("heun_euler_dirty", 1e-6, horizon, times, run_limits{});
+  EXPECT_EQ(dirty.sample_y, r.sample_y);
+  EXPECT_EQ(dirty.rejected_steps, r.rejected_steps);
+  ensure_loaded(plugin_path("bad/libbad_proposal.so"));
+  EXPECT_EQ(p->run("bad_proposal", 1e-6, horizon, times, run_limits{}).stop_reason,
+            "plugin method bad_proposal proposed a next step of nan at t = 0 (not finite and > 0)");
+}
+
 // A step that crashes, under --isolate: the run fails with the signal; this process goes on.
 TEST(plugins, a_crash_under_isolate_fails_its_run) {
   set_plugin_isolation(true);

@@ -86,5 +86,16 @@ for name, why in (("bad_status", "returned status 7"), ("bad_crash", "--isolate:
     assert all(why in r for r in reasons), (name, reasons)
 PY
 
+# Shards that loaded different plugins (by path or bytes) are not one study: merge refuses
+# them in one line (the sweep's options name each plugin and its hash); the same plugin joins.
+for k in 1 2; do
+  "$bin" sweep --plugin "$plugins/libruth3.so" --problem pendulum --problem damped_spring --method rk4 \
+    --parts sweep --shard $k/2 --quiet --out "$work/s$k.h5" 2>/dev/null || bad "shard $k"
+done
+"$bin" sweep --plugin "$plugins/librk4.so" --problem pendulum --problem damped_spring --method rk4 \
+  --parts sweep --shard 2/2 --quiet --out "$work/other.h5" 2>/dev/null || bad "shard 2 with another plugin"
+expect_error "has plugin: $plugins/librk4.so fnv1a_64" merge "$work/s1.h5" "$work/other.h5" --out "$work/never.h5"
+"$bin" merge "$work/s1.h5" "$work/s2.h5" --out "$work/merged.h5" >/dev/null 2>&1 && ok || bad "merge of shards with one plugin"
+
 echo "plugin_test: $passes passed, $fails failed"
 [ "$fails" -eq 0 ]

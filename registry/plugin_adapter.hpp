@@ -7,8 +7,9 @@
 // call, the force behind it the problem's own, inlined into one callback.
 //
 // The force callback maps the plugin's double arrays onto the problem's vectors: the
-// problem's force takes `const vec&`, so x (and v, where the force depends on it) are
-// copied into vectors sized once a run; nothing a step allocates. It returns
+// problem's force takes `const vec&`, so x (and v, where the force depends on it) of a
+// plugin's own stage are copied into vectors sized once a run (the step's state is read
+// where it is); nothing a step allocates. It returns
 // a = F / m, as plugin.h says: the host multiplies by 1 / m, which for the default
 // problems' masses (powers of two) is exact, so a plugin RK4 in rk4.hpp's order gives
 // rk4's results bit for bit (tests/test_plugins.cpp).
@@ -43,6 +44,7 @@ template <class Sys>
 struct plugin_force_context {
   using Vec = typename Sys::vec;
   const Sys* sys = nullptr;
+  const step_state<Vec>* state = nullptr;  // the step's state: read in place when the plugin passes it
   Vec x, v, f;
   double inverse_mass = 1.0;
   long max_evals = std::numeric_limits<long>::max();
@@ -70,10 +72,15 @@ STEPBENCH_FLATTEN int plugin_force(void* ctx, double t, const double* x, const d
     return STEPBENCH_HOST_STOP;
   }
   const Eigen::Index n = c.x.size();
-  c.x = Eigen::Map<const Vec>(x, n);
-  if constexpr (Sys::force_depends_on_velocity) c.v = Eigen::Map<const Vec>(v, n);
+  // The state the host gave the step (a method's first stage, or ruth3's every one) is
+  // read where it is; a stage of the plugin's own is copied in.
+  const bool in_place = x == c.state->x.data() && v == c.state->v.data();
+  if (!in_place) {
+    c.x = Eigen::Map<const Vec>(x, n);
+    if constexpr (Sys::force_depends_on_velocity) c.v = Eigen::Map<const Vec>(v, n);
+  }
   try {
-    c.sys->force(t, c.x, c.v, c.f);
+    c.sys->force(t, in_place ? c.state->x : c.x, in_place ? c.state->v : c.v, c.f);
   } catch (const std::exception& e) {
     out_of_line([&] { c.stop_reason = e.what(); });
     return STEPBENCH_HOST_STOP;
@@ -123,6 +130,7 @@ struct plugin_fixed : plugin_described {
       ws.create(static_cast<int>(like.size()));
     }
     void step(const Sys&, double t, step_state<Vec>& s, double dt) {
+      ctx.state = &s;
       const int status = ws.m->step(ws.w, t, dt, s.x.data(), s.v.data(), &plugin_force<Sys>, &ctx);
       s.f_current = false;
       if (status != STEPBENCH_OK || !ctx.stop_reason.empty()) plugin_step_failed(*ws.m, status, t, ctx.stop_reason);
@@ -159,6 +167,7 @@ struct plugin_adaptive : plugin_described {
     step_attempt try_step(const Sys&, double t, step_state<Vec>& s, double dt) {
       x0 = s.x;
       v0 = s.v;
+      ctx.state = &s;
       double dt_next = std::numeric_limits<double>::quiet_NaN();
       int accepted = 0;
       const int status =

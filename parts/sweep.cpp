@@ -30,14 +30,13 @@ std::string describe(const sweep_options& o) {
   for (const auto& [problem, params] : o.overrides)
     for (const auto& [name, value] : params) overrides.push_back(fmt::format("{}.{}={}", problem, name, value));
   return fmt::format(
-             "selection: {}\nmethods: {}\noverrides: {}\nlevels: {}\nmax_levels: {}\nround_off_fall: {}\n"
-             "base_steps: {}\nsample_count: {}\ntolerances: {}\nreference tolerances: rtol {} atol {}\n"
-             "work budget: {} (adaptive steps {})",
-             list_or_all(selected_problems(o)), list_or_all(o.methods),
-             overrides.empty() ? "none" : fmt::format("{}", fmt::join(overrides, ",")), o.levels, o.max_levels,
-             o.round_off_fall, o.base_steps, o.sample_count, fmt::join(o.tolerances, ","), o.tol.rtol, o.tol.atol,
-             o.limits.work_budget, o.limits.max_steps) +
-         plugins_described();
+      "selection: {}\nmethods: {}\noverrides: {}\nlevels: {}\nmax_levels: {}\nround_off_fall: {}\n"
+      "base_steps: {}\nsample_count: {}\ntolerances: {}\nreference tolerances: rtol {} atol {}\n"
+      "work budget: {} (adaptive steps {}){}",
+      list_or_all(selected_problems(o)), list_or_all(o.methods),
+      overrides.empty() ? "none" : fmt::format("{}", fmt::join(overrides, ",")), o.levels, o.max_levels,
+      o.round_off_fall, o.base_steps, o.sample_count, fmt::join(o.tolerances, ","), o.tol.rtol, o.tol.atol,
+      o.limits.work_budget, o.limits.max_steps, plugins_described());
 }
 
 // One problem: its truth and every selected method on its ladder.

@@ -20,6 +20,8 @@ const char* own_flags_help() {
          "  --study_out=PATH     write the study file (timings beside accuracy); results to bench.json beside it\n"
          "  --problem=NAME       sweep and time this problem only, and its scaling family (repeatable)\n"
          "  --parts=A,B          run only these parts of the study (`stepbench list` names them)\n"
+         "  --plugin=PATH        load a plugin's methods into the study (repeatable; docs/plugins.md)\n"
+         "  --isolate            run each accuracy run of a plugin's method in a child process\n"
          "  --shard=K/N          the timed study of shard K of N: the share of the problems `stepbench sweep\n"
          "                       --shard K/N` takes, timing only their cases (`stepbench merge` joins the shards)\n"
          "  --set=P.NAME=VALUE   a problem parameter, as stepbench's --set; NAME=VALUE with one --problem\n"
@@ -61,10 +63,15 @@ options take_own_flags(int& argc, char** argv, std::vector<std::string>& extra) 
         o.parts.emplace_back(name);  // checked by run_sweep's validate()
         if (name.empty()) throw std::invalid_argument("--parts needs part names: --parts=A,B");
       }
+    } else if (a == "--isolate") {
+      o.isolate = true;
+    } else if (a.rfind("--plugin=", 0) == 0) {
+      o.plugins.push_back(a.substr(9));  // loaded by main, before the sweep
+      if (o.plugins.back().empty()) throw std::invalid_argument("--plugin needs a path");
     } else if (a.rfind("--shard=", 0) == 0) {
       parse_shard(a.substr(8), o.shard_index, o.shard_count);
     } else if (a == "--study_out" || a == "--case_budget" || a == "--set" || a == "--problem" || a == "--shard" ||
-               a == "--parts") {
+               a == "--parts" || a == "--plugin") {
       throw std::invalid_argument(a + " takes its value after '=': " + a + "=VALUE");
     } else if (a.rfind("--study_out=", 0) == 0) {
       o.study_out = a.substr(12);

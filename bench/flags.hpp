@@ -28,6 +28,9 @@ struct options {
   // --parts=A,B (repeatable): run only these parts of the study (parts/part.hpp); empty:
   // the preset's (every part, or --quick's).
   std::vector<std::string> parts;
+  // --plugin=PATH (repeatable): plugins whose methods join the study (docs/plugins.md).
+  std::vector<std::string> plugins;
+  bool isolate = false;  // --isolate: each accuracy run of a plugin's method in a child process
   // --shard=K/N: shard_index K - 1 of shard_count N, as `stepbench sweep --shard K/N`.
   int shard_index = 0, shard_count = 1;
   // Google Benchmark's flags that decide where its results go, as given (empty: not given).

@@ -26,6 +26,7 @@
 #include "judge/outcome.hpp"
 #include "parts/part.hpp"
 #include "parts/study.hpp"
+#include "registry/plugins.hpp"
 #include "registry/registry.hpp"
 #include "render/verdict.hpp"
 #include "run/sweep.hpp"
@@ -77,6 +78,8 @@ int main(int argc, char** argv) {
   try {
     std::vector<std::string> extra;
     bench::options opts = bench::take_own_flags(argc, argv, extra);
+    for (const auto& path : opts.plugins) load_plugin(path);  // before any method is named
+    set_plugin_isolation(opts.isolate);
     std::vector<char*> args(argv, argv + argc);
     for (auto& e : extra) args.push_back(e.data());
     int n = static_cast<int>(args.size());

@@ -10,6 +10,7 @@
 
 #include "cli/commands.hpp"
 #include "parts/part.hpp"
+#include "registry/plugins.hpp"
 #include "registry/registry.hpp"
 #include "render/table_render.hpp"
 
@@ -61,7 +62,8 @@ void print_list(const json& out) {
                  n["description"].get<std::string>()});
     fmt::print("\nnames {} takes:\n{}", param, render_text(named));
   }
-  for (const auto origin : {method_origin::ours, method_origin::peer, method_origin::baseline}) {
+  for (const auto origin : {method_origin::ours, method_origin::peer, method_origin::baseline, method_origin::plugin}) {
+    if (origin == method_origin::plugin && plugin_methods().empty()) continue;  // list --plugin PATH shows them
     table methods{
         {{"method"}, {"kind"}, right_column("order"), right_column("evals/step"), {"description"}, {"capabilities"}},
         {}};
@@ -76,9 +78,10 @@ void print_list(const json& out) {
                    std::isfinite(m.evals_per_step) ? fmt::format("{:g}", m.evals_per_step) : "-", m.description, caps});
     }
     fmt::print("\n{}:\n{}",
-               origin == method_origin::ours   ? "integrators (ours)"
-               : origin == method_origin::peer ? "peers"
-                                               : "baseline (for scale, never recommended)",
+               origin == method_origin::ours     ? "integrators (ours)"
+               : origin == method_origin::peer   ? "peers"
+               : origin == method_origin::plugin ? "plugins (docs/plugins.md)"
+                                                 : "baseline (for scale, never recommended)",
                render_text(methods));
     // Methods that run on only some problems (xpbd: the scenes with a constraint view;
     // Odeint: a state size known at compile time), grouped by the problems they run on.

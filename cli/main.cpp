@@ -5,10 +5,12 @@
 
 #include <cstdio>
 #include <exception>
+#include <string>
 #include <vector>
 
 #include "build_info.hpp"
 #include "cli/commands.hpp"
+#include "registry/plugins.hpp"
 
 int main(int argc, char** argv) {
   using namespace stepbench::cli;
@@ -25,6 +27,20 @@ int main(int argc, char** argv) {
                                       add_ratios(app), add_compare(app), add_stability(app), add_loop(app),
                                       add_energy(app), add_schema(app),  add_scan(app),      add_merge(app),
                                       add_summary(app)};
+  // --plugin PATH (repeatable) on the commands that run methods: each plugin is loaded,
+  // checked and registered before the command starts (registry/plugins.hpp, docs/plugins.md).
+  std::vector<std::string> plugins;
+  bool isolate = false;
+  for (const auto& c : commands)
+    for (const char* name : {"list", "run", "sweep", "scan", "advise", "energy"})
+      if (c.app->get_name() == name) {
+        c.app
+            ->add_option("--plugin", plugins,
+                         "load the methods of a plugin built against include/stepbench/plugin.h (repeatable)")
+            ->allow_extra_args(false);
+        c.app->add_flag("--isolate", isolate,
+                        "run each run of a plugin's method in a child process (a crash fails the run)");
+      }
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {  // --help, --help-all, --version: printed by exit()
@@ -34,6 +50,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
+    for (const auto& path : plugins) stepbench::load_plugin(path);
+    stepbench::set_plugin_isolation(isolate);
     for (const auto& c : commands)
       if (c.app->parsed()) return c.run();
   } catch (const std::invalid_argument& e) {

@@ -136,8 +136,18 @@ json equal_error(const problem_study& p, double target, const std::string& metri
 json ratios_json(const study& s, const ratios_args& a) {
   const auto& meta = s.record->meta;
   json out = {{"study", a.study}, {"cpu", meta.count("cpu") ? meta.at("cpu") : ""}};
-  if (const auto* spring = s.find("damped_spring"))
-    out["step_cost"] = step_costs(*spring, {"rk4", "baseline_rk4", "gsl_rk4", "odeint_rk4"});
+  // null where the study has no damped_spring (print_ratios reads the key either way)
+  const auto* spring = s.find("damped_spring");
+  out["step_cost"] = spring ? step_costs(*spring, {"rk4", "baseline_rk4", "gsl_rk4", "odeint_rk4"}) : json(nullptr);
+  // The example plugin RK4 (examples/plugins/rk4.c) against rk4, where a study ran it
+  // (--plugin=build/plugins/librk4.so): the price of a step behind a C function pointer.
+  out["step_cost_plugin"] = json::array();
+  for (const char* name : {"pendulum", "spring_chain"})
+    if (const auto* p = s.find(name); p && p->find("plugin_rk4"))
+      if (auto sc = step_costs(*p, {"rk4", "plugin_rk4"}); !sc.is_null()) {
+        if (p->params.count("masses")) sc["masses"] = p->params.at("masses");
+        out["step_cost_plugin"].push_back(sc);
+      }
   out["step_cost_rk8"] = json::array();
   out["ns_per_rhs_call"] = json::array();
   for (const auto& name : a.problems)
@@ -270,6 +280,22 @@ void print_ratios(const json& out, const std::string& study) {
                  sc["force_evals_per_step"]["gsl_rk4"].get<double>());
   } else {
     fmt::print("\nStep cost: rk4 and its peers on damped_spring were not all timed\n");
+  }
+  for (const auto& sc : out["step_cost_plugin"]) {
+    // The targets (34): at most 2x on the pendulum, whose force is one sine (the
+    // call through the pointer and the copy of x are most of a step), and 1.3x on the
+    // rope of 64 masses, where the force is most of it.
+    const bool rope = sc["problem"] == "spring_chain";
+    print_step_cost(sc,
+                    rope ? fmt::format("Step cost, the example plugin RK4, {:g} masses", sc["masses"].get<double>())
+                         : std::string("Step cost, the example plugin RK4"),
+                    1,
+                    {rope ? ratio_line{"plugin_rk4", "rk4", "<= 1.3 (64 masses)", [](double r) { return r <= 1.3; }}
+                          : ratio_line{"plugin_rk4", "rk4", "<= 2", [](double r) { return r <= 2.0; }}});
+    fmt::print(
+        "  (the plugin's force is a call through a C function pointer that copies x{} into the problem's vectors: "
+        "it cannot be inlined into the step as rk4's is)\n",
+        rope ? " and v" : "");
   }
   for (const auto& sc : out["step_cost_rk8"])
     print_step_cost(sc, "Step cost, eighth order", 1,

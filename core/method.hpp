@@ -13,14 +13,15 @@
 namespace stepbench {
 
 // Where a method comes from. A baseline is a timing floor written by hand for one
-// problem, not a method a user could pick: it is shown for scale, never recommended.
-enum class method_origin { ours, peer, baseline };
+// problem, not a method a user could pick: it is shown for scale, never recommended. A
+// plugin's method was compiled outside stepbench and loaded at run time (docs/plugins.md).
+enum class method_origin { ours, peer, baseline, plugin };
 // What its parameter is: a timestep (a dt ladder) or a tolerance (a tolerance ladder).
 enum class method_kind { fixed_step, adaptive };
 
 // The names the study file stores, indexed by the enumerators.
 inline std::string_view to_string(method_origin o) {
-  constexpr std::string_view names[] = {"ours", "peer", "baseline"};
+  constexpr std::string_view names[] = {"ours", "peer", "baseline", "plugin"};
   return names[static_cast<int>(o)];
 }
 inline std::string_view to_string(method_kind k) { return k == method_kind::fixed_step ? "fixed_step" : "adaptive"; }

@@ -56,7 +56,7 @@ std::map<std::string, double> measured_eval_costs(const study& s, const std::str
   const problem_study* ps = s.find(problem);
   if (!s.timed || !ps) return out;
   for (const auto& ms : ps->methods) {
-    if (ms.info.origin != method_origin::ours || ms.info.kind != method_kind::fixed_step) continue;
+    if (!offered_as_ours(ms.info.origin) || ms.info.kind != method_kind::fixed_step) continue;
     if (const double ns = measured_eval_cost_ns(*ps, ms.info.name); std::isfinite(ns)) out[ms.info.name] = ns;
   }
   return out;

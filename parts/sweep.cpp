@@ -9,11 +9,21 @@
 
 #include "core/contains.hpp"
 #include "parts/part.hpp"
+#include "registry/plugins.hpp"
 #include "run/machine.hpp"
 #include "store/study_file.hpp"
 
 namespace stepbench {
 namespace {
+
+// The plugins loaded, a line each (none: no line, so a study without them describes
+// itself as before): merge joins only shards that ran the same builds of them.
+std::string plugins_described() {
+  std::string out;
+  for (const auto& p : loaded_plugins())
+    out += fmt::format("\nplugin: {} fnv1a_64 {} abi {}", p.path, p.fnv1a_64, p.abi_version);
+  return out;
+}
 
 std::string describe(const sweep_options& o) {
   std::vector<std::string> overrides;
@@ -22,11 +32,11 @@ std::string describe(const sweep_options& o) {
   return fmt::format(
       "selection: {}\nmethods: {}\noverrides: {}\nlevels: {}\nmax_levels: {}\nround_off_fall: {}\n"
       "base_steps: {}\nsample_count: {}\ntolerances: {}\nreference tolerances: rtol {} atol {}\n"
-      "work budget: {} (adaptive steps {})",
+      "work budget: {} (adaptive steps {}){}",
       list_or_all(selected_problems(o)), list_or_all(o.methods),
       overrides.empty() ? "none" : fmt::format("{}", fmt::join(overrides, ",")), o.levels, o.max_levels,
       o.round_off_fall, o.base_steps, o.sample_count, fmt::join(o.tolerances, ","), o.tol.rtol, o.tol.atol,
-      o.limits.work_budget, o.limits.max_steps);
+      o.limits.work_budget, o.limits.max_steps, plugins_described());
 }
 
 // One problem: its truth and every selected method on its ladder.

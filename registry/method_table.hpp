@@ -9,6 +9,7 @@
 #include <functional>
 #include <span>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "core/drive.hpp"
@@ -49,10 +50,10 @@ run_result to_run_result(const drive_result<Vec>& r, double param, double horizo
   return out;
 }
 
-template <class M, problem P>
-run_result run_method(const P& p, double param, double horizon, std::span<const double> times,
-                      const run_limits& limits) {
-  auto run_once = M::prepare(p, param, horizon, times, limits);  // throws std::invalid_argument for bad times
+// One run of a prepared method (`run_once`, from a prepare that threw
+// std::invalid_argument for bad times) in plain vectors.
+template <class RunOnce>
+run_result run_prepared(const RunOnce& run_once, double param, double horizon) {
   try {
     return to_run_result(run_once(), param, horizon);
   } catch (const std::invalid_argument&) {
@@ -68,9 +69,22 @@ run_result run_method(const P& p, double param, double horizon, std::span<const 
 }
 
 template <class M, problem P>
+run_result run_method(const P& p, double param, double horizon, std::span<const double> times,
+                      const run_limits& limits) {
+  return run_prepared(M::prepare(p, param, horizon, times, limits), param, horizon);
+}
+
+// A prepared run as the benchmark times it (what it returns keeps the run from being
+// optimised away).
+template <class RunOnce>
+std::function<double()> timed_prepared(RunOnce run_once) {
+  return [run_once = std::move(run_once)] { return run_once().final_state.x[0]; };
+}
+
+template <class M, problem P>
 std::function<double()> timed_method(const P& p, double param, double horizon, std::span<const double> times,
                                      const run_limits& limits) {
-  return [run_once = M::prepare(p, param, horizon, times, limits)] { return run_once().final_state.x[0]; };
+  return timed_prepared(M::prepare(p, param, horizon, times, limits));
 }
 
 // Appends a slot for each method of the group that runs on P, in the group's order.

@@ -15,6 +15,8 @@
 #include "core/game_loop.hpp"
 #include "core/number.hpp"
 #include "registry/method_table.hpp"
+#include "registry/plugin_adapter.hpp"
+#include "registry/plugins.hpp"
 #include "registry/registry.hpp"
 
 namespace stepbench::registry_detail {
@@ -153,19 +155,31 @@ class problem_model final : public problem_instance {
     return sys;
   }
 
+  // The table's methods, then the plugins' (registry/plugins.hpp): they run on every
+  // problem, through our loops (registry/plugin_adapter.hpp), contacts and all.
   std::vector<method_info> methods() const override {
     std::vector<method_info> out;
     for (const auto& s : *methods_) out.push_back(*s.info);
+    for (const auto& m : plugin_methods()) out.push_back(m.info);
     return out;
   }
 
   run_result run(std::string_view method, double param, double horizon, std::span<const double> times,
                  const run_limits& limits) const override {
+    if (const plugin_method* m = find_plugin_method(method)) {
+      const auto run_once = prepare_plugin(m->method, p_, param, horizon, times, limits);
+      if (!plugin_isolation()) return run_prepared(run_once, param, horizon);
+      run_result r = run_isolated([&] { return run_prepared(run_once, param, horizon); });
+      r.param = param, r.horizon = horizon;  // also where the child crashed
+      return r;
+    }
     return slot(method).run(p_, param, horizon, times, limits);
   }
 
   std::function<double()> timed_run(std::string_view method, double param, double horizon,
                                     std::span<const double> times, const run_limits& limits) const override {
+    if (const plugin_method* m = find_plugin_method(method))
+      return timed_prepared(prepare_plugin(m->method, p_, param, horizon, times, limits));
     return slot(method).timed_run(p_, param, horizon, times, limits);
   }
 

@@ -27,8 +27,9 @@ std::unique_ptr<problem_instance> make_problem(std::string_view name) {
   throw std::invalid_argument(fmt::format("unknown problem '{}' (known: {})", name, fmt::join(problem_names(), ", ")));
 }
 
-const std::vector<method_info>& all_methods() {
-  static const std::vector<method_info> all = [] {
+namespace {
+std::vector<method_info>& registered_methods() {
+  static std::vector<method_info> all = [] {
     std::vector<method_info> out;
     // Ours, then the peers: the registry's order (the study file's, `stepbench list`'s).
     for_each_type(type_list_cat_t<all_ours, all_peers>{}, [&]<class M>() { out.push_back(info_of<entry_t<M>>()); });
@@ -36,6 +37,11 @@ const std::vector<method_info>& all_methods() {
   }();
   return all;
 }
+}  // namespace
+
+const std::vector<method_info>& all_methods() { return registered_methods(); }
+
+void registry_detail::register_method(const method_info& m) { registered_methods().push_back(m); }
 
 const method_info* registered_method(std::string_view name) {
   for (const auto& m : all_methods())

@@ -150,7 +150,7 @@ energy_study run_energy_study(const energy_options& opts,
     ep.e0 = p->energy(y0);
     ep.l0 = p->has_angular_momentum() ? p->angular_momentum(y0) : nan;
     for (const auto& m : p->methods())
-      if (m.origin == method_origin::ours && m.kind == method_kind::fixed_step &&
+      if (offered_as_ours(m.origin) && m.kind == method_kind::fixed_step &&
           (opts.methods.empty() || std::find(opts.methods.begin(), opts.methods.end(), m.name) != opts.methods.end()))
         ep.runs.push_back(run_one(*p, m, ep, opts));
     if (opts.progress)

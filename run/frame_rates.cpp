@@ -78,7 +78,7 @@ std::vector<frame_rate_study> run_frame_rates(const study& s, const frame_rate_o
       const auto stride = static_cast<std::size_t>(std::lround(fastest / hz));
       const truth_table truth = every_nth(fine, stride);
       for (const auto& info : ps.problem->methods()) {
-        if (info.origin != method_origin::ours || info.kind != method_kind::fixed_step) continue;
+        if (!offered_as_ours(info.origin) || info.kind != method_kind::fixed_step) continue;
         if (!s.options.methods.empty() && !contains(s.options.methods, info.name)) continue;
         for (int n : opts.substeps) {
           const double dt = 1.0 / (hz * n);

@@ -206,7 +206,7 @@ std::vector<method_info> scan_methods(const problem_instance& problem, const sca
   std::vector<method_info> out;
   for (const auto& m : problem.methods())
     if (m.kind == method_kind::fixed_step &&
-        (opts.methods.empty() ? m.origin == method_origin::ours
+        (opts.methods.empty() ? offered_as_ours(m.origin)
                               : std::find(opts.methods.begin(), opts.methods.end(), m.name) != opts.methods.end()))
       out.push_back(m);
   return out;

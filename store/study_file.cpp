@@ -7,10 +7,12 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <stdexcept>
 
 #include "build_info.hpp"
 #include "judge/rows.hpp"
+#include "registry/plugins.hpp"
 #include "registry/registry.hpp"
 #include "run/machine.hpp"
 #include "run/sweep.hpp"
@@ -207,7 +209,8 @@ method_study read_method(const H5::Group& g, const std::string& name) {
   if (const method_info* known = registered_method(name)) m.info = *known;
   m.info.name = name;
   m.info.origin = parse_enum(h5::string_attr(g, "origin"),
-                             {method_origin::ours, method_origin::peer, method_origin::baseline}, "method origin");
+                             {method_origin::ours, method_origin::peer, method_origin::baseline, method_origin::plugin},
+                             "method origin");
   m.info.kind = parse_enum(h5::string_attr(g, "kind"), {method_kind::fixed_step, method_kind::adaptive}, "method kind");
   m.info.description = h5::string_attr(g, "description");
   m.info.library = h5::string_attr(g, "library");
@@ -312,6 +315,16 @@ void write_root_attributes(H5::H5File& file, const study& s, const std::string& 
   attr(file, "build_flags", build_info::build_flags);
   attr(file, "created_utc", utc_now_iso8601());
   write_machine(file, s.timed);
+  // The plugins whose methods ran (docs/plugins.md), as a JSON array: each one's path as
+  // given, the FNV-1a 64-bit hash of its bytes, its ABI version and its methods. Only in
+  // a study that loaded any.
+  if (!loaded_plugins().empty()) {
+    nlohmann::json plugins = nlohmann::json::array();
+    for (const auto& p : loaded_plugins())
+      plugins.push_back(
+          {{"path", p.path}, {"fnv1a_64", p.fnv1a_64}, {"abi_version", p.abi_version}, {"methods", p.methods}});
+    attr(file, "plugins", plugins.dump());
+  }
   if (s.swept) {
     // Which problems the study selected and which share of them this file holds
     // (sweep --shard K/N, stepbench_bench --shard=K/N); stepbench merge reads these.

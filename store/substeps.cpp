@@ -65,8 +65,9 @@ void read_substeps(const H5::Group& root, study& s) {
       substep_method& m = st.methods.emplace_back();
       if (const method_info* known = registered_method(name)) m.info = *known;
       m.info.name = name;
-      m.info.origin = parse_enum(h5::string_attr(mg, "origin"),
-                                 {method_origin::ours, method_origin::peer, method_origin::baseline}, "method origin");
+      m.info.origin = parse_enum(
+          h5::string_attr(mg, "origin"),
+          {method_origin::ours, method_origin::peer, method_origin::baseline, method_origin::plugin}, "method origin");
       m.info.traits.needs_jacobian = h5::long_attr(mg, "needs_jacobian") != 0;
       m.rows = substep_runs_columns().read(mg, "runs");
     }

@@ -14,6 +14,7 @@ import sys
 
 # Low to high. Folders in one layer must not include each other either.
 LAYERS = [
+    ["include"],  # the plugin ABI, a C header that includes nothing of ours (docs/plugins.md)
     ["references"],
     ["core"],
     ["problems", "integrators"],

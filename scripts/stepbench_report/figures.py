@@ -28,7 +28,7 @@ LECTURE_COLORS = ("#d62728", "#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd")
 COLORS = ("#8c564b", "#e377c2", "#17becf", "#bcbd22", "#393b79", "#843c39", "#637939", "#c51b7d", "#7b4173",
           "#000000", "#01665e", "#6b6ecf", "#e7ba52")
 MARKERS = ("o", "s", "^", "D", "v", "P", "X")
-LINESTYLES = {"ours": "-", "peer": "--", "baseline": ":"}
+LINESTYLES = {"ours": "-", "peer": "--", "baseline": ":", "plugin": "-."}
 # Methods drawn behind the labelled ones, without a legend entry.
 GREY = "#c4c4c4"
 
@@ -51,7 +51,7 @@ def method_names(study):
         others.update(m.name for s in study.substeps.scenes for m in s.methods)
     for n in others:
         origins.setdefault(n, "ours")
-    rank = {"ours": 0, "peer": 1, "baseline": 2}
+    rank = {"ours": 0, "peer": 1, "baseline": 2, "plugin": 3}
     return sorted(origins.items(), key=lambda item: (rank.get(item[1], 3), item[0]))
 
 

@@ -62,5 +62,6 @@ def fmt_count(n):
 
 
 def label(method):
-    """The method's name as every table and legend shows it: peers and the baseline marked."""
-    return method.name + {"ours": "", "peer": " (peer)", "baseline": " (baseline, for scale)"}[method.origin]
+    """The method's name as every table and legend shows it: peers, the baseline and plugins marked."""
+    marks = {"ours": "", "peer": " (peer)", "baseline": " (baseline, for scale)", "plugin": " (plugin)"}
+    return method.name + marks[method.origin]

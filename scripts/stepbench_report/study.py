@@ -59,7 +59,7 @@ SUMMARY_TARGETS = (1e-2, 1e-4, 1e-6)
 OLDER_FORMATS = {3: {"equal_error": ("cost_lo", "cost_hi", "interpolated")}}
 
 # The closed vocabularies of the format: any other value is an error, not a guess.
-ORIGINS = ("ours", "peer", "baseline")
+ORIGINS = ("ours", "peer", "baseline", "plugin")
 FIT_STATUSES = ("fitted", "exact", "insufficient")
 
 # /stability: the stability limits and regions of our integrators, computed in C++ from

@@ -19,7 +19,7 @@ SUBSTEP_RUN_FIELDS = schema.fields("substeps_runs")
 TIMED_RUN_FIELDS = schema.timed_fields("substeps_runs")
 VERDICT_FIELDS = schema.fields("substeps_verdict")
 COST_KINDS = ("time_ns", "force_evals")
-ORIGINS = ("ours", "peer", "baseline")
+ORIGINS = ("ours", "peer", "baseline", "plugin")
 FIGURE = "substeps_equal_cost.png"
 
 

@@ -1,0 +1,101 @@
+#!/usr/bin/env bash
+# Plugins as a user meets them (docs/plugins.md): a plugin built outside the tree with the
+# documented one-line command runs in `run --json` and in a sweep whose study records it;
+# a bad plugin file is refused in one line with exit 2 and nothing written; a step that
+# fails, and one that crashes under --isolate, becomes a failed row of a study written whole.
+# usage: plugin_test.sh path/to/stepbench SOURCE_DIR PLUGIN_DIR (build/plugins)
+set -u
+bin=${1:?usage: plugin_test.sh stepbench source-dir plugin-dir}
+src=${2:?}
+plugins=${3:?}
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fails=0 passes=0
+ok() { passes=$((passes + 1)); }
+bad() { echo "FAIL: $*"; fails=$((fails + 1)); }
+
+# expect_error "<what the one line must contain>" args...: exit 2, one line, no study.
+expect_error() {
+  local want=$1; shift
+  "$bin" "$@" >"$work/out" 2>"$work/err"
+  local rc=$?
+  local lines; lines=$(wc -l <"$work/err")
+  if [ "$rc" -ne 2 ]; then bad "exit $rc for: $*"; return; fi
+  if [ "$lines" -ne 1 ]; then bad "$lines lines on stderr for: $* :: $(cat "$work/err")"; return; fi
+  grep -qF -- "$want" "$work/err" || { bad "message lacks '$want' for: $* :: $(cat "$work/err")"; return; }
+  [ ! -e "$work/never.h5" ] || { bad "a study was written for: $*"; return; }
+  ok
+}
+
+# The documented build, outside the tree, of a copy of the example renamed.
+sed 's/"plugin_rk4"/"my_rk4"/' "$src/examples/plugins/rk4.c" >"$work/my.c"
+(cd "$work" && cc -shared -fPIC -O2 -I "$src/include" -o libmy.so my.c) || bad "the documented cc line failed"
+
+out=$("$bin" run --plugin "$work/libmy.so" --problem pendulum --method my_rk4 --dt 0.01 --json) || bad "run --json"
+ref=$("$bin" run --problem pendulum --method rk4 --dt 0.01 --json) || bad "run rk4 --json"
+/usr/bin/python3 - "$out" "$ref" <<'PY' && ok || bad "run --json of the plugin: $out"
+import json, sys
+d, r = json.loads(sys.argv[1]), json.loads(sys.argv[2])
+assert d["origin"] == "plugin" and d["integrator"] == "my_rk4", d
+assert d["steps"] == 552 and d["force_evals"] == 4 * 552, d
+assert d["position"] == r["position"] and d["err_pos_max"] == r["err_pos_max"], (d, r)
+PY
+
+# Refusals: one line naming the file and the problem, exit 2, nothing written.
+echo "not a library" >"$work/text.so"
+expect_error "plugin $work/text.so: not a shared library it can load" \
+  sweep --plugin "$work/text.so" --problem pendulum --parts sweep --out "$work/never.h5"
+expect_error "plugin $plugins/bad/libbad_no_entry.so: not a stepbench plugin" \
+  sweep --plugin "$plugins/bad/libbad_no_entry.so" --problem pendulum --parts sweep --out "$work/never.h5"
+expect_error "ABI version 2; this stepbench reads version 1" \
+  run --plugin "$plugins/bad/libbad_abi.so" --problem pendulum --method rk4 --dt 0.01
+expect_error "method 1 (rk4): the name is taken" \
+  run --plugin "$plugins/bad/libbad_reserved.so" --problem pendulum --method rk4 --dt 0.01
+expect_error "plugin $work/libmy.so: method 1 (my_rk4): the name is taken" \
+  run --plugin "$work/libmy.so" --plugin "$work/libmy.so" --problem pendulum --method my_rk4 --dt 0.01
+expect_error "its order is 0, not 1 to 16" \
+  run --plugin "$plugins/bad/libbad_fields.so" --problem pendulum --method rk4 --dt 0.01
+
+# A sweep with the plugin, a failing one and (under --isolate) a crashing one: the study
+# is written whole, the plugin's rows fitted, the bad ones failed with their reasons, and
+# the root attribute `plugins` names all three with their hashes.
+"$bin" sweep --plugin "$work/libmy.so" --plugin "$plugins/bad/libbad_status.so" \
+  --plugin "$plugins/bad/libbad_crash.so" --isolate --problem pendulum \
+  --method rk4 --method my_rk4 --method bad_status --method bad_crash --parts sweep --quiet \
+  --out "$work/study.h5" >"$work/out" 2>"$work/err" || bad "sweep with plugins: $(cat "$work/err")"
+/usr/bin/python3 - "$work/study.h5" "$work/libmy.so" <<'PY' && ok || bad "the study of the sweep with plugins"
+import h5py, json, sys
+f = h5py.File(sys.argv[1], "r")
+plugins = json.loads(f.attrs["plugins"])
+assert [p["methods"] for p in plugins] == [["my_rk4"], ["bad_status"], ["bad_crash"]], plugins
+assert all(p["abi_version"] == 1 and len(p["fnv1a_64"]) == 16 for p in plugins), plugins
+# FNV-1a 64 of the file's bytes, computed here again.
+h = 0xcbf29ce484222325
+for b in open(sys.argv[2], "rb").read():
+    h = ((h ^ b) * 0x100000001b3) % 2**64
+assert plugins[0]["fnv1a_64"] == f"{h:016x}", plugins[0]
+m = f["problems/pendulum/methods"]
+mine, ours = m["my_rk4"], m["rk4"]
+assert mine.attrs["origin"] == "plugin" and mine.attrs["fit_status"] == "fitted", dict(mine.attrs)
+assert mine.attrs["fit_slope"] == ours.attrs["fit_slope"], (mine.attrs["fit_slope"], ours.attrs["fit_slope"])
+assert (mine["runs"]["err_pos_max"] == ours["runs"]["err_pos_max"]).all()
+for name, why in (("bad_status", "returned status 7"), ("bad_crash", "--isolate: the run crashed: signal 11")):
+    runs = m[name]["runs"]
+    assert len(runs) > 0 and all(runs["failed"]), (name, runs["failed"])
+    reasons = {r.decode() if isinstance(r, bytes) else r for r in runs["note"]}
+    assert all(why in r for r in reasons), (name, reasons)
+PY
+
+# Shards that loaded different plugins (by path or bytes) are not one study: merge refuses
+# them in one line (the sweep's options name each plugin and its hash); the same plugin joins.
+for k in 1 2; do
+  "$bin" sweep --plugin "$plugins/libruth3.so" --problem pendulum --problem damped_spring --method rk4 \
+    --parts sweep --shard $k/2 --quiet --out "$work/s$k.h5" 2>/dev/null || bad "shard $k"
+done
+"$bin" sweep --plugin "$plugins/librk4.so" --problem pendulum --problem damped_spring --method rk4 \
+  --parts sweep --shard 2/2 --quiet --out "$work/other.h5" 2>/dev/null || bad "shard 2 with another plugin"
+expect_error "has plugin: $plugins/librk4.so fnv1a_64" merge "$work/s1.h5" "$work/other.h5" --out "$work/never.h5"
+"$bin" merge "$work/s1.h5" "$work/s2.h5" --out "$work/merged.h5" >/dev/null 2>&1 && ok || bad "merge of shards with one plugin"
+
+echo "plugin_test: $passes passed, $fails failed"
+[ "$fails" -eq 0 ]

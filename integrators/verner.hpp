@@ -19,9 +19,7 @@ namespace stepbench {
 
 namespace verner_detail {
 
-constexpr step_controller pi_control(int p) {
-  return {.error_order = p - 1, .beta = 2.0 / (5.0 * p)};
-}
+constexpr step_controller pi_control(int p) { return {.error_order = p - 1, .beta = 2.0 / (5.0 * p)}; }
 
 // Not on problems with contacts (integrators/group_verner.hpp says why).
 struct smooth_problems_only {
@@ -41,11 +39,13 @@ struct vern9_adaptive : smooth_problems_only {
 };
 struct vern7_step : smooth_problems_only {
   static constexpr std::string_view name = "vern7_fixed";
-  static constexpr std::string_view description = "seventh-order Runge-Kutta: Verner's 7(6) pair's 9-stage step at fixed dt";
+  static constexpr std::string_view description =
+      "seventh-order Runge-Kutta: Verner's 7(6) pair's 9-stage step at fixed dt";
 };
 struct vern9_step : smooth_problems_only {
   static constexpr std::string_view name = "vern9_fixed";
-  static constexpr std::string_view description = "ninth-order Runge-Kutta: Verner's 9(8) pair's 15-stage step at fixed dt";
+  static constexpr std::string_view description =
+      "ninth-order Runge-Kutta: Verner's 9(8) pair's 15-stage step at fixed dt";
 };
 
 }  // namespace verner_detail

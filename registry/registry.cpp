@@ -8,7 +8,8 @@
 
 #include "integrators/all.hpp"
 #include "peers/all.hpp"
-#include "problem_entries.hpp"  // generated from STEPBENCH_PROBLEMS (CMakeLists.txt)
+#include "problem_entries.hpp"     // generated from STEPBENCH_PROBLEMS (CMakeLists.txt)
+#include "problem_tags_check.hpp"  // the same list's tags, checked against the method groups
 #include "registry/method_entry.hpp"
 
 namespace stepbench {

@@ -31,7 +31,7 @@ LAYERS = [
 ]
 RANK = {folder: rank for rank, folders in enumerate(LAYERS) for folder in folders}
 # Headers CMake generates into the build tree, named without a folder.
-GENERATED = {"all_problems.hpp", "problem_entries.hpp", "build_info.hpp"}
+GENERATED = {"all_problems.hpp", "problem_entries.hpp", "problem_tags_check.hpp", "build_info.hpp"}
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"')
 
 

@@ -7,6 +7,7 @@
 
 #include "cli/args.hpp"
 #include "core/text.hpp"
+#include "registry/scenes.hpp"
 
 namespace stepbench::bench {
 
@@ -19,6 +20,7 @@ const char* own_flags_help() {
          "  --quick              CI mode: 8-level ladder, thinned tolerances, min time 0.002 s, 1 repetition\n"
          "  --study_out=PATH     write the study file (timings beside accuracy); results to bench.json beside it\n"
          "  --problem=NAME       sweep and time this problem only, and its scaling family (repeatable)\n"
+         "  --scene=FILE         a scene file (docs/scenes.md): swept and timed as --problem=NAME (repeatable)\n"
          "  --parts=A,B          run only these parts of the study (`stepbench list` names them)\n"
          "  --plugin=PATH        load a plugin's methods into the study (repeatable; docs/plugins.md)\n"
          "  --isolate            run each accuracy run of a plugin's method in a child process\n"
@@ -58,6 +60,11 @@ options take_own_flags(int& argc, char** argv, std::vector<std::string>& extra) 
     } else if (a.rfind("--problem=", 0) == 0) {
       o.problems.push_back(a.substr(10));  // checked by run_sweep's validate()
       if (o.problems.back().empty()) throw std::invalid_argument("--problem needs a problem name");
+    } else if (a.rfind("--scene=", 0) == 0) {
+      // A scene file (docs/scenes.md): read, checked and registered here, before any
+      // --set names it, and swept and timed as --problem=NAME.
+      if (a.size() == 8) throw std::invalid_argument("--scene needs a scene file");
+      o.problems.push_back(load_scene(a.substr(8)));
     } else if (a.rfind("--parts=", 0) == 0) {
       for (const auto name : split(std::string_view(a).substr(8), ',')) {
         o.parts.emplace_back(name);  // checked by run_sweep's validate()
@@ -71,7 +78,7 @@ options take_own_flags(int& argc, char** argv, std::vector<std::string>& extra) 
     } else if (a.rfind("--shard=", 0) == 0) {
       parse_shard(a.substr(8), o.shard_index, o.shard_count);
     } else if (a == "--study_out" || a == "--case_budget" || a == "--set" || a == "--problem" || a == "--shard" ||
-               a == "--parts" || a == "--plugin") {
+               a == "--parts" || a == "--plugin" || a == "--scene") {
       throw std::invalid_argument(a + " takes its value after '=': " + a + "=VALUE");
     } else if (a.rfind("--study_out=", 0) == 0) {
       o.study_out = a.substr(12);

@@ -36,6 +36,7 @@ command add_schema(CLI::App& app);
 command add_scan(CLI::App& app);
 command add_merge(CLI::App& app);
 command add_summary(CLI::App& app);
+command add_scene(CLI::App& app);
 
 // A command's answer on stdout: the JSON document (indented by two) with --json, else the text.
 inline void print_answer(bool as_json, const nlohmann::json& out, const std::string& text) {

@@ -148,6 +148,25 @@ json ratios_json(const study& s, const ratios_args& a) {
         if (p->params.count("masses")) sc["masses"] = p->params.at("masses");
         out["step_cost_plugin"].push_back(sc);
       }
+  // A scene file's rk4 against the built-in rope's, per coordinate a step (a moving
+  // mass's three in 3-D): what reading the forces as data costs (docs/scenes.md). Each
+  // problem's finest timed dt; a step's cost does not depend on dt.
+  out["step_cost_scene"] = json::array();
+  const auto builtin = builtin_problem_names();
+  if (const auto* chain = s.find("spring_chain"); chain && chain->find("rk4") && chain->dim > 0)
+    for (const auto& p : s.problems)
+      if (std::find(builtin.begin(), builtin.end(), p.name) == builtin.end() && p.find("rk4") && p.dim > 0) {
+        const json mine = step_costs(p, {"rk4"}), theirs = step_costs(*chain, {"rk4"});
+        if (mine.is_null() || theirs.is_null()) continue;
+        const double a = mine["ns_per_step"]["rk4"].get<double>() / p.dim;
+        const double b = theirs["ns_per_step"]["rk4"].get<double>() / chain->dim;
+        out["step_cost_scene"].push_back({{"scene", p.name},
+                                          {"scene_dim", p.dim},
+                                          {"spring_chain_dim", chain->dim},
+                                          {"scene_ns_per_coordinate_step", a},
+                                          {"spring_chain_ns_per_coordinate_step", b},
+                                          {"ratio", a / b}});
+      }
   out["step_cost_rk8"] = json::array();
   out["ns_per_rhs_call"] = json::array();
   for (const auto& name : a.problems)
@@ -296,6 +315,17 @@ void print_ratios(const json& out, const std::string& study) {
         "  (the plugin's force is a call through a C function pointer that copies x{} into the problem's vectors: "
         "it cannot be inlined into the step as rk4's is)\n",
         rope ? " and v" : "");
+  }
+  for (const auto& sc : out["step_cost_scene"]) {
+    // Issue 33's target: a scene file's rope of 64 masses within 1.3x of the built-in
+    // spring_chain at 64 masses, per mass-step (here per coordinate: both are 3-D).
+    const double r = sc["ratio"].get<double>();
+    fmt::print(
+        "\nStep cost of a scene file, rk4: {} ({} coordinates) {:.2f} ns a coordinate-step, spring_chain ({}) "
+        "{:.2f}: ratio {:.2f} (target <= 1.3 for a rope of 64 masses against spring_chain at 64: {})\n",
+        sc["scene"].get<std::string>(), sc["scene_dim"].get<int>(), sc["scene_ns_per_coordinate_step"].get<double>(),
+        sc["spring_chain_dim"].get<int>(), sc["spring_chain_ns_per_coordinate_step"].get<double>(), r,
+        r <= 1.3 ? "met" : "OPEN");
   }
   for (const auto& sc : out["step_cost_rk8"])
     print_step_cost(sc, "Step cost, eighth order", 1,

@@ -27,7 +27,7 @@ namespace {
 using json = nlohmann::json;
 
 struct run_args {
-  std::string problem, method, dt_text, tol_text, horizon_text;
+  std::string problem, method, dt_text, tol_text, horizon_text, reference_budget_text;
   std::vector<std::string> sets;
   bool json = false;
 };
@@ -96,6 +96,9 @@ int run_run(const run_args& a) {
   const run_result run = problem.run(m.name, param, horizon, times);
   truth_options topts;
   topts.run_references = !problem.has_closed_form();
+  if (!a.reference_budget_text.empty()) {
+    topts.reference_budget = parse_positive(a.reference_budget_text, "--reference-budget");
+  }
   const truth_table truth = build_truth(problem, times, topts);
   const run_metrics metrics = measure(problem, run, truth);
 
@@ -168,6 +171,9 @@ command add_run(CLI::App& app) {
   sub->add_option("--tol", a->tol_text, "relative tolerance (adaptive methods)");
   sub->add_option("--horizon", a->horizon_text, "end time [s] (default: the problem's)");
   sub->add_option("--set", a->sets, "override a parameter, problem.name=value or name=value (repeatable)");
+  sub->add_option("--reference-budget", a->reference_budget_text,
+                  "run the references only when their predicted work (coordinates x w_max T) is at most this "
+                  "(default: always); above it the run is judged on stability alone");
   sub->add_flag("--json", a->json, "print JSON");
   return {sub, [a] { return run_run(*a); }};
 }

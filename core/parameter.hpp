@@ -94,10 +94,19 @@ struct param_value {
   double parse(std::string_view text, std::string_view qualified_name) const;
 };
 
-// Declared parameters of P with their values in `p` (P's parameters() and its defaults).
+// Declared parameters of P with their values in `p` (P's parameters() and its defaults:
+// a default P's, or p.defaults() where the defaults are the instance's own, as a scene
+// file's are).
 template <class P>
 std::vector<param_value> declared_params(const P& p) {
-  static const P defaults{};
+  const P defaults = [&] {
+    if constexpr (requires {
+                    { p.defaults() } -> std::same_as<P>;
+                  })
+      return p.defaults();
+    else
+      return P{};
+  }();
   std::vector<param_value> out;
   for (const auto& q : P::parameters())
     out.push_back({std::string(q.name), std::string(q.unit), std::string(q.description), p.*q.member,

@@ -48,6 +48,7 @@ problem_study sweep_problem(const std::string& name, const sweep_options& opts, 
   ps.unit = ps.problem->position_unit();
   for (const auto& p : ps.problem->params()) ps.params[p.name] = p.value;
   ps.horizon = ps.problem->horizon();
+  ps.dim = ps.problem->dim();
   ps.truth = build_truth(*ps.problem, sample_times(ps.horizon, opts.sample_count), {.tol = opts.tol});
   for (const auto& r : ps.truth.references)
     if (r.status != "ok" && r.status != "unsupported")

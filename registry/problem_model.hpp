@@ -44,14 +44,25 @@ class problem_model final : public problem_instance {
     find_method(method);  // throws for an unknown name
     for (const auto& s : *methods_)
       if (s.info->name == method) return s;
-    not_applicable(method, P::name);
+    not_applicable(method, name());
   }
 
  public:
-  explicit problem_model(const method_table<P>& methods) : methods_(&methods) {}
+  explicit problem_model(const method_table<P>& methods, P p = P{}) : p_(std::move(p)), methods_(&methods) {}
 
-  std::string_view name() const override { return P::name; }
-  std::string_view description() const override { return P::description; }
+  // A problem type's name, or an instance's own where it has one (a scene file's).
+  std::string_view name() const override {
+    if constexpr (requires { p_.label(); })
+      return p_.label();
+    else
+      return P::name;
+  }
+  std::string_view description() const override {
+    if constexpr (requires { p_.summary(); })
+      return p_.summary().empty() ? P::description : p_.summary();
+    else
+      return P::description;
+  }
   int dim() const override { return p_.dim(); }
   std::string_view position_unit() const override { return P::position_unit; }
 
@@ -65,7 +76,7 @@ class problem_model final : public problem_instance {
     std::vector<std::string_view> known;
     for (const auto& q : P::parameters()) known.push_back(q.name);
     throw std::invalid_argument(
-        fmt::format("unknown parameter '{}' for problem {} (known: {})", param, P::name, fmt::join(known, ", ")));
+        fmt::format("unknown parameter '{}' for problem {} (known: {})", param, name(), fmt::join(known, ", ")));
   }
   std::string validate() const override { return stepbench::validate(p_); }
   double horizon() const override { return p_.horizon(); }
@@ -75,7 +86,7 @@ class problem_model final : public problem_instance {
 
   std::vector<double> exact(double t) const override {
     if constexpr (stepbench::has_closed_form<P>) return stacked(p_.exact(t));
-    throw std::logic_error(fmt::format("problem {} has no closed form", P::name));
+    throw std::logic_error(fmt::format("problem {} has no closed form", name()));
   }
   double energy(std::span<const double> y) const override {
     if constexpr (stepbench::has_energy<P>) return p_.energy(unflatten(y, 0), unflatten(y, p_.dim()));
@@ -121,7 +132,7 @@ class problem_model final : public problem_instance {
   bool has_exact_contacts() const override { return stepbench::has_exact_contacts<P>; }
   exact_contact_list exact_contacts(double t_end) const override {
     if constexpr (stepbench::has_exact_contacts<P>) return p_.exact_contacts(t_end);
-    throw std::logic_error(fmt::format("problem {} has no exact contacts", P::name));
+    throw std::logic_error(fmt::format("problem {} has no exact contacts", name()));
   }
   std::vector<double> initial() const override { return stacked(p_.initial()); }
   double fastest_frequency() const override { return stepbench::fastest_frequency(p_); }

@@ -11,20 +11,28 @@
 #include "problem_entries.hpp"     // generated from STEPBENCH_PROBLEMS (CMakeLists.txt)
 #include "problem_tags_check.hpp"  // the same list's tags, checked against the method groups
 #include "registry/method_entry.hpp"
+#include "registry/scenes.hpp"
 
 namespace stepbench {
 
 using namespace registry_detail;
 
-std::vector<std::string> problem_names() {
+std::vector<std::string> builtin_problem_names() {
   std::vector<std::string> names;
   for (const auto entry : problem_entries) names.emplace_back(entry().name);
+  return names;
+}
+
+std::vector<std::string> problem_names() {
+  std::vector<std::string> names = builtin_problem_names();
+  for (const auto& s : loaded_scenes()) names.push_back(s.name);
   return names;
 }
 
 std::unique_ptr<problem_instance> make_problem(std::string_view name) {
   for (const auto entry : problem_entries)
     if (const problem_entry e = entry(); e.name == name) return e.make();
+  if (const loaded_scene* s = find_scene(name)) return make_scene_problem(s->data);
   throw std::invalid_argument(fmt::format("unknown problem '{}' (known: {})", name, fmt::join(problem_names(), ", ")));
 }
 

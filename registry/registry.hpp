@@ -12,7 +12,9 @@
 
 namespace stepbench {
 
+// The built-in problems, then the scenes loaded from files (registry/scenes.hpp).
 std::vector<std::string> problem_names();
+std::vector<std::string> builtin_problem_names();
 // Throws std::invalid_argument naming the unknown problem and the known ones.
 std::unique_ptr<problem_instance> make_problem(std::string_view name);
 

@@ -5,7 +5,7 @@ set -euo pipefail
 packages=(
   g++ cmake make ninja-build git pkg-config clang-format ccache
   libeigen3-dev libgsl-dev libsundials-dev libhdf5-dev hdf5-tools
-  libbenchmark-dev libbenchmark-tools libcli11-dev libfmt-dev nlohmann-json3-dev libboost-dev
+  libbenchmark-dev libbenchmark-tools libcli11-dev libfmt-dev nlohmann-json3-dev libboost-dev libtomlplusplus-dev
   googletest libgtest-dev
   python3-h5py python3-matplotlib python3-numpy python3-scipy python3-pytest python3-markdown
   chromium  # renders the report in tests/python/test_report_browser.py

@@ -14,6 +14,7 @@
 #include "judge/rows.hpp"
 #include "registry/plugins.hpp"
 #include "registry/registry.hpp"
+#include "registry/scenes.hpp"
 #include "run/machine.hpp"
 #include "run/sweep.hpp"
 #include "store/h5.hpp"
@@ -232,6 +233,7 @@ problem_study read_problem(const H5::Group& g, const std::string& name) {
   p.name = name;
   p.unit = h5::string_attr(g, "position_unit");
   p.horizon = h5::double_attr(g, "horizon");
+  p.dim = static_cast<int>(h5::double_attr(g, "dim"));
   p.truth.source = h5::string_attr(g, "truth_source");
   p.truth.trusted = h5::long_attr(g, "truth_trusted") != 0;
   p.truth.pos_scale = h5::double_attr(g, "pos_scale");
@@ -324,6 +326,14 @@ void write_root_attributes(H5::H5File& file, const study& s, const std::string& 
       plugins.push_back(
           {{"path", p.path}, {"fnv1a_64", p.fnv1a_64}, {"abi_version", p.abi_version}, {"methods", p.methods}});
     attr(file, "plugins", plugins.dump());
+  }
+  // The scene files whose scenes ran (docs/scenes.md), likewise: each one's name, path as
+  // given and FNV-1a 64-bit hash; the file's own text is the scene's definition.
+  if (!loaded_scenes().empty()) {
+    nlohmann::json scenes = nlohmann::json::array();
+    for (const auto& sc : loaded_scenes())
+      scenes.push_back({{"name", sc.name}, {"path", sc.path}, {"fnv1a_64", sc.fnv1a_64}});
+    attr(file, "scenes", scenes.dump());
   }
   if (s.swept) {
     // Which problems the study selected and which share of them this file holds

@@ -116,6 +116,7 @@ struct problem_study {
   std::map<std::string, double> params;  // its declared parameters' values, by name
   std::unique_ptr<problem_instance> problem;
   double horizon = 0.0;
+  int dim = 0;  // coordinates of its position (as read from a file; the problem's own in a run)
   // As read from a file: source, trusted, note, the references' outcomes (not their
   // solutions) and the scales; not the truth's states.
   truth_table truth;

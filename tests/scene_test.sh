@@ -87,6 +87,14 @@ rc=$?
 [ "$rc" -eq 0 ] || [ "$rc" -eq 3 ] && ok || bad "advise --scene exit $rc: $(cat "$work/err")"
 grep -q "cloth" <<<"$out$(cat "$work/err")" && ok || bad "advise --scene names the scene: $out"
 
+# scan --scene: a range of one of the scene's parameters; loop --scene: one configuration.
+"$bin" scan --scene "$scenes/web.toml" --param web.stiffness_scale=0.5:2:3 --hz 60 --substeps 1,4 --quiet \
+  --out "$work/scan.h5" >"$work/out" 2>"$work/err" && [ -s "$work/scan.h5" ] && ok ||
+  bad "scan --scene: $(cat "$work/err")"
+"$bin" loop --scene "$scenes/web.toml" --integrator semi_implicit_euler --design fixed --json >"$work/out" 2>"$work/err" &&
+  /usr/bin/python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["problem"] == "web", d' "$work/out" &&
+  ok || bad "loop --scene: $(cat "$work/err") $(head -c 300 "$work/out")"
+
 # stepbench_bench --scene=: swept and timed as a problem.
 "$bench" --quick --scene="$scenes/damped_spring.toml" --parts=sweep --benchmark_min_time=0.0001 \
   --study_out="$work/t.h5" >/dev/null 2>"$work/err" || bad "stepbench_bench --scene: $(cat "$work/err")"

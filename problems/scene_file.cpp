@@ -324,6 +324,26 @@ scene_data parse_scene(std::string_view text, const std::string& path) {
           r.fail(at(*attraction),
                  fmt::format("masses {} and {} start at one point: their attraction is infinite", i, j));
   }
+  // The force Jacobians are band matrices (problems/scene.hpp make_jacobian): their band
+  // reaches the farthest pair of moving masses a spring joins in the file's order, or
+  // every mass under attraction. Their storage, 3 band + 1 rows of every coordinate, is
+  // kept under 512 MiB, so that a scene cannot take the implicit methods, the references
+  // or `scene check` past the memory a process may have.
+  {
+    long reach = s.has_attraction ? s.moving() - 1 : 0;
+    for (const auto& sp : s.between_moving) reach = std::max<long>(reach, std::abs(sp.a - sp.b));
+    const long coordinates = static_cast<long>(s.dim) * s.moving();
+    const long band = reach == 0 ? s.dim - 1 : s.dim * reach + s.dim - 1;
+    const double bytes = 8.0 * static_cast<double>(3 * band + 1) * static_cast<double>(coordinates);
+    if (bytes > 512.0 * (1 << 20))
+      r.fail(s.has_attraction ? at(*doc.get("attraction")) : top,
+             fmt::format("the scene's force Jacobian would take {:.3g} GiB as a band matrix ({} coordinates, {} "
+                         "off-diagonals; at most 0.5 GiB): {}",
+                         bytes / (1 << 30), coordinates, band,
+                         s.has_attraction ? "attraction couples every pair of masses; use fewer masses"
+                                          : "a spring joins masses far apart in the file's order; number the masses "
+                                            "along the springs"));
+  }
   if (const toml::array* planes = r.tables(doc, "plane"))
     r.fail(at(*planes), "[[plane]]: contacts in scene files are not supported by this build yet (docs/scenes.md)");
   return s;

@@ -2,6 +2,7 @@
 // scenes re-expressed as files step as the built-ins do, a closed form, the Pleiades
 // end positions published by the IVP test set, the analytic Jacobians against
 // differences, the energy, and every bad-file case refused in one line with its place.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -288,6 +289,20 @@ TEST(scene_files, bad_files_are_refused_in_one_line_with_their_place) {
       EXPECT_NE(what.find(c.expected), std::string::npos) << "message: " << what << "\nexpected: " << c.expected;
       EXPECT_EQ(what.find('\n'), std::string::npos) << what;
       EXPECT_EQ(what.rfind("bad.toml:", 0), 0u) << what;
+    }
+  }
+  // A scene whose force Jacobian would not fit in memory: 2000 masses in a line, the
+  // first joined to the last (a band of every coordinate: 0.8 GiB).
+  {
+    std::string text = "name = \"long_spring\"\ndim = 3\nhorizon = 1.0\n";
+    for (int i = 0; i < 2000; ++i) text += fmt::format("[[mass]]\nmass = 1.0\nposition = [{}.0, 0.0, 0.0]\n", i);
+    text += "[[spring]]\nbetween = [0, 1999]\nstiffness = 1.0\n";
+    try {
+      parse_scene(text, "long.toml");
+      ADD_FAILURE() << "a scene of 2000 masses with a spring from the first to the last was accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("long.toml:1:1: the scene's force Jacobian would take"), std::string::npos)
+          << e.what();
     }
   }
   // A scene may not take a built-in problem's name, nor a loaded scene's from another file.

@@ -14,9 +14,10 @@
 #include "registry/problem_model.hpp"
 #include "registry/scenes.hpp"
 
-namespace stepbench::registry_detail {
+namespace stepbench {
 
-std::unique_ptr<problem_instance> make_smooth_scene_problem(std::shared_ptr<const scene_data> data) {
+std::unique_ptr<problem_instance> make_scene_problem(std::shared_ptr<const scene_data> data) {
+  using namespace registry_detail;
   static const method_table<scene> methods = [] {
     method_table<scene> table;
     append_group(explicit_integrators{}, table);
@@ -31,4 +32,4 @@ std::unique_ptr<problem_instance> make_smooth_scene_problem(std::shared_ptr<cons
   return std::make_unique<problem_model<scene>>(methods, scene(std::move(data)));
 }
 
-}  // namespace stepbench::registry_detail
+}  // namespace stepbench

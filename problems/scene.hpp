@@ -243,27 +243,13 @@ struct scene {
       const point<D> xa = x.template segment<D>(D * sp.a), va = v.template segment<D>(D * sp.a);
       if (spring_force<D>(fixed_point<D>(s, sp.b) - xa, -va, sp, ks, cs, fs)) f.template segment<D>(D * sp.a) += fs;
     }
-    // The sum of the mass the last spring ended at is held here, not stored: a rope's next
-    // spring starts at it (the same additions in the same order, one store and one load
-    // fewer a spring, and no load waiting on the store just made).
-    int held = -1;
-    point<D> held_f = point<D>::Zero();
     for (const auto& sp : s.between_moving) {
       const point<D> d = x.template segment<D>(D * sp.b) - x.template segment<D>(D * sp.a);
       const point<D> w = v.template segment<D>(D * sp.b) - v.template segment<D>(D * sp.a);
       if (!spring_force<D>(d, w, sp, ks, cs, fs)) continue;
-      if (sp.a == held) {
-        held_f += fs;
-        f.template segment<D>(D * sp.a) = held_f;
-      } else {
-        if (held >= 0) f.template segment<D>(D * held) = held_f;
-        f.template segment<D>(D * sp.a) += fs;
-      }
-      held_f = f.template segment<D>(D * sp.b);
-      held_f -= fs;
-      held = sp.b;
+      f.template segment<D>(D * sp.a) += fs;
+      f.template segment<D>(D * sp.b) -= fs;
     }
-    if (held >= 0) f.template segment<D>(D * held) = held_f;
     if (s.has_drag) {  // -(linear + quadratic |v|) v
       const double lin = s.drag_linear * drag_scale, quad = s.drag_quadratic * drag_scale;
       for (int i = 0; i < n; ++i) {

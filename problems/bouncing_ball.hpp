@@ -24,10 +24,9 @@
 
 namespace stepbench {
 
-template <class Scene>
-struct ground_ball {
-  static constexpr std::string_view name = Scene::name;
-  static constexpr std::string_view description = Scene::description;
+struct bouncing_ball {
+  static constexpr std::string_view name = "bouncing_ball";
+  static constexpr std::string_view description = "ball bouncing on the ground, k_r 0.8, k_f 0.1; contacts end_of_step";
   static constexpr std::string_view position_unit = "m";
   static constexpr bool force_depends_on_velocity = false;
   static constexpr int dim() { return 2; }
@@ -40,20 +39,35 @@ struct ground_ball {
   double friction = 0.1;
   double gravity = 9.8;
   double mass_kg = 1.0;
-  double locate = Scene::locate;
+  // A scene of the registry: its name, description and contact mode. One type for both
+  // (one compiled unit, registry/problem_unit.cpp.in); the instance says which it is.
+  struct preset {
+    std::string_view name, description;
+    double locate;
+  };
+  static constexpr preset end_of_step{name, description, 0.0};
+
+  const preset* scene = &end_of_step;
+  double locate = scene->locate;
   double duration = 2.0;
 
+  bouncing_ball() = default;
+  explicit bouncing_ball(const preset& s) : scene(&s) {}
+  std::string_view label() const { return scene->name; }
+  std::string_view summary() const { return scene->description; }
+  bouncing_ball defaults() const { return bouncing_ball(*scene); }
+
   static constexpr auto parameters() {
-    using p = param<ground_ball>;
+    using p = param<bouncing_ball>;
     return std::array{
-        p{"height", &ground_ball::height, "m", "launch height", positive},
-        p{"vx0", &ground_ball::vx0, "m/s", "horizontal launch speed"},
-        p{"restitution", &ground_ball::restitution, "1", "k_r: 1 elastic, 0 sticks", in_closed(0.0, 1.0)},
-        p{"friction", &ground_ball::friction, "1", "k_f: 1 stops the tangential motion, 0 none", in_closed(0.0, 1.0)},
-        p{"gravity", &ground_ball::gravity, "m/s^2", "gravitational acceleration", positive},
-        p{"mass_kg", &ground_ball::mass_kg, "kg", "mass", positive},
-        p{"locate", &ground_ball::locate, "1", "contact mode", whole_from(0, 1), contact_mode_names},
-        p{"duration", &ground_ball::duration, "s", "default horizon", positive},
+        p{"height", &bouncing_ball::height, "m", "launch height", positive},
+        p{"vx0", &bouncing_ball::vx0, "m/s", "horizontal launch speed"},
+        p{"restitution", &bouncing_ball::restitution, "1", "k_r: 1 elastic, 0 sticks", in_closed(0.0, 1.0)},
+        p{"friction", &bouncing_ball::friction, "1", "k_f: 1 stops the tangential motion, 0 none", in_closed(0.0, 1.0)},
+        p{"gravity", &bouncing_ball::gravity, "m/s^2", "gravitational acceleration", positive},
+        p{"mass_kg", &bouncing_ball::mass_kg, "kg", "mass", positive},
+        p{"locate", &bouncing_ball::locate, "1", "contact mode", whole_from(0, 1), contact_mode_names},
+        p{"duration", &bouncing_ball::duration, "s", "default horizon", positive},
     };
   }
   exact::bouncing_ball motion() const { return {gravity, height, vx0, 0.0, restitution, friction}; }
@@ -102,18 +116,8 @@ struct ground_ball {
   }
 };
 
-struct bouncing_ball_scene {
-  static constexpr std::string_view name = "bouncing_ball";
-  static constexpr std::string_view description = "ball bouncing on the ground, k_r 0.8, k_f 0.1; contacts end_of_step";
-  static constexpr double locate = 0.0;
-};
-using bouncing_ball = ground_ball<bouncing_ball_scene>;
-
-struct bouncing_ball_locate_scene {
-  static constexpr std::string_view name = "bouncing_ball_locate";
-  static constexpr std::string_view description = "ball bouncing on the ground, k_r 0.8, k_f 0.1; contacts located";
-  static constexpr double locate = 1.0;
-};
-using bouncing_ball_locate = ground_ball<bouncing_ball_locate_scene>;
+inline constexpr bouncing_ball::preset bouncing_ball_locate_scene{
+    "bouncing_ball_locate", "ball bouncing on the ground, k_r 0.8, k_f 0.1; contacts located", 1.0};
+inline bouncing_ball bouncing_ball_locate() { return bouncing_ball(bouncing_ball_locate_scene); }
 
 }  // namespace stepbench

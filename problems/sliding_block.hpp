@@ -46,42 +46,59 @@ constexpr int friction_row(std::string_view name) {
   return 0;
 }
 
-template <class Scene>
-struct incline_block {
-  static constexpr std::string_view name = Scene::name;
-  static constexpr std::string_view description = Scene::description;
+struct sliding_block {
+  static constexpr std::string_view name = "sliding_block";
+  static constexpr std::string_view description = "block pushed up a 30 deg incline, mu = 0.5: stops, slides back";
   static constexpr std::string_view position_unit = "m";
   static constexpr bool force_depends_on_velocity = true;
   static constexpr int dim() { return 1; }
   using vec = Eigen::Matrix<double, 1, 1>;
   using jacobian_matrix = Eigen::Matrix<double, 1, 1>;
 
-  double angle_deg = Scene::angle_deg;
-  double v0 = Scene::v0;
+  // A scene of the registry: its name, description and the defaults that differ. One
+  // type for both (one compiled unit, registry/problem_unit.cpp.in); the instance says
+  // which it is.
+  struct preset {
+    std::string_view name, description;
+    double angle_deg, v0, material, mu_s, mu_k;
+  };
+  // The lecture's friction worked example: 30 degrees, mu_k = 0.5 (and mu_s = 0.5, its
+  // static example's): tan 30 = 0.577 > 0.5, so the block stops and slides back.
+  static constexpr preset lecture{name, description, 30.0, 5.0, 0.0, 0.5, 0.5};
+
+  const preset* scene = &lecture;
+  double angle_deg = scene->angle_deg;
+  double v0 = scene->v0;
   double mass_kg = 10.0;  // the lecture's block
   double gravity = 9.8;
-  double material = Scene::material;
+  double material = scene->material;
   double lubricated = 0.0;
-  double mu_s = Scene::mu_s;
-  double mu_k = Scene::mu_k;
+  double mu_s = scene->mu_s;
+  double mu_k = scene->mu_k;
   double locate = 0.0;
   double duration = 2.0;
 
+  sliding_block() = default;
+  explicit sliding_block(const preset& s) : scene(&s) {}
+  std::string_view label() const { return scene->name; }
+  std::string_view summary() const { return scene->description; }
+  sliding_block defaults() const { return sliding_block(*scene); }
+
   static constexpr auto parameters() {
-    using p = param<incline_block>;
+    using p = param<sliding_block>;
     return std::array{
-        p{"angle_deg", &incline_block::angle_deg, "deg", "incline angle", in_closed_open(0.0, 90.0)},
-        p{"v0", &incline_block::v0, "m/s", "initial speed along the slope, positive up"},
-        p{"mass_kg", &incline_block::mass_kg, "kg", "mass", positive},
-        p{"gravity", &incline_block::gravity, "m/s^2", "gravitational acceleration", positive},
-        p{"material", &incline_block::material, "1",
+        p{"angle_deg", &sliding_block::angle_deg, "deg", "incline angle", in_closed_open(0.0, 90.0)},
+        p{"v0", &sliding_block::v0, "m/s", "initial speed along the slope, positive up"},
+        p{"mass_kg", &sliding_block::mass_kg, "kg", "mass", positive},
+        p{"gravity", &sliding_block::gravity, "m/s^2", "gravitational acceleration", positive},
+        p{"material", &sliding_block::material, "1",
           "friction pair of the lecture's table: its row or its name (0: none, mu_s and mu_k apply)",
           whole_from(0, static_cast<double>(exact::friction_table.size())), material_names},
-        p{"lubricated", &incline_block::lubricated, "1", "the table's column", whole_from(0, 1), lubrication_names},
-        p{"mu_s", &incline_block::mu_s, "1", "static friction coefficient (material 0)", non_negative},
-        p{"mu_k", &incline_block::mu_k, "1", "kinetic friction coefficient (material 0)", non_negative},
-        p{"locate", &incline_block::locate, "1", "contact mode", whole_from(0, 1), contact_mode_names},
-        p{"duration", &incline_block::duration, "s", "default horizon", positive},
+        p{"lubricated", &sliding_block::lubricated, "1", "the table's column", whole_from(0, 1), lubrication_names},
+        p{"mu_s", &sliding_block::mu_s, "1", "static friction coefficient (material 0)", non_negative},
+        p{"mu_k", &sliding_block::mu_k, "1", "kinetic friction coefficient (material 0)", non_negative},
+        p{"locate", &sliding_block::locate, "1", "contact mode", whole_from(0, 1), contact_mode_names},
+        p{"duration", &sliding_block::duration, "s", "default horizon", positive},
     };
   }
 
@@ -117,7 +134,7 @@ struct incline_block {
   // and the table must hold both coefficients in the chosen column.
   std::string scene_check() const {
     if (const auto* r = record()) {
-      if (mu_s != Scene::mu_s || mu_k != Scene::mu_k) return "give either material or mu_s and mu_k, not both";
+      if (mu_s != scene->mu_s || mu_k != scene->mu_k) return "give either material or mu_s and mu_k, not both";
       const auto &s = table_cell(*r, false), &k = table_cell(*r, true);
       if (!s || !k)
         return fmt::format(
@@ -187,23 +204,17 @@ struct incline_block {
   bool locate_contacts() const { return locate != 0.0; }
 };
 
-// The lecture's friction worked example: 30 degrees, mu_k = 0.5 (and mu_s = 0.5,
-// its static example's): tan 30 = 0.577 > 0.5, so the block stops and slides back.
-struct sliding_block_scene {
-  static constexpr std::string_view name = "sliding_block";
-  static constexpr std::string_view description = "block pushed up a 30 deg incline, mu = 0.5: stops, slides back";
-  static constexpr double angle_deg = 30.0, v0 = 5.0, material = 0.0, mu_s = 0.5, mu_k = 0.5;
-};
-using sliding_block = incline_block<sliding_block_scene>;
-
 // Steel on steel, dry (mu_s 0.74, mu_k 0.57), at 30 degrees: mu_k < tan 30 = 0.577 <=
 // mu_s, so the block sticks where it stops, and kinetic friction alone would let it creep
 // back at 0.06 m/s^2.
-struct sliding_block_stick_scene {
-  static constexpr std::string_view name = "sliding_block_stick";
-  static constexpr std::string_view description = "block pushed up a 30 deg incline, steel on steel: stops and sticks";
-  static constexpr double angle_deg = 30.0, v0 = 5.0, material = friction_row("steel_on_steel"), mu_s = 0.5, mu_k = 0.5;
-};
-using sliding_block_stick = incline_block<sliding_block_stick_scene>;
+inline constexpr sliding_block::preset sliding_block_stick_scene{
+    "sliding_block_stick",
+    "block pushed up a 30 deg incline, steel on steel: stops and sticks",
+    30.0,
+    5.0,
+    friction_row("steel_on_steel"),
+    0.5,
+    0.5};
+inline sliding_block sliding_block_stick() { return sliding_block(sliding_block_stick_scene); }
 
 }  // namespace stepbench

@@ -25,7 +25,7 @@ using namespace stepbench;
 namespace {
 
 bouncing_ball ball() { return bouncing_ball{}; }
-bouncing_ball_locate located_ball() { return bouncing_ball_locate{}; }
+bouncing_ball located_ball() { return bouncing_ball_locate(); }
 
 using test_support::run_fixed;
 
@@ -90,7 +90,7 @@ TEST(contacts, records_the_first_64_and_counts_all) {
   EXPECT_EQ(r.contact_times.size(), 64u);
   EXPECT_TRUE(std::is_sorted(r.contact_times.begin(), r.contact_times.end()));
   EXPECT_NEAR(r.final_state.x.y(), 0.0, 1e-4);  // resting on the plane
-  bouncing_ball_locate q;
+  auto q = bouncing_ball_locate();
   q.restitution = 0.5;
   q.duration = 3.0;
   const auto rl = run_fixed(q, rk4{}, 1e-2);

@@ -154,7 +154,7 @@ TEST(sliding_block, material_by_name) {
 // friction alone (0.57 < tan 30) would not. With the stop as a contact the block stays
 // where it stopped, in both modes; the force alone would let it creep back.
 TEST(sliding_block, sticks_where_it_stops) {
-  sliding_block_stick p;
+  auto p = sliding_block_stick();
   ASSERT_TRUE(p.holds());
   const auto stop = p.exact(p.horizon());
   EXPECT_EQ(stop.v[0], 0.0);

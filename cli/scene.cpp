@@ -38,6 +38,7 @@ int run_scene_check(const scene_args& a) {
   if (d.has_gravity) elements.push_back("gravity");
   if (d.has_drag) elements.push_back("drag");
   if (d.has_attraction) elements.push_back("attraction");
+  if (!d.planes.empty()) elements.push_back(count_of(static_cast<long long>(d.planes.size()), "plane"));
   const double w = problem->fastest_frequency();
   json out{{"file", a.path},
            {"name", name},
@@ -52,6 +53,8 @@ int run_scene_check(const scene_args& a) {
            {"gravity", d.has_gravity},
            {"drag", d.has_drag},
            {"attraction", d.has_attraction},
+           {"planes", d.planes.size()},
+           {"contact_mode", problem->contact_mode()},
            {"state_size", 2 * problem->dim()},
            {"energy_J", problem->energy(problem->initial())},
            {"fastest_frequency_rad_s", w},

@@ -17,8 +17,10 @@
 // the springs in file order, then drag, then attraction; the sum is scaled by 1 / m
 // once. So those scenes step bit for bit as the built-ins do (tests/test_scenes.cpp).
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -59,6 +61,16 @@ struct scene_data {
   // negates the declared d exactly when the fixed end was declared first), then those
   // between two moving masses, each in file order.
   std::vector<spring> anchored, between_moving;
+
+  // A wall: the half-space {x : normal . x >= offset}, the normal a unit vector (the file's
+  // divided by its length, the offset with it), with the lecture's collision response.
+  struct plane {
+    std::array<double, 3> normal{};
+    double offset = 0.0;
+    double restitution = 1.0;  // k_r
+    double friction = 0.0;     // k_f
+  };
+  std::vector<plane> planes;
 
   double drag_linear = 0.0, drag_quadratic = 0.0;
   bool has_drag = false;
@@ -396,6 +408,58 @@ struct scene {
       }
     }
     return e;
+  }
+};
+
+// A scene with walls ([[plane]]): the scene's forces, and its masses' contacts with the
+// planes resolved as problems/bouncing_ball.hpp resolves the ball's with the ground, at
+// the end of each step (core/drive.hpp's end_of_step): a mass found on a plane's wrong
+// side, n . x < offset, is moved back onto it along n, and if it approaches, its velocity
+// v_n = (v . n) n, v_t = v - v_n becomes (1 - k_f) v_t - k_r v_n. The references locate
+// the contacts (CVODE's root finding on contact_gap). A type of its own: the methods that
+// run on problems with contacts are another set (no peers, no Verner pairs).
+struct contact_scene : scene {
+  using scene::scene;
+  contact_scene defaults() const { return contact_scene(data); }
+
+  // The smallest signed distance of a moving mass to a plane.
+  double contact_gap(double, const vec& x, const vec&) const {
+    const int d = data->dim;
+    double gap = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < count(); ++i)
+      for (const auto& p : data->planes) gap = std::min(gap, distance(p, x, d * i, d));
+    return gap;
+  }
+  contact_outcome resolve_contacts(double, vec& x, vec& v) const {
+    const int d = data->dim;
+    contact_outcome c;
+    for (int i = 0; i < count(); ++i)
+      for (const auto& p : data->planes) {
+        const double g = distance(p, x, d * i, d);
+        double vn = 0.0;
+        for (int k = 0; k < d; ++k) vn += p.normal[static_cast<std::size_t>(k)] * v[d * i + k];
+        if (g > 0.0 || (g == 0.0 && vn >= 0.0)) continue;
+        c.depth = std::max(c.depth, -g);
+        c.changed = c.changed || g < 0.0;
+        for (int k = 0; k < d; ++k) x[d * i + k] -= g * p.normal[static_cast<std::size_t>(k)];  // onto the plane
+        if (vn < 0.0) {  // approaching: v_b = (1 - k_f) v_t - k_r v_n
+          for (int k = 0; k < d; ++k) {
+            const double nk = p.normal[static_cast<std::size_t>(k)];
+            v[d * i + k] = (1.0 - p.friction) * (v[d * i + k] - vn * nk) - p.restitution * vn * nk;
+          }
+          ++c.resolved;
+          c.changed = true;
+        }
+      }
+    return c;
+  }
+  bool locate_contacts() const { return false; }
+
+ private:
+  static double distance(const scene_data::plane& p, const vec& x, int at, int d) {
+    double s = 0.0;
+    for (int k = 0; k < d; ++k) s += p.normal[static_cast<std::size_t>(k)] * x[at + k];
+    return s - p.offset;
   }
 };
 

@@ -345,7 +345,39 @@ scene_data parse_scene(std::string_view text, const std::string& path) {
                                             "along the springs"));
   }
   if (const toml::array* planes = r.tables(doc, "plane"))
-    r.fail(at(*planes), "[[plane]]: contacts in scene files are not supported by this build yet (docs/scenes.md)");
+    for (const auto& node : *planes) {
+      const auto& t = *node.as_table();
+      const place here = at(t);
+      r.only(t, "[[plane]]", {"normal", "offset", "restitution", "friction", "static_friction"});
+      if (const auto* st = t.get("static_friction"))
+        r.fail(at(*st), "'static_friction': a plane's static friction is not built yet (docs/scenes.md); leave it out");
+      const auto& normal = r.need(t, "normal", here, " in [[plane]]");
+      const auto n = r.vector(normal, "normal", s.dim);
+      double length2 = 0.0;
+      for (int c = 0; c < s.dim; ++c) length2 += n[c] * n[c];
+      if (!(length2 > 0.0) || !std::isfinite(length2))
+        r.fail(at(normal), "'normal' must be a non-zero vector of finite length");
+      const double length = std::sqrt(length2);
+      scene_data::plane pl;
+      for (int c = 0; c < s.dim; ++c) pl.normal[c] = length == 1.0 ? n[c] : n[c] / length;
+      if (const auto* o = t.get("offset")) pl.offset = r.number(*o, "offset") / length;
+      if (const auto* k = t.get("restitution"))
+        pl.restitution = r.number(
+            *k, "restitution", [](double v) { return v >= 0 && v <= 1; }, "in [0, 1]");
+      if (const auto* k = t.get("friction"))
+        pl.friction = r.number(
+            *k, "friction", [](double v) { return v >= 0 && v <= 1; }, "in [0, 1]");
+      // Every moving mass starts on the plane's side.
+      for (const auto& m : s.masses) {
+        if (m.fixed) continue;
+        double side = 0.0;
+        for (int c = 0; c < s.dim; ++c) side += pl.normal[c] * m.position[c];
+        if (side < pl.offset)
+          r.fail(here, fmt::format("mass {}{} starts on the wrong side of this plane (normal . x = {:g} < offset {:g})",
+                                   &m - s.masses.data(), m.name.empty() ? "" : " '" + m.name + "'", side, pl.offset));
+      }
+      s.planes.push_back(pl);
+    }
   return s;
 }
 

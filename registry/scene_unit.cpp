@@ -14,10 +14,9 @@
 #include "registry/problem_model.hpp"
 #include "registry/scenes.hpp"
 
-namespace stepbench {
+namespace stepbench::registry_detail {
 
-std::unique_ptr<problem_instance> make_scene_problem(std::shared_ptr<const scene_data> data) {
-  using namespace registry_detail;
+std::unique_ptr<problem_instance> make_smooth_scene_problem(std::shared_ptr<const scene_data> data) {
   static const method_table<scene> methods = [] {
     method_table<scene> table;
     append_group(explicit_integrators{}, table);
@@ -32,4 +31,4 @@ std::unique_ptr<problem_instance> make_scene_problem(std::shared_ptr<const scene
   return std::make_unique<problem_model<scene>>(methods, scene(std::move(data)));
 }
 
-}  // namespace stepbench
+}  // namespace stepbench::registry_detail

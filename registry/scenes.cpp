@@ -40,6 +40,11 @@ std::string load_scene(const std::string& path) {
 
 const std::vector<loaded_scene>& loaded_scenes() { return scenes(); }
 
+std::unique_ptr<problem_instance> make_scene_problem(std::shared_ptr<const scene_data> data) {
+  return data->planes.empty() ? registry_detail::make_smooth_scene_problem(std::move(data))
+                              : registry_detail::make_contact_scene_problem(std::move(data));
+}
+
 const loaded_scene* find_scene(std::string_view name) {
   for (const auto& s : scenes())
     if (s.name == name) return &s;

@@ -29,8 +29,14 @@ const std::vector<loaded_scene>& loaded_scenes();
 // The loaded scene of that name, or nullptr.
 const loaded_scene* find_scene(std::string_view name);
 
-// The problem_instance of a scene (registry/scene_unit.cpp: problem_model<scene> over
-// the methods that run on it).
+// The problem_instance of a scene: problem_model<scene> over the methods that run on it
+// (registry/scene_unit.cpp), or problem_model<contact_scene> for a scene with walls
+// (registry/contact_scene_unit.cpp).
 std::unique_ptr<problem_instance> make_scene_problem(std::shared_ptr<const scene_data> data);
+
+namespace registry_detail {
+std::unique_ptr<problem_instance> make_smooth_scene_problem(std::shared_ptr<const scene_data> data);
+std::unique_ptr<problem_instance> make_contact_scene_problem(std::shared_ptr<const scene_data> data);
+}  // namespace registry_detail
 
 }  // namespace stepbench

@@ -40,6 +40,9 @@ assert d["name"] == "pleiades" and d["moving"] == 7 and d["attraction"] and not 
 assert d["state_size"] == 28 and abs(d["moving_mass_kg"] - 28.0) < 1e-12, d
 assert [p["name"] for p in d["parameters"]][:2] == ["stiffness_scale", "damping_scale"], d' && ok || bad "scene check --json"
 
+out=$("$bin" scene check "$scenes/bouncing_ball.toml") || bad "scene check bouncing_ball"
+head -1 <<<"$out" | grep -q "1 mass (1 moving, 0 fixed), gravity, 1 plane; horizon 2 s" && ok || bad "a plane in scene check: $out"
+
 # run: the scene's name, its truth from the references.
 out=$("$bin" run --scene "$scenes/damped_spring.toml" --method rk4 --dt 0.01 --json) || bad "run --scene"
 /usr/bin/python3 - "$out" <<'PY' && ok || bad "run --scene --json: $out"

@@ -48,7 +48,8 @@ TEST(scene_files, the_built_in_scenes_as_files_step_as_the_built_ins) {
                                        {"stiff_spring.toml", "stiff_spring", 0, (32.0 / 60) / 4096},
                                        {"projectile.toml", "projectile", 0, 0.05},
                                        {"falling_drag.toml", "falling_drag", 0, 5.0 / 256},
-                                       {"spring_chain.toml", "spring_chain", 3, (32.0 / 60) / 2048}};
+                                       {"spring_chain.toml", "spring_chain", 3, (32.0 / 60) / 2048},
+                                       {"bouncing_ball.toml", "bouncing_ball", 0, 2.0 / 256}};
   for (const auto& c : cases) {
     const auto scene = make_problem(load_scene(scene_path(c.file)));
     const auto builtin = make_problem(c.builtin);
@@ -86,9 +87,11 @@ TEST(scene_files, the_built_in_scenes_as_files_step_as_the_built_ins) {
       if (!adaptive) {
         EXPECT_EQ(a.steps, b.steps) << c.file << " " << m.name;
       }
+      EXPECT_EQ(a.contacts, b.contacts) << c.file << " " << m.name;
       ++compared;
     }
-    EXPECT_GE(compared, 15) << c.file;
+    EXPECT_GE(compared, std::min<int>(13, static_cast<int>(scene->methods().size()))) << c.file;
+    EXPECT_EQ(scene->contact_mode(), builtin->contact_mode()) << c.file;
   }
 }
 
@@ -108,6 +111,25 @@ TEST(scene_files, one_mass_on_a_spring_follows_its_closed_form) {
   }
   const run_result rk4 = scene->run("rk4", 1e-3, 10.0, times);
   for (std::size_t k = 0; k < times.size(); ++k) EXPECT_NEAR(rk4.sample_y[k][0], builtin->exact(times[k])[0], 1e-11);
+}
+
+// A ball bouncing on a plane: the scene's references (CVODE locating the contacts as roots
+// of the gap) against the built-in's exact bounce sequence (problems/exact/bouncing_ball.hpp),
+// three contacts in 2 s.
+TEST(scene_files, a_ball_on_a_plane_follows_the_exact_bounces) {
+  const auto scene = make_problem(load_scene(scene_path("bouncing_ball.toml")));
+  const auto builtin = make_problem("bouncing_ball");
+  EXPECT_EQ(scene->contact_mode(), "end_of_step");
+  const std::vector<double> times{0.3, 1.0, 1.5, 2.0};
+  for (const char* source : {"cvode_bdf", "cvode_adams"}) {
+    ASSERT_TRUE(reference_handles_contacts(source));
+    const reference_solution r = solve_reference(source, scene->ode(), times);
+    EXPECT_EQ(r.contacts, 3) << source;
+    for (std::size_t k = 0; k < times.size(); ++k) {
+      const auto exact = builtin->exact(times[k]);
+      for (std::size_t i = 0; i < 4; ++i) EXPECT_NEAR(r.y[k][i], exact[i], 1e-9) << source << " t=" << times[k];
+    }
+  }
 }
 
 // Free fall: x = x0 + v0 t + g t^2 / 2 exactly (every method of order >= 2 is exact on it).
@@ -272,8 +294,12 @@ TEST(scene_files, bad_files_are_refused_in_one_line_with_their_place) {
        "'stiffness' must be non-negative (is -1)"},
       {head + mass + "[[mass]]\nmass = 1.0\nposition = [1.0, 0.0]\n[[spring]]\nbetween = [0, 1]\n",
        "missing key 'stiffness' in [[spring]]"},
-      {head + mass + "[[plane]]\nnormal = [0.0, 1.0]\noffset = 0.0\n",
-       "[[plane]]: contacts in scene files are not supported"},
+      {head + mass + "[[plane]]\nnormal = [0.0, 0.0]\n", "bad.toml:8:10: 'normal' must be a non-zero vector"},
+      {head + mass + "[[plane]]\nnormal = [0.0, 1.0]\noffset = 0.5\n",
+       "bad.toml:7:1: mass 0 starts on the wrong side of this plane (normal . x = 0 < offset 0.5)"},
+      {head + mass + "[[plane]]\nnormal = [0.0, 1.0]\nrestitution = 1.5\n", "'restitution' must be in [0, 1] (is 1.5)"},
+      {head + mass + "[[plane]]\nnormal = [0.0, 1.0]\nstatic_friction = 0.5\n", "'static_friction': a plane's static"},
+      {head + mass + "[[plane]]\noffset = 0.0\n", "missing key 'normal' in [[plane]]"},
       {head + "[[mass]]\nfixed = true\nposition = [0.0, 0.0]\n", "every [[mass]] is fixed"},
       {head + mass + "[attraction]\nG = 0.0\n", "'G' must be positive (is 0)"},
       {head + mass + "[drag]\nlinear = inf\n", "'linear' must be finite"},

@@ -156,9 +156,17 @@ void truth_from_references(const problem_instance& problem, truth_table& t, cons
       if (w < best) best = w, best_i = i, best_k = k;
     }
   if (ok.size() < 2 || !(best <= t.agreement_limit)) {
+    // The first failure's reason with the count: what a user can act on.
+    std::string first_failure;
+    for (const auto& r : t.references)
+      if (r.status == "failed") {
+        first_failure = r.reason.starts_with(r.source) ? fmt::format(" ({})", r.reason)
+                                                       : fmt::format(" ({}: {})", r.source, r.reason);
+        break;
+      }
     distrust(t,
-             ok.size() < 2 ? fmt::format("only {} of {} references completed, and no closed form to check them",
-                                         ok.size(), t.references.size())
+             ok.size() < 2 ? fmt::format("only {} of {} references completed, and no closed form to check them{}",
+                                         ok.size(), t.references.size(), first_failure)
                            : fmt::format("no two references agree within {:.1e} (best pair {} and {}: {:.3e})",
                                          t.agreement_limit, ok[best_i]->source, ok[best_k]->source, best),
              problem.dim());

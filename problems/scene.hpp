@@ -63,12 +63,15 @@ struct scene_data {
   std::vector<spring> anchored, between_moving;
 
   // A wall: the half-space {x : normal . x >= offset}, the normal a unit vector (the file's
-  // divided by its length, the offset with it), with the lecture's collision response.
+  // divided by its length, the offset with it), with the lecture's collision response and
+  // Coulomb's friction on the impulse (contact_scene::resolve_contacts).
   struct plane {
     std::array<double, 3> normal{};
     double offset = 0.0;
-    double restitution = 1.0;  // k_r
-    double friction = 0.0;     // k_f
+    double restitution = 1.0;      // k_r
+    double friction = 0.0;         // mu_k, Coulomb's kinetic coefficient
+    double static_friction = 0.0;  // mu_s, Coulomb's static coefficient
+    double tangential_loss = 0.0;  // the lecture's k_f
   };
   std::vector<plane> planes;
 
@@ -415,9 +418,19 @@ struct scene {
 // planes resolved as problems/bouncing_ball.hpp resolves the ball's with the ground, at
 // the end of each step (core/drive.hpp's end_of_step): a mass found on a plane's wrong
 // side, n . x < offset, is moved back onto it along n, and if it approaches, its velocity
-// v_n = (v . n) n, v_t = v - v_n becomes (1 - k_f) v_t - k_r v_n. The references locate
-// the contacts (CVODE's root finding on contact_gap). A type of its own: the methods that
-// run on problems with contacts are another set (no peers, no Verner pairs).
+// v_n = (v . n) n, v_t = v - v_n becomes v_t' - k_r v_n (the lecture's response).
+//
+// v_t' is Coulomb's law applied to the contact's impulse, as impulse-based engines do
+// (Box2D's contact solver clamps the tangent impulse to mu times the normal impulse):
+// the normal impulse per unit mass is j = (1 + k_r) |v_n|; the slip stops if |v_t| <=
+// mu_s j (static friction holds), else it loses mu_k j of its speed (kinetic). The
+// lecture's k_f then takes its share: v_t' = (1 - k_f) v_t''. On a mass resting on the
+// plane (k_r = 0), the step's normal impulse is what the force pressed into the plane
+// over dt, so the slip slows by mu_k |F_n| dt / m a step: Coulomb's sliding friction,
+// F = mu_k |F_n|, and the block sticks where tan(theta) <= mu_s, as the lecture's incline
+// (tests/test_scenes.cpp checks both). The references locate the contacts (CVODE's root
+// finding on contact_gap). A type of its own: the methods that run on problems with
+// contacts are another set (no peers, no Verner pairs).
 struct contact_scene : scene {
   using scene::scene;
   contact_scene defaults() const { return contact_scene(data); }
@@ -442,10 +455,19 @@ struct contact_scene : scene {
         c.depth = std::max(c.depth, -g);
         c.changed = c.changed || g < 0.0;
         for (int k = 0; k < d; ++k) x[d * i + k] -= g * p.normal[static_cast<std::size_t>(k)];  // onto the plane
-        if (vn < 0.0) {  // approaching: v_b = (1 - k_f) v_t - k_r v_n
+        if (vn < 0.0) {        // approaching: v_b = v_t' - k_r v_n
+          double slip2 = 0.0;  // |v_t|^2
+          for (int k = 0; k < d; ++k) {
+            const double t = v[d * i + k] - vn * p.normal[static_cast<std::size_t>(k)];
+            slip2 += t * t;
+          }
+          const double impulse = -(1.0 + p.restitution) * vn, slip = std::sqrt(slip2);
+          double keep = 1.0 - p.tangential_loss;  // v_t' = keep v_t
+          if (p.friction != 0.0 || p.static_friction != 0.0)
+            keep *= slip <= p.static_friction * impulse ? 0.0 : std::max(0.0, 1.0 - p.friction * impulse / slip);
           for (int k = 0; k < d; ++k) {
             const double nk = p.normal[static_cast<std::size_t>(k)];
-            v[d * i + k] = (1.0 - p.friction) * (v[d * i + k] - vn * nk) - p.restitution * vn * nk;
+            v[d * i + k] = keep * (v[d * i + k] - vn * nk) - p.restitution * vn * nk;
           }
           ++c.resolved;
           c.changed = true;

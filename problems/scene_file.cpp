@@ -348,9 +348,7 @@ scene_data parse_scene(std::string_view text, const std::string& path) {
     for (const auto& node : *planes) {
       const auto& t = *node.as_table();
       const place here = at(t);
-      r.only(t, "[[plane]]", {"normal", "offset", "restitution", "friction", "static_friction"});
-      if (const auto* st = t.get("static_friction"))
-        r.fail(at(*st), "'static_friction': a plane's static friction is not built yet (docs/scenes.md); leave it out");
+      r.only(t, "[[plane]]", {"normal", "offset", "restitution", "friction", "static_friction", "tangential_loss"});
       const auto& normal = r.need(t, "normal", here, " in [[plane]]");
       const auto n = r.vector(normal, "normal", s.dim);
       double length2 = 0.0;
@@ -364,9 +362,14 @@ scene_data parse_scene(std::string_view text, const std::string& path) {
       if (const auto* k = t.get("restitution"))
         pl.restitution = r.number(
             *k, "restitution", [](double v) { return v >= 0 && v <= 1; }, "in [0, 1]");
-      if (const auto* k = t.get("friction"))
-        pl.friction = r.number(
-            *k, "friction", [](double v) { return v >= 0 && v <= 1; }, "in [0, 1]");
+      const auto non_negative = [](double v) { return v >= 0; };
+      if (const auto* k = t.get("friction")) pl.friction = r.number(*k, "friction", non_negative, ">= 0");
+      pl.static_friction = pl.friction;  // one coefficient unless the file gives both
+      if (const auto* k = t.get("static_friction"))
+        pl.static_friction = r.number(*k, "static_friction", non_negative, ">= 0");
+      if (const auto* k = t.get("tangential_loss"))
+        pl.tangential_loss = r.number(
+            *k, "tangential_loss", [](double v) { return v >= 0 && v <= 1; }, "in [0, 1]");
       // Every moving mass starts on the plane's side.
       for (const auto& m : s.masses) {
         if (m.fixed) continue;

@@ -211,9 +211,11 @@ class cvode_session {
         check("CVodeReInit", CVodeReInit(h_.mem, t, h_.y));
       } else if (gap < 0.0) {
         // A root the problem did not resolve, with the bodies already overlapping: the
-        // one gap function would stay negative and hide every later contact.
+        // one gap function would stay negative and hide every later contact. The response
+        // leaves a body that does not approach (a body resting or sliding on a wall).
         throw std::runtime_error(std::string(source_) + ": a contact at t=" + detail::num(t) +
-                                 " that the problem did not resolve (the gap stays negative)");
+                                 " that the problem did not resolve (the gap stays negative): a body resting or "
+                                 "sliding on a wall is a lasting contact, which root location cannot follow");
       }
       flag = CVode(h_.mem, tout, h_.y, &t, CV_NORMAL);
     }
@@ -222,6 +224,19 @@ class cvode_session {
     const auto y = st_.plain(N_VGetArrayPointer(h_.y));
     if (!std::all_of(y.begin(), y.end(), [](double v) { return std::isfinite(v); }))
       throw std::runtime_error(std::string(source_) + ": non-finite state at t=" + detail::num(tout));
+    // Root location sees a contact where the gap crosses zero. A body that starts on a
+    // wall and stays pressed to it (resting, sliding) never makes the gap cross: it would
+    // pass through the wall unseen. Between located contacts the gap is never below
+    // round-off; anything deeper is that, and the reference fails with the reason.
+    if (sys_.has_contacts()) {
+      double scale = 1.0;
+      for (const double v : y) scale = std::max(scale, std::abs(v));
+      if (const double gap = sys_.contact_gap(tout, y); gap < -1e-9 * scale)
+        throw std::runtime_error(std::string(source_) + ": a body went through a contact unseen by t=" +
+                                 detail::num(tout) + " (gap " + detail::num(gap) +
+                                 "): a body resting or sliding on a wall is a lasting contact, which root location "
+                                 "cannot follow");
+    }
     return y;
   }
 

@@ -26,15 +26,19 @@ std::string load_scene(const std::string& path) {
       throw std::invalid_argument(
           fmt::format("{}:{}:{}: the scene's name '{}' is a built-in problem's; give it another", path, data->name_line,
                       data->name_column, data->name));
-  for (const auto& s : scenes())
-    if (s.name == data->name) {
-      if (s.path == path) return s.name;  // the same file twice
-      throw std::invalid_argument(fmt::format("{}:{}:{}: the scene's name '{}' is taken by the scene file {}", path,
-                                              data->name_line, data->name_column, data->name, s.path));
-    }
   std::ifstream in(path, std::ios::binary);
   const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  scenes().push_back({data->name, path, fnv1a_64_hex(bytes), std::move(data)});
+  const std::string hash = fnv1a_64_hex(bytes);
+  for (auto& s : scenes())
+    if (s.name == data->name) {
+      if (s.path != path)
+        throw std::invalid_argument(fmt::format("{}:{}:{}: the scene's name '{}' is taken by the scene file {}", path,
+                                                data->name_line, data->name_column, data->name, s.path));
+      // The same file again: as it reads now (problems made from the earlier reading keep it).
+      if (s.fnv1a_64 != hash) s = {data->name, path, hash, std::move(data)};
+      return s.name;
+    }
+  scenes().push_back({data->name, path, hash, std::move(data)});
   return scenes().back().name;
 }
 

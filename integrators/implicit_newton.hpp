@@ -17,7 +17,9 @@
 // (4 eps (|v1| + |v0| + h |F| / m); that last update applied), or until the update stops
 // decreasing once it is small (the rounding floor of the residual: x1 = x0 + h v1
 // cancels when h^2 |dF/dx| >> m, a stiff spring at a large step), or until the residual
-// is subnormal (a decayed state). No tolerance relative to the residual's size: a test
+// is subnormal (a decayed state), or, where no iterate reduces the residual, until the
+// update moves x1 by a few of its ulps (a motion decayed about an equilibrium away from
+// the origin: position_floor). No tolerance relative to the residual's size: a test
 // like |r| < 1e-12 (m |v1| + h |F|) is met by small steps after one update, and its error
 // accumulates over the steps.
 //
@@ -224,7 +226,7 @@ struct backward_euler_newton {
         // No descent: converged if the update is at the residual's rounding floor (where
         // no matrix makes the residual fall); else, with a fresh Jacobian, no root from
         // here, and with a stale one, retry from the same iterate with a fresh one.
-        if (update <= floor_update * scale) return true;
+        if (update <= floor_update * scale || update <= position_floor(h)) return true;
         if (fresh) return false;
         refresh = true;
         continue;
@@ -240,8 +242,14 @@ struct backward_euler_newton {
       r_norm = r_try_norm;
       last_update = update;  // the full Newton step: the distance to the root it estimates
     }
-    return last_update <= floor_update * velocity_scale(m, h, v0);
+    return last_update <= floor_update * velocity_scale(m, h, v0) || last_update <= position_floor(h);
   }
+
+  // The velocity update that moves x1 = x0 + h v1 by a few of x1's own ulps: below it the
+  // residual is x1's rounding, whatever the velocities. A motion decayed about an
+  // equilibrium away from the origin (a mass at rest on a spring at x = 1.5 m) has
+  // velocities far below it, and the tests on the velocity terms alone would never pass.
+  double position_floor(double h) const { return round_off * x1.template lpNorm<Eigen::Infinity>() / h; }
 
   // The size of the velocity terms of the equation, for the round-off tests.
   double velocity_scale(double m, double h, const Vec& v0) const {

@@ -6,13 +6,16 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "cli/args.hpp"
 #include "cli/commands.hpp"
 #include "core/work_precision.hpp"
+#include "registry/registry.hpp"
 #include "render/table_render.hpp"
 #include "study/energy.hpp"
 
@@ -30,6 +33,9 @@ using json = nlohmann::json;
 struct energy_args {
   bool json = false;
   double periods = 1e4;
+  std::optional<double> period;
+  int steps_per_period = 64;
+  bool steps_given = false;
   std::vector<std::string> problems, sets;
 };
 
@@ -39,16 +45,39 @@ std::string signed_sci(double v) { return std::isfinite(v) ? fmt::format("{:+.2e
 int run_energy(const energy_args& a) {
   energy_options opts;
   opts.periods = a.periods;
+  if (a.period && !(std::isfinite(*a.period) && *a.period > 0.0))
+    throw std::invalid_argument(fmt::format("--period must be a time > 0 s, got {:g}", *a.period));
+  if (a.steps_given && (a.steps_per_period < 1 || a.steps_per_period % opts.samples_per_period != 0))
+    throw std::invalid_argument(fmt::format("--steps-per-period must be a positive multiple of {}, got {}",
+                                            opts.samples_per_period, a.steps_per_period));
   if (!a.problems.empty()) {
+    // pendulum and kepler as the study sets them up; any other problem with an energy (a
+    // built-in or a scene file's) at --steps-per-period steps of --period, by default its
+    // horizon (a scene has no period of its own).
     std::vector<energy_scene> chosen;
     for (const auto& name : a.problems) {
-      bool found = false;
-      for (const auto& s : opts.scenes)
-        if (s.problem == name) chosen.push_back(s), found = true;
-      if (!found)
-        throw std::invalid_argument(fmt::format("the energy study runs on pendulum and kepler, not {}", name));
+      const auto known = std::find_if(opts.scenes.begin(), opts.scenes.end(),
+                                      [&](const energy_scene& s) { return s.problem == name; });
+      energy_scene s;
+      if (known != opts.scenes.end())
+        s = *known;
+      else
+        s.problem = name;
+      if (a.steps_given) s.steps_per_period = a.steps_per_period;
+      const auto p = make_problem(name);  // names an unknown problem
+      if (!p->has_energy()) throw std::invalid_argument(fmt::format("problem {} has no energy to follow", name));
+      if (std::isfinite(p->period())) {
+        if (a.period)
+          throw std::invalid_argument(fmt::format("problem {} has a period of its own; leave out --period", name));
+      } else {
+        s.period = a.period.value_or(p->horizon());
+      }
+      chosen.push_back(s);
     }
     opts.scenes = chosen;
+  } else if (a.period) {
+    throw std::invalid_argument(
+        "--period is for a problem without a period of its own: give it with --problem or --scene");
   }
   parameter_overrides overrides;
   std::vector<std::string> names;
@@ -72,8 +101,10 @@ int run_energy(const energy_args& a) {
     return 0;
   }
   for (const auto& p : s.problems) {
-    fmt::print("{}: {:g} periods of {:.6g} s, dt = {:.6g} s ({} a period); E0 = {:.6g} J{}\n", p.problem, opts.periods,
-               p.period, p.dt, count_of(p.steps_per_period, "step"), p.e0,
+    const bool own_period = std::isfinite(make_problem(p.problem)->period());
+    fmt::print("{}: {:g} periods of {:.6g} s{}, dt = {:.6g} s ({} a period); E0 = {:.6g} J{}\n", p.problem,
+               opts.periods, p.period, own_period ? "" : " (no period of its own: --period, default the horizon)", p.dt,
+               count_of(p.steps_per_period, "step"), p.e0,
                std::isfinite(p.l0) ? fmt::format(", L0 = {:.6g} kg m^2/s", p.l0) : "");
     // Relative errors (dE/E, dL/L: no unit); the drifts per period of the problem.
     table t{{"method", right_column("max |dE|/E"), right_column("final dE/E"), right_column("dE/E drift", "1/period"),
@@ -105,10 +136,18 @@ int run_energy(const energy_args& a) {
 
 command add_energy(CLI::App& app) {
   auto a = std::make_shared<energy_args>();
-  auto* sub = app.add_subcommand("energy", "long-run energy of the fixed-step integrators on pendulum and kepler");
+  auto* sub = app.add_subcommand(
+      "energy",
+      "long-run energy of the fixed-step integrators on pendulum and kepler, or any problem or scene with one");
   sub->add_flag("--json", a->json, "print JSON: one record per problem and integrator");
   sub->add_option("--periods", a->periods, "periods to run (whole number)")->capture_default_str();
-  sub->add_option("--problem", a->problems, "pendulum and/or kepler (repeatable; default both)");
+  sub->add_option("--problem", a->problems,
+                  "a problem with an energy (repeatable; default pendulum and kepler); --scene FILE for a scene file");
+  sub->add_option("--period", a->period,
+                  "the drift's time unit for a problem without a period of its own [s] (default its horizon)");
+  sub->add_option("--steps-per-period", a->steps_per_period,
+                  "fixed steps a period (a multiple of 32; default 64, kepler's 1024)")
+      ->each([a](const std::string&) { a->steps_given = true; });
   sub->add_option("--set", a->sets,
                   "override a parameter, problem.name=value, or name=value with one --problem (repeatable)");
   return {sub, [a] { return run_energy(*a); }};

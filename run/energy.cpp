@@ -137,12 +137,16 @@ energy_study run_energy_study(const energy_options& opts,
       throw std::invalid_argument(fmt::format("energy study: {}: steps_per_period must be a positive multiple of {}",
                                               scene.problem, opts.samples_per_period));
     const auto p = configured_problem(scene.problem, configure);
-    if (!std::isfinite(p->period()) || !p->has_energy())
-      throw std::invalid_argument(fmt::format("energy study: problem {} has no period or no energy", scene.problem));
+    if (!p->has_energy())
+      throw std::invalid_argument(fmt::format("energy study: problem {} has no energy to follow", scene.problem));
+    const double period = std::isfinite(p->period()) ? p->period() : scene.period;
+    if (!(std::isfinite(period) && period > 0.0))
+      throw std::invalid_argument(
+          fmt::format("energy study: problem {} has no period: give one (--period)", scene.problem));
     energy_problem ep;
     ep.problem = scene.problem;
     ep.params = p->params();
-    ep.period = p->period();
+    ep.period = period;
     ep.steps_per_period = scene.steps_per_period;
     ep.dt = ep.period / scene.steps_per_period;
     ep.horizon = static_cast<double>(std::llround(opts.periods) * scene.steps_per_period) * ep.dt;

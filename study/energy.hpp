@@ -19,6 +19,7 @@
 // Numerical Integration, 2nd ed., ch. IX): its error oscillates without drift; explicit
 // Euler and the explicit midpoint rule gain energy on oscillators, RK4 loses it.
 // Runs through the registry's drive loops, like every study row.
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -32,6 +33,9 @@ struct energy_scene {
   std::string problem;
   int steps_per_period = 64;
   std::map<std::string, double> params;  // the scene's own defaults; the user's --set wins
+  // The time unit of the drift: the problem's period where it has one (pendulum, kepler);
+  // else this, which `stepbench energy` sets to --period or the problem's horizon.
+  double period = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct energy_options {

@@ -68,7 +68,7 @@ assert len(rope) == 1 and rope[0]["dim"] == 189, rope
 assert "duration" in [q["name"] for q in rope[0]["parameters"]], rope' && ok || bad "list --scene"
 
 # sweep --scene: its rows and fitted orders in the study, the file recorded.
-"$bin" sweep --scene "$scenes/damped_spring.toml" --scene "$scenes/pleiades.toml" --quick --parts sweep --quiet \
+"$bin" sweep --scene "$scenes/damped_spring.toml" --scene "$scenes/pleiades.toml" --quick --parts sweep,verdict --quiet \
   --out "$work/s.h5" 2>"$work/err" ||
   bad "sweep --scene: $(cat "$work/err")"
 /usr/bin/python3 - "$work/s.h5" <<'PY' && ok || bad "the sweep's study of pleiades"
@@ -84,6 +84,15 @@ with h5py.File(sys.argv[1]) as f:
     assert 3.8 < order < 4.2, order
 PY
 
+# The report of one scene: --scene FILE finds its name in the study's `scenes`.
+/usr/bin/python3 "$src/scripts/report" "$work/s.h5" --scene "$scenes/pleiades.toml" --markdown "$work/p.md" \
+  >/dev/null 2>"$work/err" && grep -q "^| pleiades" "$work/p.md" && ! grep -q "^| damped_spring_file" "$work/p.md" && ok ||
+  bad "report --scene: $(cat "$work/err") $(head -c 300 "$work/p.md")"
+/usr/bin/python3 "$src/scripts/report" "$work/s.h5" --scene "$scenes/web.toml" --markdown "$work/never.md" \
+  >/dev/null 2>"$work/err"
+[ $? -eq 2 ] && grep -q "not one of the study's scene files (damped_spring_file" "$work/err" && [ ! -e "$work/never.md" ] &&
+  ok || bad "report --scene of a file the study did not run: $(cat "$work/err")"
+
 # advise --scene --hz: the frame-rate answer, run here (the study lacks the scene).
 out=$("$bin" advise --scene "$scenes/cloth.toml" --hz 60 --tol 1e-3 --study "$work/none.h5" 2>"$work/err")
 rc=$?
@@ -97,6 +106,40 @@ grep -q "cloth" <<<"$out$(cat "$work/err")" && ok || bad "advise --scene names t
 "$bin" loop --scene "$scenes/web.toml" --integrator semi_implicit_euler --design fixed --json >"$work/out" 2>"$work/err" &&
   /usr/bin/python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["problem"] == "web", d' "$work/out" &&
   ok || bad "loop --scene: $(cat "$work/err") $(head -c 300 "$work/out")"
+
+# energy --scene: an undamped mass on a spring, the period its horizon: explicit Euler
+# gains energy, implicit Euler loses it (to rest about x = 1 m: its Newton solve ends at
+# x's round-off), semi-implicit Euler's error stays bounded.
+cat >"$work/spring.toml" <<'TOML'
+name = "undamped_spring"
+dim = 1
+horizon = 0.6283185307179586
+[[mass]]
+position = [0.0]
+fixed = true
+[[mass]]
+mass = 1.0
+position = [1.5]
+[[spring]]
+between = [0, 1]
+stiffness = 100.0
+rest_length = 1.0
+TOML
+"$bin" energy --scene "$work/spring.toml" --periods 200 --json >"$work/out" 2>"$work/err" &&
+  /usr/bin/python3 - "$work/out" <<'PY' && ok || bad "energy --scene: $(cat "$work/err") $(head -c 300 "$work/out")"
+import json, sys
+runs = {r["method"]: r for r in json.load(open(sys.argv[1]))}
+assert all(r["problem"] == "undamped_spring" and r["steps_per_period"] == 64 for r in runs.values()), runs
+assert runs["euler"]["drift_sign"] == 1, runs["euler"]
+assert runs["implicit_euler"]["completed"] and runs["implicit_euler"]["drift_sign"] == -1, runs["implicit_euler"]
+assert runs["semi_implicit_euler"]["verdict"] == "bounded", runs["semi_implicit_euler"]
+PY
+"$bin" energy --scene "$work/spring.toml" --periods 10 --period 0.1 --steps-per-period 32 >"$work/out" 2>"$work/err" &&
+  grep -q "undamped_spring: 10 periods of 0.1 s (no period of its own" "$work/out" && ok ||
+  bad "energy --period: $(cat "$work/err" "$work/out")"
+expect_error "problem pendulum has a period of its own; leave out --period" energy --problem pendulum --period 2
+expect_error "--steps-per-period must be a positive multiple of 32, got 50" energy --scene "$work/spring.toml" \
+  --steps-per-period 50
 
 # stepbench_bench --scene=: swept and timed as a problem.
 "$bench" --quick --scene="$scenes/damped_spring.toml" --parts=sweep --benchmark_min_time=0.0001 \

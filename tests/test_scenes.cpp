@@ -212,6 +212,32 @@ TEST(scene_files, a_block_on_a_wall_with_friction_follows_the_lecture_incline) {
   }
 }
 
+// Implicit Euler damps an undamped spring to rest at its rest length, 1 m from the anchor:
+// its Newton solve must end there, though the velocities fall far below the position's
+// ulps over h (the solve failed at t = 42 s before integrators/implicit_newton.hpp's
+// position_floor). Amplitude 0.5 m, omega = 10/s, dt = 0.01 s: (1 + (omega dt)^2)^(-n/2).
+TEST(scene_files, implicit_euler_settles_at_an_equilibrium_away_from_the_origin) {
+  const std::string path = testing::TempDir() + "/settle.toml";
+  std::ofstream(path) << R"(name = "settle"
+dim = 1
+horizon = 80.0
+[[mass]]
+position = [0.0]
+fixed = true
+[[mass]]
+mass = 1.0
+position = [1.5]
+[[spring]]
+between = [0, 1]
+stiffness = 100.0
+rest_length = 1.0
+)";
+  const auto p = make_problem(load_scene(path));
+  const run_result r = p->run("implicit_euler", 0.01, 80.0, std::vector<double>{80.0});
+  ASSERT_TRUE(r.stop_reason.empty()) << r.stop_reason;
+  EXPECT_NEAR(r.final_y[0], 1.0, 0.5 * std::pow(1.0 + 0.01, -8000.0 / 2) + 4e-15);
+}
+
 // Free fall: x = x0 + v0 t + g t^2 / 2 exactly (every method of order >= 2 is exact on it).
 TEST(scene_files, free_fall_is_exact) {
   const std::string text = R"(name = "free_fall"

@@ -141,6 +141,29 @@ def _answers(s, args, argv, readme_text):
     return 0
 
 
+def _scene_name(study_path, scene_file):
+    """The name of the scene the study ran from `scene_file` (its root attribute `scenes`:
+    name, path as given to stepbench, FNV-1a 64 of the bytes), by the file's real path, or
+    by its file name where one scene has it; None after a one-line error."""
+    import json
+    import h5py
+    with h5py.File(study_path, "r") as f:
+        raw = f.attrs.get("scenes")
+    entries = json.loads(raw) if raw is not None else []
+    if not entries:
+        print(f"report: error: --scene {scene_file}: '{study_path}' ran no scene file", file=sys.stderr)
+        return None
+    want = os.path.realpath(scene_file)
+    found = [e for e in entries if os.path.realpath(e["path"]) == want]
+    if not found:
+        found = [e for e in entries if os.path.basename(e["path"]) == os.path.basename(scene_file)]
+    if len(found) != 1:
+        ran = ", ".join(f"{e['name']} ({e['path']})" for e in entries)
+        print(f"report: error: --scene {scene_file}: not one of the study's scene files ({ran})", file=sys.stderr)
+        return None
+    return found[0]["name"]
+
+
 def main(argv=None, start=None):
     start = time.perf_counter() if start is None else start
     argv = sys.argv[1:] if argv is None else list(argv)
@@ -157,6 +180,8 @@ def main(argv=None, start=None):
                     help="study file, or scan file (default: %(default)s)")
     ap.add_argument("--out", default=None, help="report folder (default: results/report)")
     ap.add_argument("--problem", metavar="P", help="a report (or --markdown, --readme) of this problem only")
+    ap.add_argument("--scene", metavar="FILE", help="a report of the scene this file declares only (as --problem "
+                    "with its name: the study's `scenes` record which file each scene came from)")
     ap.add_argument("--hz", type=_rate, default=None, metavar="H",
                     help="the frame rate the index answers for, one the study ran (default: 60 where it ran it)")
     ap.add_argument("--tol", type=_tolerances, action="extend", default=None, metavar="X",
@@ -197,6 +222,13 @@ def main(argv=None, start=None):
         print(f"report: error: unknown problem '{args.problem}' (the study has "
               f"{', '.join(p.name for p in s.problems)})", file=sys.stderr)
         return 2
+    if args.scene is not None:
+        if args.problem is not None:
+            print("report: error: give --problem or --scene, not both", file=sys.stderr)
+            return 2
+        args.problem = _scene_name(args.study, args.scene)
+        if args.problem is None:
+            return 2
     if (status := _frame_choice(s, args)) is not None:
         return status
     if args.markdown or args.readme:

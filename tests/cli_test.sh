@@ -1,26 +1,10 @@
 #!/usr/bin/env bash
 # The command line as a user meets it: the lecture's example through `run --json`, and
-# every kind of bad input getting one line on stderr, a non-zero exit, and an existing
-# results file left as it was.
+# every kind of bad input getting one line on stderr, exit 2 (1 for a file it cannot read or
+# write), and an existing results file left as it was.
 set -u
 bin=${1:?usage: cli_test.sh path/to/stepbench}
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0 passes=0
-ok() { passes=$((passes + 1)); }
-bad() { echo "FAIL: $*"; fails=$((fails + 1)); }
-
-# expect_error "<what the message must contain>" args...
-expect_error() {
-  local want=$1; shift
-  "$bin" "$@" >"$work/out" 2>"$work/err"
-  local rc=$?
-  local lines; lines=$(wc -l <"$work/err")
-  if [ "$rc" -eq 0 ]; then bad "exit 0 for: $*"; return; fi
-  if [ "$lines" -ne 1 ]; then bad "$lines lines on stderr for: $* :: $(cat "$work/err")"; return; fi
-  grep -qi -- "$want" "$work/err" || { bad "message lacks '$want' for: $* :: $(cat "$work/err")"; return; }
-  ok
-}
+. "$(dirname "${BASH_SOURCE[0]}")/expect.sh"
 
 # The lecture's example: 450 m with explicit Euler, exact 500 m.
 out=$("$bin" run --problem constant_acceleration --integrator euler --dt 1 --json) || bad "run --json failed"
@@ -92,30 +76,30 @@ assert abs(d["err_pos_final"] - worst) <= 1e-15 * worst, d
   /usr/bin/python3 -c 'import json,sys; d=json.load(sys.stdin); assert abs(d["position"][0]-1000.0) < 1e-9, d' && ok || bad "--set"
 
 # Bad input.
-expect_error "unknown problem 'nope'" run --problem nope --integrator rk4 --dt 0.1
-expect_error "unknown method 'rk5'" run --problem pendulum --integrator rk5 --dt 0.1
-expect_error "--dt must be > 0" run --problem pendulum --integrator rk4 --dt 0
-expect_error "--dt must be > 0" run --problem pendulum --integrator rk4 --dt -1
-expect_error "--dt must be a finite number, got 'abc'" run --problem pendulum --integrator rk4 --dt abc
-expect_error "--dt must be a finite number, got 'nan'" run --problem pendulum --integrator rk4 --dt nan
-expect_error "--dt must be a finite number, got '0.1x'" run --problem pendulum --integrator rk4 --dt 0.1x
-expect_error "--horizon must be > 0" run --problem pendulum --integrator rk4 --dt 0.1 --horizon 0
-expect_error "--horizon must be a finite number" run --problem pendulum --integrator rk4 --dt 0.1 --horizon inf
-expect_error "malformed --set 'theta0_deg'" run --problem pendulum --integrator rk4 --dt 0.1 --set theta0_deg
-expect_error "malformed --set '=3'" run --problem pendulum --integrator rk4 --dt 0.1 --set =3
-expect_error "--set pendulum.theta0_deg must be a finite number, got 'big'" run --problem pendulum --integrator rk4 --dt 0.1 --set theta0_deg=big
-expect_error "unknown parameter 'k' for problem pendulum" run --problem pendulum --integrator rk4 --dt 0.1 --set k=1
-expect_error "theta0_deg must be in (0, 180)" run --problem pendulum --integrator rk4 --dt 0.1 --set theta0_deg=200
-expect_error "--problem is required" run --integrator rk4 --dt 0.1
-expect_error "unknown problem 'nope'" sweep --problem nope --out "$work/s.h5"
-expect_error "unknown method 'rk5'" sweep --integrator rk5 --out "$work/s.h5"
-expect_error "cannot write results file '$work/missing/s.h5'" sweep --levels 3 --out "$work/missing/s.h5"
-expect_error "it is a directory" sweep --levels 3 --out "$work"
+expect_error_re "unknown problem 'nope'" run --problem nope --integrator rk4 --dt 0.1
+expect_error_re "unknown method 'rk5'" run --problem pendulum --integrator rk5 --dt 0.1
+expect_error_re "--dt must be > 0" run --problem pendulum --integrator rk4 --dt 0
+expect_error_re "--dt must be > 0" run --problem pendulum --integrator rk4 --dt -1
+expect_error_re "--dt must be a finite number, got 'abc'" run --problem pendulum --integrator rk4 --dt abc
+expect_error_re "--dt must be a finite number, got 'nan'" run --problem pendulum --integrator rk4 --dt nan
+expect_error_re "--dt must be a finite number, got '0.1x'" run --problem pendulum --integrator rk4 --dt 0.1x
+expect_error_re "--horizon must be > 0" run --problem pendulum --integrator rk4 --dt 0.1 --horizon 0
+expect_error_re "--horizon must be a finite number" run --problem pendulum --integrator rk4 --dt 0.1 --horizon inf
+expect_error_re "malformed --set 'theta0_deg'" run --problem pendulum --integrator rk4 --dt 0.1 --set theta0_deg
+expect_error_re "malformed --set '=3'" run --problem pendulum --integrator rk4 --dt 0.1 --set =3
+expect_error_re "--set pendulum.theta0_deg must be a finite number, got 'big'" run --problem pendulum --integrator rk4 --dt 0.1 --set theta0_deg=big
+expect_error_re "unknown parameter 'k' for problem pendulum" run --problem pendulum --integrator rk4 --dt 0.1 --set k=1
+expect_error_re "theta0_deg must be in (0, 180)" run --problem pendulum --integrator rk4 --dt 0.1 --set theta0_deg=200
+expect_error_re "--problem is required" run --integrator rk4 --dt 0.1
+expect_error_re "unknown problem 'nope'" sweep --problem nope --out "$work/s.h5"
+expect_error_re "unknown method 'rk5'" sweep --integrator rk5 --out "$work/s.h5"
+expect_file_error "cannot write results file '$work/missing/s.h5'" sweep --levels 3 --out "$work/missing/s.h5"
+expect_file_error "it is a directory" sweep --levels 3 --out "$work"
 
 # An existing results file survives every failed sweep, byte for byte.
 echo "previous results" >"$work/study.h5"
-expect_error "unknown parameter 'zzz'" sweep --problem pendulum --set zzz=1 --out "$work/study.h5"
-expect_error "levels must be between 2 and 20" sweep --levels 1 --out "$work/study.h5"
+expect_error_re "unknown parameter 'zzz'" sweep --problem pendulum --set zzz=1 --out "$work/study.h5"
+expect_error_re "levels must be between 2 and 20" sweep --levels 1 --out "$work/study.h5"
 [ "$(cat "$work/study.h5")" = "previous results" ] && ok || bad "existing results file was touched"
 [ -z "$(ls "$work" | grep tmp)" ] && ok || bad "temporary file left behind: $(ls "$work")"
 
@@ -152,7 +136,7 @@ grep -q '^compiler: .*; flags: ' "$work/out" && grep -q '^dependencies: .*Google
 
 # Usage errors exit 2 with one line naming what is wrong.
 expect_usage() {
-  expect_error "$@"
+  expect_error_re "$@"
   shift
   "$bin" "$@" >/dev/null 2>&1
   local rc=$?
@@ -193,13 +177,13 @@ grep -q 'e+0[0-9] ns' "$work/out" && bad "loop prints powers of ten of ns: $(cat
 
 # scan: one line and exit 2 for a bad axis; the answer as JSON on stdout, progress on
 # stderr; advise --scan answers from the file; a file without a scan is exit 1.
-expect_error "outside the parameter's range: k_s must be a positive finite number" scan --problem stiff_spring --param stiff_spring.k_s=-1:1e7:5 --out "$work/scan.h5"
-expect_error "stiff_spring has no parameter 'kk'" scan --problem stiff_spring --param stiff_spring.kk=1:2:3 --out "$work/scan.h5"
-expect_error "frame rate 45 Hz does not divide the fastest, 60 Hz" scan --problem stiff_spring --param stiff_spring.k_s=1:2:3 --hz 60,45 --out "$work/scan.h5"
+expect_error_re "outside the parameter's range: k_s must be a positive finite number" scan --problem stiff_spring --param stiff_spring.k_s=-1:1e7:5 --out "$work/scan.h5"
+expect_error_re "stiff_spring has no parameter 'kk'" scan --problem stiff_spring --param stiff_spring.kk=1:2:3 --out "$work/scan.h5"
+expect_error_re "frame rate 45 Hz does not divide the fastest, 60 Hz" scan --problem stiff_spring --param stiff_spring.k_s=1:2:3 --hz 60,45 --out "$work/scan.h5"
 # Rates and horizons are bounded before anything is allocated (a scan at 1e9 Hz grew past
 # 8 GB): 0.533 s x 1e9 Hz = 5.33e8 frame ends, refused; a grid point over the bound is not
 # run, with the reason, and the scan goes on (durations 1 and 1e9 s at 240 Hz).
-expect_error "scan: 5.33e+08 frame ends (1e+09 Hz over 0.533 s); the limit is 1e+07" \
+expect_error_re "scan: 5.33e+08 frame ends (1e+09 Hz over 0.533 s); the limit is 1e+07" \
   scan --problem stiff_spring --param stiff_spring.k_s=1e1:1e7:5:log --hz 1e9 --out "$work/scan.h5"
 "$bin" scan --problem stiff_spring --param stiff_spring.duration=1:1e9:2:log --hz 240 --integrator rk4 --substeps 16 \
   --quiet --out "$work/long.h5" >/dev/null && /usr/bin/python3 -c '
@@ -230,9 +214,9 @@ grep -q '60 Hz  rk4  *diverges for k_s >= 5.62e+04 N/m' "$work/out" && ok || bad
 [ $? -eq 1 ] && grep -q "cannot read study file '.*none.h5': no such file" "$work/err" && ok ||
   bad "advise --scan of a missing file: $(cat "$work/err")"
 # A scan file given as a study: one line pointing to --scan, with and without --hz.
-expect_error "holds a scan of stiff_spring, not a study: read it with \`stepbench advise --scan" \
+expect_error_re "holds a scan of stiff_spring, not a study: read it with \`stepbench advise --scan" \
   advise --study "$work/scan.h5" --problem stiff_spring --tol 1e-3
-expect_error "holds a scan of stiff_spring, not a study" advise --study "$work/scan.h5" --problem stiff_spring --hz 60 --tol 1e-3
+expect_error_re "holds a scan of stiff_spring, not a study" advise --study "$work/scan.h5" --problem stiff_spring --hz 60 --tol 1e-3
 
 # scan --shard K/N and merge: three shards join to the unsharded scan's answer; a shard
 # twice, a missing shard, another build: one line, exit 2, no file.
@@ -247,16 +231,16 @@ done
 "$bin" advise --scan "$work/merged.h5" --tol 1e-3 >"$work/merged.txt"
 cmp -s "$work/merged.txt" "$work/whole.txt" && ok || bad "the merged scan answers otherwise: $(diff "$work/merged.txt" "$work/whole.txt")"
 cp "$work/shard3.h5" "$work/shard3copy.h5"
-expect_error "grid point .* is in two shards" merge "$work/shard1.h5" "$work/shard2.h5" "$work/shard3.h5" "$work/shard3copy.h5" -o "$work/m2.h5"
-expect_error "is named twice" merge "$work/shard1.h5" "$work/shard1.h5" -o "$work/m2.h5"
-expect_error "4 of 13 grid points are in no shard\|grid points are in no shard" merge "$work/shard1.h5" "$work/shard2.h5" -o "$work/m2.h5"
+expect_error_re "grid point .* is in two shards" merge "$work/shard1.h5" "$work/shard2.h5" "$work/shard3.h5" "$work/shard3copy.h5" -o "$work/m2.h5"
+expect_error_re "is named twice" merge "$work/shard1.h5" "$work/shard1.h5" -o "$work/m2.h5"
+expect_error_re "4 of 13 grid points are in no shard\|grid points are in no shard" merge "$work/shard1.h5" "$work/shard2.h5" -o "$work/m2.h5"
 [ ! -e "$work/m2.h5" ] && ok || bad "a refused merge wrote its file"
 "$bin" merge "$work/shard1.h5" "$work/shard2.h5" --partial -o "$work/m2.h5" 2>"$work/err" && grep -q "lacks .* of 13 grid points (--partial)" "$work/err" && ok ||
   bad "merge --partial: $(cat "$work/err")"
 cp "$work/shard3.h5" "$work/other.h5"
 /usr/bin/python3 -c 'import h5py,sys; f=h5py.File(sys.argv[1],"r+"); f.attrs["git_commit"]="0000000"' "$work/other.h5"
-expect_error "was written by another build" merge "$work/shard1.h5" "$work/shard2.h5" "$work/other.h5" -o "$work/m3.h5"
-expect_error "shard 4 of 3\|1 <= K <= N" scan --problem stiff_spring --param stiff_spring.k_s=1:2:3 --shard 4/3 --out "$work/x.h5"
+expect_error_re "was written by another build" merge "$work/shard1.h5" "$work/shard2.h5" "$work/other.h5" -o "$work/m3.h5"
+expect_error_re "shard 4 of 3\|1 <= K <= N" scan --problem stiff_spring --param stiff_spring.k_s=1:2:3 --shard 4/3 --out "$work/x.h5"
 
 # A 10^4-point scan over 4 local shards (xargs -P 2, the README's recipe) finishes and
 # merges: every grid point once, in grid order, each with its runs.
@@ -276,18 +260,18 @@ assert len(runs) == 10000 * 2 * 2, len(runs)
 fmt_secs=$(/usr/bin/python3 -c "import sys; print(f'{float(sys.argv[2]) - float(sys.argv[1]):.2f}')" "$start" "$(date +%s.%N)")
 echo "10^4-point scan, 4 shards by xargs -P 2, and merge: $fmt_secs s" >&2
 
-expect_error "frame rate 60 Hz is given twice" scan --problem stiff_spring --param stiff_spring.k_s=1:2:3 --hz 60,60 --out "$work/x.h5"
-expect_error "not an HDF5 file" merge "$work/out" "$work/shard1.h5" -o "$work/m4.h5"
+expect_error_re "frame rate 60 Hz is given twice" scan --problem stiff_spring --param stiff_spring.k_s=1:2:3 --hz 60,60 --out "$work/x.h5"
+expect_file_error "not an HDF5 file" merge "$work/out" "$work/shard1.h5" -o "$work/m4.h5"
 
 # Shards run with another --set or other methods are another scan: refused in one line
 # naming what differs and both values.
 "$bin" scan --problem stiff_spring --param stiff_spring.k_s=1e1:1e7:13:log --hz 60 --substeps 1,4 --shard 3/3 \
   --set stiff_spring.mass_kg=2 --quiet --out "$work/set3.h5" >/dev/null || bad "scan --shard 3/3 --set failed"
-expect_error "differ in their fixed parameters (--set): '.*shard1.h5' has none, '.*set3.h5' has mass_kg=2$" \
+expect_error_re "differ in their fixed parameters (--set): '.*shard1.h5' has none, '.*set3.h5' has mass_kg=2$" \
   merge "$work/shard1.h5" "$work/shard2.h5" "$work/set3.h5" -o "$work/m5.h5"
 "$bin" scan --problem stiff_spring --param stiff_spring.k_s=1e1:1e7:13:log --hz 60 --substeps 1,4 --shard 3/3 \
   --method rk4 --quiet --out "$work/rk4only3.h5" >/dev/null || bad "scan --shard 3/3 --method rk4 failed"
-expect_error "differ in their methods: '.*shard1.h5' has .*rk4.*, '.*rk4only3.h5' has rk4$" \
+expect_error_re "differ in their methods: '.*shard1.h5' has .*rk4.*, '.*rk4only3.h5' has rk4$" \
   merge "$work/shard1.h5" "$work/shard2.h5" "$work/rk4only3.h5" -o "$work/m5.h5"
 [ ! -e "$work/m5.h5" ] && ok || bad "a refused merge wrote its file"
 # A shard with no point (more shards than points) is written, read and merged; the merged
@@ -309,7 +293,7 @@ cmp -s "$work/small.txt" "$work/smallwhole.txt" && ok ||
 # A file whose grid_points is not the product of its axes' counts is refused by name.
 cp "$work/whole.h5" "$work/badgrid.h5"
 /usr/bin/python3 -c 'import h5py,sys; f=h5py.File(sys.argv[1],"r+"); f["scan/stiff_spring"].attrs["grid_points"]=14' "$work/badgrid.h5"
-expect_error "cannot read study file '.*badgrid.h5': scan 'stiff_spring': grid_points 14 is not the product of its axes' counts, 13" \
+expect_file_error "cannot read study file '.*badgrid.h5': scan 'stiff_spring': grid_points 14 is not the product of its axes' counts, 13" \
   advise --scan "$work/badgrid.h5" --tol 1e-3
 
 # stepbench_bench, beside stepbench: --help lists our flags, one line each, above Google
@@ -353,5 +337,4 @@ extreme "substeps 2.09715e+06 is not a whole number from 1 to 2^20" scan --probl
   --out "$work/x.h5"
 [ ! -e "$work/x.h5" ] && ok || bad "an extreme value left a file behind"
 
-echo "cli: $passes passed, $fails failed"
-[ "$fails" -eq 0 ]
+finish cli

@@ -6,11 +6,7 @@
 set -u
 bin=${1:?usage: compare_test.sh path/to/stepbench}
 py=/usr/bin/python3
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0 passes=0
-ok() { passes=$((passes + 1)); }
-bad() { echo "FAIL: $*"; fails=$((fails + 1)); }
+. "$(dirname "${BASH_SOURCE[0]}")/expect.sh"
 
 # expect_exit CODE args...: the exit status, and nothing on stderr unless asked.
 expect_exit() {
@@ -130,5 +126,4 @@ expect_cannot "--format" "$work/base.h5" "$work/same.h5" --format xml
 "$bin" compare --help >"$work/help" 2>&1
 grep -q "1e-12 x pos_scale" "$work/help" && grep -q "2 could not" "$work/help" && ok || bad "--help: $(cat "$work/help")"
 
-echo "compare_test: $passes passed, $fails failed"
-[ "$fails" -eq 0 ]
+finish compare_test

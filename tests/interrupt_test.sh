@@ -11,11 +11,7 @@ set -m  # job control: background jobs keep SIGINT's default action (bash ignore
 stepbench=${1:?usage: interrupt_test.sh path/to/stepbench path/to/stepbench_bench path/to/scripts/report}
 bench=${2:?}
 report=${3:?}
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0 passes=0
-ok() { passes=$((passes + 1)); }
-bad() { echo "FAIL: $*"; fails=$((fails + 1)); }
+. "$(dirname "${BASH_SOURCE[0]}")/expect.sh"
 
 snapshot() { (cd "$work" && find . -type f -not -name err -print0 | sort -z | xargs -0 sha256sum); }
 

@@ -8,11 +8,7 @@ set -u
 bin=${1:?usage: one_answer_test.sh path/to/stepbench path/to/timed-study.h5 [path/to/stepbench_bench]}
 timed=${2:?usage: one_answer_test.sh path/to/stepbench path/to/timed-study.h5 [path/to/stepbench_bench]}
 bench=${3:-}
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0 passes=0
-ok() { passes=$((passes + 1)); }
-bad() { echo "FAIL: $*"; fails=$((fails + 1)); }
+. "$(dirname "${BASH_SOURCE[0]}")/expect.sh"
 
 "$bin" advise --study "$timed" --problem spring_chain --hz 60 --tol 1e-3 --json >"$work/advise.json" ||
   bad "advise --hz 60 on the timed study exited $?"
@@ -124,5 +120,4 @@ assert d["choices"][0]["method"] in (None, "rk4"), d["choices"]
 ' && ok || bad "scan --costs with rk4 alone timed"
 fi
 
-echo "one_answer: $passes passed, $fails failed"
-[ "$fails" -eq 0 ]
+finish one_answer

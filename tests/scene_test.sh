@@ -9,24 +9,7 @@ bin=${1:?usage: scene_test.sh stepbench stepbench_bench source-dir}
 bench=${2:?}
 src=${3:?}
 scenes="$src/examples/scenes"
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0 passes=0
-ok() { passes=$((passes + 1)); }
-bad() { echo "FAIL: $*"; fails=$((fails + 1)); }
-
-# expect_error "<what the one line must contain>" args...: exit 2, one line, no study.
-expect_error() {
-  local want=$1; shift
-  "$bin" "$@" >"$work/out" 2>"$work/err"
-  local rc=$?
-  local lines; lines=$(wc -l <"$work/err")
-  if [ "$rc" -ne 2 ]; then bad "exit $rc for: $* :: $(cat "$work/err")"; return; fi
-  if [ "$lines" -ne 1 ]; then bad "$lines lines on stderr for: $* :: $(cat "$work/err")"; return; fi
-  grep -qF -- "$want" "$work/err" || { bad "message lacks '$want' for: $* :: $(cat "$work/err")"; return; }
-  [ ! -e "$work/never.h5" ] || { bad "a study was written for: $*"; return; }
-  ok
-}
+. "$(dirname "${BASH_SOURCE[0]}")/expect.sh"
 
 # scene check: the answer first, then what the file holds.
 out=$("$bin" scene check "$scenes/cloth.toml") || bad "scene check cloth"
@@ -170,5 +153,4 @@ expect_error "empty.toml:1:1: empty scene file" scene check "$work/empty.toml"
 "$bench" --scene="$work/short.toml" >/dev/null 2>"$work/err"
 [ $? -eq 2 ] && grep -q "short.toml:6:12:" "$work/err" && ok || bad "stepbench_bench --scene of a bad file: $(cat "$work/err")"
 
-echo "scene_test: $passes passed, $fails failed"
-[ "$fails" -eq 0 ]
+finish scene_test

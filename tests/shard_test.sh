@@ -9,25 +9,8 @@
 set -u
 bin=${1:?usage: shard_test.sh path/to/stepbench path/to/stepbench_bench}
 bench=${2:?usage: shard_test.sh path/to/stepbench path/to/stepbench_bench}
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-fails=0 passes=0
-ok() { passes=$((passes + 1)); }
-bad() { echo "FAIL: $*"; fails=$((fails + 1)); }
+. "$(dirname "${BASH_SOURCE[0]}")/expect.sh"
 
-# expect_error "<what the message must contain>" args...: one line on stderr, exit 2
-# (expect_failure RC "<message>" args...: exit RC).
-expect_failure() {
-  local code=$1 want=$2; shift 2
-  "$bin" "$@" >"$work/out" 2>"$work/err"
-  local rc=$?
-  local lines; lines=$(wc -l <"$work/err")
-  if [ "$rc" -ne "$code" ]; then bad "exit $rc, not $code, for: $* :: $(cat "$work/err")"; return; fi
-  if [ "$lines" -ne 1 ]; then bad "$lines lines on stderr for: $* :: $(cat "$work/err")"; return; fi
-  grep -qi -- "$want" "$work/err" || { bad "message lacks '$want' for: $* :: $(cat "$work/err")"; return; }
-  ok
-}
-expect_error() { expect_failure 2 "$@"; }
 
 problems=(--problem constant_acceleration --problem projectile --problem damped_spring --problem pendulum)
 "$bin" sweep "${problems[@]}" --quick --quiet --out "$work/whole.h5" 2>"$work/err" || bad "the unsharded sweep: $(cat "$work/err")"
@@ -121,27 +104,27 @@ PY
 
 # Refusals: one line, exit 2, no file.
 cp "$work/s1.h5" "$work/s1copy.h5"
-expect_error "both hold shard 1 of 3 (overlapping shards)" merge "$work/s1.h5" "$work/s1copy.h5" "$work/s2.h5" "$work/s3.h5" -o "$work/x.h5"
+expect_error_re "both hold shard 1 of 3 (overlapping shards)" merge "$work/s1.h5" "$work/s1copy.h5" "$work/s2.h5" "$work/s3.h5" -o "$work/x.h5"
 /usr/bin/python3 -c '
 import h5py, sys
 with h5py.File(sys.argv[1], "r+") as f: f.attrs["shard_index"] = 1' "$work/s1copy.h5"
-expect_error "is in two shards" merge "$work/s1.h5" "$work/s1copy.h5" "$work/s3.h5" -o "$work/x.h5"
+expect_error_re "is in two shards" merge "$work/s1.h5" "$work/s1copy.h5" "$work/s3.h5" -o "$work/x.h5"
 /usr/bin/python3 - "$work" <<'PY'
 import h5py, sys
 problems = {k: sorted(h5py.File(f"{sys.argv[1]}/s{k}.h5")["problems"]) for k in (1, 2, 3)}
 open(f"{sys.argv[1]}/missing.txt", "w").write(", ".join(p for p in ["constant_acceleration", "projectile", "damped_spring", "pendulum"] if p in problems[2]))
 PY
 missing=$(cat "$work/missing.txt")
-expect_error "selected problems* \(is\|are\) in no shard ($missing): shard 2 of 3 not given; --partial" merge "$work/s1.h5" "$work/s3.h5" -o "$work/x.h5"
+expect_error_re "selected problems* \(is\|are\) in no shard ($missing): shard 2 of 3 not given; --partial" merge "$work/s1.h5" "$work/s3.h5" -o "$work/x.h5"
 # The output may not be one of the inputs: the shard is left as it was.
 sum_before=$(md5sum <"$work/s1.h5")
-expect_error "the output '.*s1.h5' is one of the shards" merge "$work/s1.h5" "$work/s2.h5" "$work/s3.h5" -o "$work/s1.h5"
+expect_error_re "the output '.*s1.h5' is one of the shards" merge "$work/s1.h5" "$work/s2.h5" "$work/s3.h5" -o "$work/s1.h5"
 [ "$(md5sum <"$work/s1.h5")" = "$sum_before" ] && ok || bad "merge -o an input changed it"
 cp "$work/s2.h5" "$work/other_build.h5"
 /usr/bin/python3 -c '
 import h5py, sys
 with h5py.File(sys.argv[1], "r+") as f: f.attrs["git_commit"] = "0123456789ab"' "$work/other_build.h5"
-expect_error "was written by another build" merge "$work/s1.h5" "$work/other_build.h5" "$work/s3.h5" -o "$work/x.h5"
+expect_error_re "was written by another build" merge "$work/s1.h5" "$work/other_build.h5" "$work/s3.h5" -o "$work/x.h5"
 # Merge reads the options and the selection from these two attributes: a shard with
 # another --set, --base-steps or --problem selection, written over a copy (a sweep each
 # took 8 to 13 s of the sanitizer stage).
@@ -159,11 +142,11 @@ for path, old, new in ((sys.argv[1], "\noverrides: none\n", "\noverrides: damped
 with h5py.File(sys.argv[3], "r+") as f:
     f.attrs["selection"] = "constant_acceleration,projectile"
 PY
-expect_error "differ in their options: .* has overrides: none, .* has overrides: damped_spring.k_s=20" merge "$work/s1.h5" "$work/s2set.h5" "$work/s3.h5" -o "$work/x.h5"
-expect_error "differ in their options: .* has base_steps: 32, .* has base_steps: 64" merge "$work/s1.h5" "$work/s2base.h5" "$work/s3.h5" -o "$work/x.h5"
-expect_error "differ in their selection of problems" merge "$work/s1.h5" "$work/s2sel.h5" "$work/s3.h5" -o "$work/x.h5"
+expect_error_re "differ in their options: .* has overrides: none, .* has overrides: damped_spring.k_s=20" merge "$work/s1.h5" "$work/s2set.h5" "$work/s3.h5" -o "$work/x.h5"
+expect_error_re "differ in their options: .* has base_steps: 32, .* has base_steps: 64" merge "$work/s1.h5" "$work/s2base.h5" "$work/s3.h5" -o "$work/x.h5"
+expect_error_re "differ in their selection of problems" merge "$work/s1.h5" "$work/s2sel.h5" "$work/s3.h5" -o "$work/x.h5"
 "$bin" scan --problem stiff_spring --param stiff_spring.k_s=1e1:1e3:3:log --hz 60 --substeps 1 --quiet --out "$work/scan.h5" >/dev/null
-expect_error "is a study shard and .* a scan file" merge "$work/s1.h5" "$work/scan.h5" -o "$work/x.h5"
+expect_error_re "is a study shard and .* a scan file" merge "$work/s1.h5" "$work/scan.h5" -o "$work/x.h5"
 [ ! -e "$work/x.h5" ] && ok || bad "a refused merge wrote its file"
 # --partial merges what there is and names what is missing.
 "$bin" merge "$work/s1.h5" "$work/s3.h5" --partial -o "$work/partial.h5" 2>"$work/err" &&
@@ -194,8 +177,8 @@ assert (m.attrs["shard_index"], m.attrs["shard_count"]) == (0, 1)' "$work/partia
 same_study "$work/whole.h5" "$work/completed.h5" && ok || bad "the completed partial merge differs from the unsharded study"
 "$bin" merge "$work/s2.h5" "$work/partial.h5" -o "$work/completed2.h5" 2>"$work/err" &&
   same_study "$work/merged.h5" "$work/completed2.h5" && ok || bad "completing a partial merge, the shard first: $(cat "$work/err")"
-expect_error "'.*partial.h5' and '.*s1.h5' both hold shard 1 of 3 (overlapping shards)" merge "$work/partial.h5" "$work/s1.h5" "$work/s2.h5" -o "$work/x.h5"
-expect_error "is in two shards, '.*partial.h5' and '.*s1copy.h5' (overlapping shards)" merge "$work/partial.h5" "$work/s1copy.h5" -o "$work/x.h5"
+expect_error_re "'.*partial.h5' and '.*s1.h5' both hold shard 1 of 3 (overlapping shards)" merge "$work/partial.h5" "$work/s1.h5" "$work/s2.h5" -o "$work/x.h5"
+expect_error_re "is in two shards, '.*partial.h5' and '.*s1copy.h5' (overlapping shards)" merge "$work/partial.h5" "$work/s1copy.h5" -o "$work/x.h5"
 [ ! -e "$work/x.h5" ] && ok || bad "a refused merge wrote its file"
 
 # Scan shards too: a partial merge of shards 1 and 3, merged with shard 2, is the merge
@@ -209,7 +192,7 @@ done
   "$bin" merge "$work/scan_partial.h5" "$work/scan2.h5" -o "$work/scan_completed.h5" 2>"$work/err" &&
   same_study "$work/scan_all.h5" "$work/scan_completed.h5" /scan/stiff_spring@wall_seconds && ok ||
   bad "completing a partial scan merge: $(cat "$work/err")"
-expect_error "grid point .* is in two shards (overlapping shards)" merge "$work/scan_partial.h5" "$work/scan1.h5" -o "$work/x.h5"
+expect_error_re "grid point .* is in two shards (overlapping shards)" merge "$work/scan_partial.h5" "$work/scan1.h5" -o "$work/x.h5"
 
 # Each shard's Google Benchmark JSON, crafted here for the sweep's shards as stepbench_bench
 # writes it (its context names its shard; a counter may be NaN, written bare), joins with
@@ -289,19 +272,19 @@ PY
 printf '{"context": {}, "benchmarks": [' >"$work/cbad.json"
 b=(-o "$work/x.h5" --bench-out "$work/xb.json")
 s123=("$work/s1.h5" "$work/s2.h5" "$work/s3.h5")
-expect_error "2 benchmark JSON files (--bench) for 3 study files" merge "${s123[@]}" --bench "$work/c1.json" "$work/c2.json" "${b[@]}"
-expect_error "'.*c2.json' is the benchmark JSON of shard 2 of 3, and its study file '.*s1.h5' holds shard 1 of 3; give --bench in the order" \
+expect_error_re "2 benchmark JSON files (--bench) for 3 study files" merge "${s123[@]}" --bench "$work/c1.json" "$work/c2.json" "${b[@]}"
+expect_error_re "'.*c2.json' is the benchmark JSON of shard 2 of 3, and its study file '.*s1.h5' holds shard 1 of 3; give --bench in the order" \
   merge "${s123[@]}" --bench "$work/c2.json" "$work/c1.json" "$work/c3.json" "${b[@]}"
-expect_error "is the benchmark JSON of shard 2 of 3, and its study file '.*pb.h5' holds shards 1, 3 of 3" \
+expect_error_re "is the benchmark JSON of shard 2 of 3, and its study file '.*pb.h5' holds shards 1, 3 of 3" \
   merge "$work/pb.h5" "$work/s2.h5" --bench "$work/c2.json" "$work/pb.json" "${b[@]}"
-expect_error "benchmark '[a-z_]*/rk4/dt:0.1/real_time' is in shard 1 of 3 ('.*c1.json') and shard 2 of 3 ('.*c2dup.json') (overlapping shards)" \
+expect_error_re "benchmark '[a-z_]*/rk4/dt:0.1/real_time' is in shard 1 of 3 ('.*c1.json') and shard 2 of 3 ('.*c2dup.json') (overlapping shards)" \
   merge "${s123[@]}" --bench "$work/c1.json" "$work/c2dup.json" "$work/c3.json" "${b[@]}"
-expect_error "'.*c1.json' is named twice (overlapping shards)" merge "${s123[@]}" --bench "$work/c1.json" "$work/c1.json" "$work/c3.json" "${b[@]}"
-expect_error "the output '.*c1.json' is one of the shards" merge "${s123[@]}" --bench "$work/c1.json" "$work/c2.json" "$work/c3.json" -o "$work/x.h5" --bench-out "$work/c1.json"
-expect_error "requires --bench-out\|--bench-out is required\|needs --bench-out" merge "${s123[@]}" --bench "$work/c1.json" "$work/c2.json" "$work/c3.json" -o "$work/x.h5"
-expect_error "--bench joins the benchmark JSON of timed study shards; these are scan files" \
+expect_error_re "'.*c1.json' is named twice (overlapping shards)" merge "${s123[@]}" --bench "$work/c1.json" "$work/c1.json" "$work/c3.json" "${b[@]}"
+expect_error_re "the output '.*c1.json' is one of the shards" merge "${s123[@]}" --bench "$work/c1.json" "$work/c2.json" "$work/c3.json" -o "$work/x.h5" --bench-out "$work/c1.json"
+expect_error_re "requires --bench-out\|--bench-out is required\|needs --bench-out" merge "${s123[@]}" --bench "$work/c1.json" "$work/c2.json" "$work/c3.json" -o "$work/x.h5"
+expect_error_re "--bench joins the benchmark JSON of timed study shards; these are scan files" \
   merge "$work"/scan[123].h5 --bench "$work/c1.json" "$work/c2.json" "$work/c3.json" "${b[@]}"
-expect_failure 1 "cannot read '.*cbad.json': not JSON" merge "${s123[@]}" --bench "$work/c1.json" "$work/cbad.json" "$work/c3.json" "${b[@]}"
+expect_file_error "cannot read '.*cbad.json': not JSON" merge "${s123[@]}" --bench "$work/c1.json" "$work/cbad.json" "$work/c3.json" "${b[@]}"
 [ ! -e "$work/x.h5" ] && [ "$(cat "$work/xb.json")" = previous ] && ! ls "$work"/*.tmp.* >/dev/null 2>&1 && ok ||
   bad "a refused merge wrote a file: $(ls "$work")"
 
@@ -320,7 +303,7 @@ assert j["context"] == {"host_name": "node1", "stepbench_shards": [{"host_name":
                                                                   {"stepbench_shard": "2/2"}]}, j["context"]
 assert [b["stepbench_shard"] for b in j["benchmarks"]] == ["1/2"]' "$work/one_empty.json" && ok ||
   bad "merge --bench with a shard that timed nothing: $(cat "$work/err")"
-expect_failure 1 "cannot read '.*empty.json': it is empty, and its study file '.*one.h5' holds 1 problem" \
+expect_file_error "cannot read '.*empty.json': it is empty, and its study file '.*one.h5' holds 1 problem" \
   merge "$work/one.h5" "$work/empty.h5" -o "$work/x.h5" --bench "$work/empty.json" "$work/one.json" --bench-out "$work/xb.json"
 
 # Timed shards: two stepbench_bench shards merge with each problem's machine, and their
@@ -386,5 +369,4 @@ for name, second in (("timed", "t2"), ("timed2", "t2other")):
     assert m.attrs["benchmark_wall_seconds"] == t[0].attrs["benchmark_wall_seconds"] + t[1].attrs["benchmark_wall_seconds"]
 PY
 
-echo "shard_test: $passes passed, $fails failed"
-[ "$fails" -eq 0 ]
+finish shard_test

@@ -63,15 +63,10 @@ int run_energy(const energy_args& a) {
         s = *known;
       else
         s.problem = name;
-      if (a.steps_given) s.steps_per_period = a.steps_per_period;
       const auto p = make_problem(name);  // names an unknown problem
-      if (!p->has_energy()) throw std::invalid_argument(fmt::format("problem {} has no energy to follow", name));
-      if (std::isfinite(p->period())) {
-        if (a.period)
-          throw std::invalid_argument(fmt::format("problem {} has a period of its own; leave out --period", name));
-      } else {
-        s.period = a.period.value_or(p->horizon());
-      }
+      if (std::isfinite(p->period()) && a.period)
+        throw std::invalid_argument(fmt::format("problem {} has a period of its own; leave out --period", name));
+      if (a.period) s.period = *a.period;  // else the study takes the horizon, as --set leaves it
       chosen.push_back(s);
     }
     opts.scenes = chosen;
@@ -79,6 +74,8 @@ int run_energy(const energy_args& a) {
     throw std::invalid_argument(
         "--period is for a problem without a period of its own: give it with --problem or --scene");
   }
+  if (a.steps_given)
+    for (auto& s : opts.scenes) s.steps_per_period = a.steps_per_period;
   parameter_overrides overrides;
   std::vector<std::string> names;
   for (const auto& s : opts.scenes) names.push_back(s.problem);

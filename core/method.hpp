@@ -27,6 +27,11 @@ inline std::string_view to_string(method_origin o) {
 inline std::string_view to_string(method_kind k) { return k == method_kind::fixed_step ? "fixed_step" : "adaptive"; }
 inline std::string_view param_name(method_kind k) { return k == method_kind::fixed_step ? "dt" : "tolerance"; }
 
+// A method the study offers a user as it offers ours (the frame rates, the energy study,
+// scans, the game loop): ours, and a plugin's, which the user brought to be measured the
+// same way (docs/plugins.md).
+inline bool offered_as_ours(method_origin o) { return o == method_origin::ours || o == method_origin::plugin; }
+
 // Limits on one run. The work budget is counted in force evaluations times coordinates,
 // so a large scene gets proportionally fewer steps; a run that would exceed it is
 // recorded as skipped (with the reason), not as failed.

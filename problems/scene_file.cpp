@@ -358,7 +358,8 @@ scene_data parse_scene(std::string_view text, const std::string& path) {
       const double length = std::sqrt(length2);
       scene_data::plane pl;
       for (int c = 0; c < s.dim; ++c) pl.normal[c] = length == 1.0 ? n[c] : n[c] / length;
-      if (const auto* o = t.get("offset")) pl.offset = r.number(*o, "offset") / length;
+      const double offset = t.get("offset") != nullptr ? r.number(*t.get("offset"), "offset") : 0.0;
+      pl.offset = offset / length;
       if (const auto* k = t.get("restitution"))
         pl.restitution = r.number(
             *k, "restitution", [](double v) { return v >= 0 && v <= 1; }, "in [0, 1]");
@@ -370,14 +371,15 @@ scene_data parse_scene(std::string_view text, const std::string& path) {
       if (const auto* k = t.get("tangential_loss"))
         pl.tangential_loss = r.number(
             *k, "tangential_loss", [](double v) { return v >= 0 && v <= 1; }, "in [0, 1]");
-      // Every moving mass starts on the plane's side.
+      // Every moving mass starts on the plane's side, as the file writes it (before the
+      // division by the normal's length, which could round a mass on the plane off it).
       for (const auto& m : s.masses) {
         if (m.fixed) continue;
         double side = 0.0;
-        for (int c = 0; c < s.dim; ++c) side += pl.normal[c] * m.position[c];
-        if (side < pl.offset)
+        for (int c = 0; c < s.dim; ++c) side += n[c] * m.position[c];
+        if (side < offset)
           r.fail(here, fmt::format("mass {}{} starts on the wrong side of this plane (normal . x = {:g} < offset {:g})",
-                                   &m - s.masses.data(), m.name.empty() ? "" : " '" + m.name + "'", side, pl.offset));
+                                   &m - s.masses.data(), m.name.empty() ? "" : " '" + m.name + "'", side, offset));
       }
       s.planes.push_back(pl);
     }

@@ -139,10 +139,10 @@ energy_study run_energy_study(const energy_options& opts,
     const auto p = configured_problem(scene.problem, configure);
     if (!p->has_energy())
       throw std::invalid_argument(fmt::format("energy study: problem {} has no energy to follow", scene.problem));
-    const double period = std::isfinite(p->period()) ? p->period() : scene.period;
-    if (!(std::isfinite(period) && period > 0.0))
-      throw std::invalid_argument(
-          fmt::format("energy study: problem {} has no period: give one (--period)", scene.problem));
+    // The problem's period; else the one given (--period); else its horizon, after --set.
+    const double period = std::isfinite(p->period())    ? p->period()
+                          : std::isfinite(scene.period) ? scene.period
+                                                        : p->horizon();
     energy_problem ep;
     ep.problem = scene.problem;
     ep.params = p->params();
@@ -152,6 +152,9 @@ energy_study run_energy_study(const energy_options& opts,
     ep.horizon = static_cast<double>(std::llround(opts.periods) * scene.steps_per_period) * ep.dt;
     const auto y0 = p->initial();
     ep.e0 = p->energy(y0);
+    if (!(ep.e0 != 0.0))  // dE/E is relative to E0
+      throw std::invalid_argument(
+          fmt::format("energy study: problem {} starts with zero energy: dE/E has no scale", scene.problem));
     ep.l0 = p->has_angular_momentum() ? p->angular_momentum(y0) : nan;
     for (const auto& m : p->methods())
       if (offered_as_ours(m.origin) && m.kind == method_kind::fixed_step &&

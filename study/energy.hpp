@@ -34,7 +34,7 @@ struct energy_scene {
   int steps_per_period = 64;
   std::map<std::string, double> params;  // the scene's own defaults; the user's --set wins
   // The time unit of the drift: the problem's period where it has one (pendulum, kepler);
-  // else this, which `stepbench energy` sets to --period or the problem's horizon.
+  // else this (`stepbench energy --period`); else the problem's horizon.
   double period = std::numeric_limits<double>::quiet_NaN();
 };
 

@@ -28,11 +28,6 @@
 
 namespace stepbench {
 
-// A method the study offers a user as it offers ours (the frame rates, the energy study,
-// scans): ours, and a plugin's, which the user brought to be measured the same way
-// (docs/plugins.md).
-inline bool offered_as_ours(method_origin o) { return o == method_origin::ours || o == method_origin::plugin; }
-
 // 10^-first, 10^-(first + stride), ... down to 10^-last: the tolerance ladder and the
 // equal-error targets are both decades, built here.
 inline std::vector<double> decades(int first, int last, int stride) {

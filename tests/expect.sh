@@ -1,5 +1,5 @@
-# The shell tests' shared preamble (sourced by cli_test.sh, compare_test.sh, plugin_test.sh
-# and scene_test.sh after they set `bin`, the stepbench under test): a scratch folder
+# The shell tests' shared preamble (sourced by the tests/*_test.sh scripts after they set
+# `bin`, the stepbench under test, where they check refusals): a scratch folder
 # `work` removed on exit, the pass and failure counts, and the check every script makes of
 # a refusal. `finish NAME` prints the counts and ends the script with its status.
 work=$(mktemp -d)

@@ -141,15 +141,11 @@ def _answers(s, args, argv, readme_text):
     return 0
 
 
-def _scene_name(study_path, scene_file):
-    """The name of the scene the study ran from `scene_file` (its root attribute `scenes`:
-    name, path as given to stepbench, FNV-1a 64 of the bytes), by the file's real path, or
-    by its file name where one scene has it; None after a one-line error."""
-    import json
-    import h5py
-    with h5py.File(study_path, "r") as f:
-        raw = f.attrs.get("scenes")
-    entries = json.loads(raw) if raw is not None else []
+def _scene_name(s, study_path, scene_file):
+    """The name of the scene the study `s` ran from `scene_file` (its `scenes`: name, path
+    as given to stepbench, FNV-1a 64 of the bytes), by the file's real path, or by its file
+    name where one scene has it; None after a one-line error."""
+    entries = s.attrs.get("scenes", [])
     if not entries:
         print(f"report: error: --scene {scene_file}: '{study_path}' ran no scene file", file=sys.stderr)
         return None
@@ -210,6 +206,13 @@ def main(argv=None, start=None):
     except study.StudyError as e:
         print(f"report: error: {e}", file=sys.stderr)
         return 1
+    if args.scene is not None:
+        if args.problem is not None:
+            print("report: error: give --problem or --scene, not both", file=sys.stderr)
+            return 2
+        args.problem = _scene_name(s, args.study, args.scene)
+        if args.problem is None:
+            return 2
     if s.scan_only and args.markdown:
         print(f"report: error: '{args.study}' is a scan file (only /scan, no problems): --markdown writes the verdict "
               "tables of a study file; nothing written", file=sys.stderr)
@@ -222,13 +225,6 @@ def main(argv=None, start=None):
         print(f"report: error: unknown problem '{args.problem}' (the study has "
               f"{', '.join(p.name for p in s.problems)})", file=sys.stderr)
         return 2
-    if args.scene is not None:
-        if args.problem is not None:
-            print("report: error: give --problem or --scene, not both", file=sys.stderr)
-            return 2
-        args.problem = _scene_name(args.study, args.scene)
-        if args.problem is None:
-            return 2
     if (status := _frame_choice(s, args)) is not None:
         return status
     if args.markdown or args.readme:

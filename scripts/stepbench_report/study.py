@@ -8,6 +8,7 @@ attribute, field or dataset is a StudyError naming the file and what is missing.
 Nothing is filled in with a default.
 """
 import ctypes
+import json
 import os
 import sys
 from dataclasses import dataclass, field
@@ -471,6 +472,10 @@ class _Reader:
         missing = f.attrs.get("missing_problems", "")
         attrs["missing_problems"] = [p for p in (missing.decode() if isinstance(missing, bytes) else missing).split(",")
                                      if p]
+        # The scene files the study ran (name, path as given, FNV-1a 64 of the bytes; none: []).
+        scenes = f.attrs.get("scenes")
+        attrs["scenes"] = [] if scenes is None else \
+            json.loads(scenes.decode() if isinstance(scenes, bytes) else scenes)
         # The parts the study ran, in its order (a file written before the attribute: None).
         parts = f.attrs.get("parts")
         attrs["parts"] = None if parts is None else \

@@ -93,22 +93,7 @@ grep -q "cloth" <<<"$out$(cat "$work/err")" && ok || bad "advise --scene names t
 # energy --scene: an undamped mass on a spring, the period its horizon: explicit Euler
 # gains energy, implicit Euler loses it (to rest about x = 1 m: its Newton solve ends at
 # x's round-off), semi-implicit Euler's error stays bounded.
-cat >"$work/spring.toml" <<'TOML'
-name = "undamped_spring"
-dim = 1
-horizon = 0.6283185307179586
-[[mass]]
-position = [0.0]
-fixed = true
-[[mass]]
-mass = 1.0
-position = [1.5]
-[[spring]]
-between = [0, 1]
-stiffness = 100.0
-rest_length = 1.0
-TOML
-"$bin" energy --scene "$work/spring.toml" --periods 200 --json >"$work/out" 2>"$work/err" &&
+"$bin" energy --scene "$src/tests/data/undamped_spring.toml" --periods 200 --json >"$work/out" 2>"$work/err" &&
   /usr/bin/python3 - "$work/out" <<'PY' && ok || bad "energy --scene: $(cat "$work/err") $(head -c 300 "$work/out")"
 import json, sys
 runs = {r["method"]: r for r in json.load(open(sys.argv[1]))}
@@ -117,11 +102,11 @@ assert runs["euler"]["drift_sign"] == 1, runs["euler"]
 assert runs["implicit_euler"]["completed"] and runs["implicit_euler"]["drift_sign"] == -1, runs["implicit_euler"]
 assert runs["semi_implicit_euler"]["verdict"] == "bounded", runs["semi_implicit_euler"]
 PY
-"$bin" energy --scene "$work/spring.toml" --periods 10 --period 0.1 --steps-per-period 32 >"$work/out" 2>"$work/err" &&
+"$bin" energy --scene "$src/tests/data/undamped_spring.toml" --periods 10 --period 0.1 --steps-per-period 32 >"$work/out" 2>"$work/err" &&
   grep -q "undamped_spring: 10 periods of 0.1 s (no period of its own" "$work/out" && ok ||
   bad "energy --period: $(cat "$work/err" "$work/out")"
 expect_error "problem pendulum has a period of its own; leave out --period" energy --problem pendulum --period 2
-expect_error "--steps-per-period must be a positive multiple of 32, got 50" energy --scene "$work/spring.toml" \
+expect_error "--steps-per-period must be a positive multiple of 32, got 50" energy --scene "$src/tests/data/undamped_spring.toml" \
   --steps-per-period 50
 
 # stepbench_bench --scene=: swept and timed as a problem.

@@ -221,22 +221,7 @@ TEST(scene_files, a_block_on_a_wall_with_friction_follows_the_lecture_incline) {
 // ulps over h (the solve failed at t = 42 s before integrators/implicit_newton.hpp's
 // position_floor). Amplitude 0.5 m, omega = 10/s, dt = 0.01 s: (1 + (omega dt)^2)^(-n/2).
 TEST(scene_files, implicit_euler_settles_at_an_equilibrium_away_from_the_origin) {
-  const std::string path = testing::TempDir() + "/settle.toml";
-  std::ofstream(path) << R"(name = "settle"
-dim = 1
-horizon = 80.0
-[[mass]]
-position = [0.0]
-fixed = true
-[[mass]]
-mass = 1.0
-position = [1.5]
-[[spring]]
-between = [0, 1]
-stiffness = 100.0
-rest_length = 1.0
-)";
-  const auto p = make_problem(load_scene(path));
+  const auto p = make_problem(load_scene(std::string(STEPBENCH_TEST_DATA) + "/undamped_spring.toml"));
   const run_result r = p->run("implicit_euler", 0.01, 80.0, std::vector<double>{80.0});
   ASSERT_TRUE(r.stop_reason.empty()) << r.stop_reason;
   EXPECT_NEAR(r.final_y[0], 1.0, 0.5 * std::pow(1.0 + 0.01, -8000.0 / 2) + 4e-15);

@@ -79,10 +79,11 @@ std::uint64_t parse_seed(const std::string& text) {
 
 const method_info& loop_method_info(const std::string& name) {
   const method_info& m = find_method(name);
-  if (m.origin != method_origin::ours || m.kind != method_kind::fixed_step)
-    throw std::invalid_argument(fmt::format(
-        "the game loop runs our fixed-step integrators; {} is {}", name,
-        m.origin == method_origin::ours ? std::string("adaptive") : fmt::format("a {} method", to_string(m.origin))));
+  const bool offered = offered_as_ours(m.origin);
+  if (!offered || m.kind != method_kind::fixed_step)
+    throw std::invalid_argument(
+        fmt::format("the game loop runs fixed-step integrators, ours and the plugins'; {} is {}", name,
+                    offered ? std::string("adaptive") : fmt::format("a {} method", to_string(m.origin))));
   return m;
 }
 

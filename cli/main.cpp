@@ -81,14 +81,16 @@ int main(int argc, char** argv) {
   std::vector<std::string> plugins;
   bool isolate = false;
   for (const auto& c : commands)
-    for (const char* name : {"list", "run", "sweep", "scan", "advise", "energy"})
+    for (const char* name : {"list", "run", "sweep", "scan", "advise", "energy", "loop"})
       if (c.app->get_name() == name) {
         c.app
             ->add_option("--plugin", plugins,
                          "load the methods of a plugin built against include/stepbench/plugin.h (repeatable)")
             ->allow_extra_args(false);
-        c.app->add_flag("--isolate", isolate,
-                        "run each run of a plugin's method in a child process (a crash fails the run)");
+        // The game loop runs in this process: a loop is not one run a child could return.
+        if (c.app->get_name() != std::string_view("loop"))
+          c.app->add_flag("--isolate", isolate,
+                          "run each run of a plugin's method in a child process (a crash fails the run)");
       }
   // Shown in each command's help; parsed above (load_scenes).
   std::vector<std::string> scene_files;

@@ -196,11 +196,16 @@ class problem_model final : public problem_instance {
 
   loop_result loop(std::string_view method, const loop_config& config) const override {
     const method_info& m = find_method(method);  // throws for an unknown name
-    if (m.origin != method_origin::ours || m.kind != method_kind::fixed_step)
-      throw std::invalid_argument(fmt::format(
-          "the game loop runs our fixed-step integrators; {} is {}", method,
-          m.origin == method_origin::ours ? std::string("adaptive") : fmt::format("a {} method", to_string(m.origin))));
+    const bool offered = m.origin == method_origin::ours || m.origin == method_origin::plugin;
+    if (!offered || m.kind != method_kind::fixed_step)
+      throw std::invalid_argument(
+          fmt::format("the game loop runs fixed-step integrators, ours and the plugins'; {} is {}", method,
+                      offered ? std::string("adaptive") : fmt::format("a {} method", to_string(m.origin))));
     if (auto err = loop_config_error(config); !err.empty()) throw std::invalid_argument(err);
+    // A plugin's fixed-step method steps the loop through its C function, as it steps
+    // drive() (registry/plugin_adapter.hpp); in this process (--isolate is for runs).
+    if (const plugin_method* pm = find_plugin_method(method))
+      return simulate_loop(p_, plugin_fixed{{pm->method}}, config);
     const auto& s = slot(method);
     if (s.loop == nullptr)  // the position-based methods step particles, not the loop's states
       throw std::invalid_argument(

@@ -245,8 +245,7 @@ loop_study run_loop_study(const study& s, const loop_options& opts) {
     lp.position_unit = ps.problem->position_unit();
     lp.horizon = ps.problem->horizon();
     for (const auto& m : ps.problem->methods()) {
-      if (m.origin != method_origin::ours || m.kind != method_kind::fixed_step || !contains(opts.methods, m.name))
-        continue;
+      if (!offered_as_ours(m.origin) || m.kind != method_kind::fixed_step || !contains(opts.methods, m.name)) continue;
       lp.methods.push_back(run_loop_method(*ps.problem, m, opts));
       configs += lp.methods.back().rows.size();
     }

@@ -69,6 +69,25 @@ for name, why in (("bad_status", "returned status 7"), ("bad_crash", "--isolate:
     assert all(why in r for r in reasons), (name, reasons)
 PY
 
+# loop --plugin: the plugin's RK4 in the game loop shows what rk4 shows, its errors over
+# the frames and its end state (bit for bit: the pendulum's mass is 1, docs/plugins.md);
+# --isolate is not a loop option.
+for m in plugin_rk4 rk4; do
+  "$bin" loop --plugin "$plugins/librk4.so" --problem pendulum --integrator $m --design interpolated --json \
+    >"$work/loop_$m.json" 2>"$work/err" || bad "loop --plugin ($m): $(cat "$work/err")"
+done
+/usr/bin/python3 - "$work/loop_plugin_rk4.json" "$work/loop_rk4.json" <<'PY' && ok || bad "loop --plugin against rk4"
+import json, sys
+mine, ours = (json.load(open(p)) for p in sys.argv[1:3])
+assert mine["integrator"] == "plugin_rk4" and mine["frames"] > 100, mine
+for key in ("final_physics_position", "final_physics_velocity", "final_shown_position", "shown_err_max",
+            "shown_err_rms", "physics_steps", "force_evals", "frames"):
+    assert mine[key] == ours[key], (key, mine[key], ours[key])
+assert 0 < mine["shown_err_max"] < 0.2, mine["shown_err_max"]  # the shown state lags a step at most
+PY
+expect_error "The following argument was not expected: --isolate" loop --plugin "$plugins/librk4.so" --isolate --problem pendulum \
+  --integrator plugin_rk4 --design fixed
+
 # Shards that loaded different plugins (by path or bytes) are not one study: merge refuses
 # them in one line (the sweep's options name each plugin and its hash); the same plugin joins.
 for k in 1 2; do

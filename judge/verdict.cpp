@@ -46,10 +46,12 @@ cost_at_error cost_of(const std::vector<wp_method>& methods, const wp_pick* p) {
   return {m.name, std::string(to_string(m.kind)), p->param, p->cost, p->cost_lo, p->cost_hi, p->interpolated};
 }
 
-std::string verdict_of(const cost_at_error& ours, const cost_at_error& peer, bool timed) {
+// `mine` against `other` at equal error; the one-sided outcomes are named by the caller.
+std::string verdict_of(const cost_at_error& ours, const cost_at_error& peer, bool timed,
+                       const char* ours_only = "ours only", const char* peers_only = "peers only") {
   if (!ours.found() && !peer.found()) return "not reached";
-  if (!peer.found()) return "ours only";
-  if (!ours.found()) return "peers only";
+  if (!peer.found()) return ours_only;
+  if (!ours.found()) return peers_only;
   const std::string v =
       compare_at_equal_error({ours.cost, ours.cost_lo, ours.cost_hi}, {peer.cost, peer.cost_lo, peer.cost_hi}, timed);
   // An upper bound on the side found cheaper proves nothing: its true cost may be lower.
@@ -90,6 +92,29 @@ std::vector<std::string> findings_of(const verdict_tables& v, const finding_inpu
                           worst_loss->problem, worst_loss->target, worst_loss->unit, worst_loss->ratio,
                           worst_loss->peer.method);
     out.push_back(line);
+  }
+  // The plugins' methods at equal error, against ours and against the peers.
+  if (!v.plugin_equal_error.empty()) {
+    std::map<std::string, int> vs_ours, vs_peer;
+    std::vector<std::string> names;
+    for (const auto& e : v.plugin_equal_error) {
+      ++vs_ours[e.verdict_ours];
+      ++vs_peer[e.verdict_peer];
+      if (e.plugin.found() && !contains(names, e.plugin.method)) names.push_back(e.plugin.method);
+    }
+    const auto counts = [&](std::map<std::string, int>& n) {
+      return fmt::format("ahead on {}, behind on {}, within the {} on {}, undecided on {} of the {} pairs both reach",
+                         n["ahead"], n["behind"], timed ? "timing noise" : "rounding", n["within spread"], n["bounded"],
+                         n["ahead"] + n["behind"] + n["within spread"] + n["bounded"]);
+    };
+    out.push_back(fmt::format(
+        "The plugins' fastest method at equal error ({}) against the fastest of ours: {}; against the fastest "
+        "library peer: {}; a plugin method reaches {} of the {} problem-and-target pairs.",
+        names.empty() ? std::string("none reaches a target") : fmt::format("{}", fmt::join(names, ", ")),
+        counts(vs_ours), counts(vs_peer),
+        std::count_if(v.plugin_equal_error.begin(), v.plugin_equal_error.end(),
+                      [](const plugin_at_error& e) { return e.plugin.found(); }),
+        v.plugin_equal_error.size()));
   }
   // Implicit step against substeps.
   for (const auto& [problem, frame_dt, sv] : in.substeps) {
@@ -233,14 +258,24 @@ verdict_tables compute_verdict(const study& s) {
     for (double target : verdict_targets()) {
       const auto r = cheapest(methods, target, timed, verdict_metric, unit,
                               timed ? wp_candidates::timed_methods : wp_candidates::every_method);
-      const wp_pick *ours = nullptr, *peer = nullptr;
+      const wp_pick *ours = nullptr, *peer = nullptr, *plugin = nullptr;
       for (const auto& p : r.ranked) {
         if (methods[p.method].origin == method_origin::ours && !ours) ours = &p;
         if (methods[p.method].origin == method_origin::peer && !peer) peer = &p;
+        if (methods[p.method].origin == method_origin::plugin && !plugin) plugin = &p;
       }
       const cost_at_error o = cost_of(methods, ours), q = cost_of(methods, peer);
+      const bool by_time = r.cost == "time_ns";
       v.equal_error.push_back({ps.name, unit, target, o, q, ours && peer ? ours->cost / peer->cost : nan, r.cost,
-                               verdict_of(o, q, r.cost == "time_ns"), std::isfinite(best_error) ? best_error : nan});
+                               verdict_of(o, q, by_time), std::isfinite(best_error) ? best_error : nan});
+      if (std::any_of(methods.begin(), methods.end(),
+                      [](const wp_method& m) { return m.origin == method_origin::plugin; })) {
+        const cost_at_error y = cost_of(methods, plugin);
+        v.plugin_equal_error.push_back({ps.name, unit, target, y, plugin && ours ? plugin->cost / ours->cost : nan,
+                                        plugin && peer ? plugin->cost / peer->cost : nan,
+                                        verdict_of(y, o, by_time, "plugin only", "others only"),
+                                        verdict_of(y, q, by_time, "plugin only", "others only")});
+      }
     }
   }
   for (const auto& fs : s.results.get<std::vector<frame_rate_study>>()) {

@@ -17,6 +17,15 @@ std::string cost_text(const std::string& kind, double c) {
   return kind == "time_ns" ? format_time_ns(c) : fmt::format("{:.3g} evals", c);
 }
 
+// A ratio at equal error with its verdict's mark (format_verdict_text's legend).
+std::string marked_ratio(double ratio, const std::string& verdict) {
+  return fmt::format("{:.2g}x{}", ratio,
+                     verdict == "ahead"     ? "+"
+                     : verdict == "behind"  ? "-"
+                     : verdict == "bounded" ? "?"
+                                            : "~");
+}
+
 }  // namespace
 
 std::string format_verdict_text(const study& s) {
@@ -32,7 +41,9 @@ std::string format_verdict_text(const verdict_tables& v) {
   std::vector<std::string> problems;
   for (const auto& e : v.equal_error)
     if (!contains(problems, e.problem)) problems.push_back(e.problem);
-  {
+  // A table of problems down and the shown targets across, a cell from each row of `rows`
+  // at its (problem, target): "-" where none.
+  const auto by_target = [&](const auto& rows, const auto& cell_of) {
     std::vector<column> cols{{"problem"}};
     for (double t : shown) cols.push_back({fmt::format("err <= {:g}", t)});
     table tb{cols, {}};
@@ -40,32 +51,39 @@ std::string format_verdict_text(const verdict_tables& v) {
       std::vector<std::string> row{p};
       for (double t : shown) {
         std::string cell = "-";
-        for (const auto& e : v.equal_error) {
-          if (e.problem != p || e.target != t) continue;
-          if (e.ours.found()) {
-            cell = e.ours.method;
-            if (std::isfinite(e.ratio))
-              cell += fmt::format(" {:.2g}x{}", e.ratio,
-                                  e.verdict == "ahead"     ? "+"
-                                  : e.verdict == "behind"  ? "-"
-                                  : e.verdict == "bounded" ? "?"
-                                                           : "~");
-          } else if (e.peer.found()) {
-            cell = "(" + e.peer.method + ")";
-          }
-        }
+        for (const auto& e : rows)
+          if (e.problem == p && e.target == t) cell = cell_of(e);
         row.push_back(cell);
       }
       tb.add(row);
     }
+    return render_text(tb);
+  };
+  out += fmt::format(
+      "Fastest of ours at equal error (err_pos_max in the problem's unit, m or rad), and its {} over the fastest "
+      "library peer's: + ahead, - behind, ~ within the {}, ? undecided (the cheaper side's cost only bounded: "
+      "its ladder does not bracket the target); (peer) when none of ours reaches it.\n",
+      timed ? "time" : "force evaluations",
+      timed ? "timing noise (the larger of 15 %, 25 % from a single repetition, and 3x the repetitions' spread)"
+            : "interpolation's rounding");
+  out += by_target(v.equal_error, [](const equal_error_verdict& e) -> std::string {
+    if (e.ours.found())
+      return e.ours.method + (std::isfinite(e.ratio) ? " " + marked_ratio(e.ratio, e.verdict) : std::string());
+    return e.peer.found() ? "(" + e.peer.method + ")" : "-";
+  });
+  // The plugins' fastest method at the same targets, against both sides.
+  if (!v.plugin_equal_error.empty()) {
     out += fmt::format(
-        "Fastest of ours at equal error (err_pos_max in the problem's unit, m or rad), and its {} over the fastest "
-        "library peer's: + ahead, - behind, ~ within the {}, ? undecided (the cheaper side's cost only bounded: "
-        "its ladder does not bracket the target); (peer) when none of ours reaches it.\n",
-        timed ? "time" : "force evaluations",
-        timed ? "timing noise (the larger of 15 %, 25 % from a single repetition, and 3x the repetitions' spread)"
-              : "interpolation's rounding");
-    out += render_text(tb);
+        "\nFastest plugin method at equal error, and its {} over the fastest of ours's / over the fastest library "
+        "peer's (marks as above, from the plugin's side: + the plugin's is cheaper); - where none reaches it.\n",
+        timed ? "time" : "force evaluations");
+    out += by_target(v.plugin_equal_error, [](const plugin_at_error& e) -> std::string {
+      if (!e.plugin.found()) return "-";
+      const auto against = [](double r, const std::string& verdict) {
+        return std::isfinite(r) ? marked_ratio(r, verdict) : std::string("-");
+      };
+      return e.plugin.method + " " + against(e.vs_ours, e.verdict_ours) + " / " + against(e.vs_peer, e.verdict_peer);
+    });
   }
   // The frame-rate table at 60 Hz.
   {

@@ -158,6 +158,9 @@ std::pair<std::string, std::string> first_difference(const std::string& a, const
 // study's problem order, each problem's rows in its shard's order; fields by the schema.
 void join_table(const std::vector<shard_file>& shards, H5::Group& dst, const std::string& where,
                 const std::string& name, const schema::table& spec, const std::vector<std::string>& order) {
+  // A table only some studies have (/verdict/plugin_equal_error: the shards loaded the same
+  // plugins, or merge refused them) is joined where the shards have it.
+  if (!h5::is_dataset(shards.front().file.openGroup(where), name)) return;
   std::vector<h5::table_data> parts;
   for (const auto& s : shards) parts.push_back(h5::read_table(s.file.openDataSet(where + "/" + name)));
   std::map<std::string, std::size_t> rank;

@@ -40,13 +40,13 @@ void judge_findings_again(H5::Group& root, const std::vector<std::string>& probl
 namespace {
 
 // A side's figure at equal error, NaN when it reaches no target.
-template <cost_at_error equal_error_verdict::*side, double cost_at_error::*figure>
-double figure_of(const equal_error_verdict& e) {
+template <class R, cost_at_error R::*side, double cost_at_error::*figure>
+double figure_of(const R& e) {
   const auto& c = e.*side;
   return c.found() ? c.*figure : nan;
 }
-template <cost_at_error equal_error_verdict::*side, double cost_at_error::*figure>
-void set_figure(equal_error_verdict& e, double v) {
+template <class R, cost_at_error R::*side, double cost_at_error::*figure>
+void set_figure(R& e, double v) {
   (e.*side).*figure = v;
 }
 
@@ -60,22 +60,44 @@ const column_map<equal_error_verdict>& equal_error_columns() {
           .member("target", &R::target)
           .member("ours_method", &R::ours, &C::method)
           .member("ours_kind", &R::ours, &C::kind)
-          .field("ours_param", figure_of<&R::ours, &C::param>, set_figure<&R::ours, &C::param>)
-          .field("ours_cost", figure_of<&R::ours, &C::cost>, set_figure<&R::ours, &C::cost>)
-          .field("ours_cost_lo", figure_of<&R::ours, &C::cost_lo>, set_figure<&R::ours, &C::cost_lo>)
-          .field("ours_cost_hi", figure_of<&R::ours, &C::cost_hi>, set_figure<&R::ours, &C::cost_hi>)
+          .field("ours_param", figure_of<R, &R::ours, &C::param>, set_figure<R, &R::ours, &C::param>)
+          .field("ours_cost", figure_of<R, &R::ours, &C::cost>, set_figure<R, &R::ours, &C::cost>)
+          .field("ours_cost_lo", figure_of<R, &R::ours, &C::cost_lo>, set_figure<R, &R::ours, &C::cost_lo>)
+          .field("ours_cost_hi", figure_of<R, &R::ours, &C::cost_hi>, set_figure<R, &R::ours, &C::cost_hi>)
           .member("ours_interpolated", &R::ours, &C::interpolated)
           .member("peer_method", &R::peer, &C::method)
           .member("peer_kind", &R::peer, &C::kind)
-          .field("peer_param", figure_of<&R::peer, &C::param>, set_figure<&R::peer, &C::param>)
-          .field("peer_cost", figure_of<&R::peer, &C::cost>, set_figure<&R::peer, &C::cost>)
-          .field("peer_cost_lo", figure_of<&R::peer, &C::cost_lo>, set_figure<&R::peer, &C::cost_lo>)
-          .field("peer_cost_hi", figure_of<&R::peer, &C::cost_hi>, set_figure<&R::peer, &C::cost_hi>)
+          .field("peer_param", figure_of<R, &R::peer, &C::param>, set_figure<R, &R::peer, &C::param>)
+          .field("peer_cost", figure_of<R, &R::peer, &C::cost>, set_figure<R, &R::peer, &C::cost>)
+          .field("peer_cost_lo", figure_of<R, &R::peer, &C::cost_lo>, set_figure<R, &R::peer, &C::cost_lo>)
+          .field("peer_cost_hi", figure_of<R, &R::peer, &C::cost_hi>, set_figure<R, &R::peer, &C::cost_hi>)
           .member("peer_interpolated", &R::peer, &C::interpolated)
           .member("ratio", &R::ratio)
           .member("cost_kind", &R::cost_kind)
           .member("verdict", &R::verdict)
           .member("best_error", &R::best_error);
+  return columns;
+}
+
+const column_map<plugin_at_error>& plugin_equal_error_columns() {
+  using R = plugin_at_error;
+  using C = cost_at_error;
+  static const auto columns =
+      column_map<R>("verdict_plugin_equal_error", "/verdict/plugin_equal_error")
+          .member("problem", &R::problem)
+          .member("unit", &R::unit)
+          .member("target", &R::target)
+          .member("plugin_method", &R::plugin, &C::method)
+          .member("plugin_kind", &R::plugin, &C::kind)
+          .field("plugin_param", figure_of<R, &R::plugin, &C::param>, set_figure<R, &R::plugin, &C::param>)
+          .field("plugin_cost", figure_of<R, &R::plugin, &C::cost>, set_figure<R, &R::plugin, &C::cost>)
+          .field("plugin_cost_lo", figure_of<R, &R::plugin, &C::cost_lo>, set_figure<R, &R::plugin, &C::cost_lo>)
+          .field("plugin_cost_hi", figure_of<R, &R::plugin, &C::cost_hi>, set_figure<R, &R::plugin, &C::cost_hi>)
+          .member("plugin_interpolated", &R::plugin, &C::interpolated)
+          .member("vs_ours", &R::vs_ours)
+          .member("vs_peer", &R::vs_peer)
+          .member("verdict_ours", &R::verdict_ours)
+          .member("verdict_peer", &R::verdict_peer);
   return columns;
 }
 
@@ -115,8 +137,8 @@ const auto frame_rate_run_columns = column_map<frame_option>("frame_rate_runs", 
 }  // namespace
 
 std::vector<schema::table> verdict_file_tables() {
-  return {equal_error_columns().spec(), frame_rate_columns.spec(), frame_answer_columns.spec(),
-          frame_rate_run_columns.spec()};
+  return {equal_error_columns().spec(), plugin_equal_error_columns().spec(), frame_rate_columns.spec(),
+          frame_answer_columns.spec(), frame_rate_run_columns.spec()};
 }
 
 void write_verdict(H5::Group& root, const study& s) {
@@ -136,6 +158,8 @@ void write_verdict(H5::Group& root, const study& s) {
        "lies outside the timing noise: the larger of 15 % (25 % from one repetition) and 3 x the repetitions' "
        "relative spread, the band stepbench compare uses between two runs");
   equal_error_columns().write(g, "equal_error", v.equal_error);
+  // Only in a study that loaded plugins: a study without has no table rather than an empty one.
+  if (!v.plugin_equal_error.empty()) plugin_equal_error_columns().write(g, "plugin_equal_error", v.plugin_equal_error);
   frame_rate_columns.write(g, "frame_rate", v.frame_rate);
   frame_answer_columns.write(g, "frame_answer", v.frame_answers);
 }
@@ -189,6 +213,8 @@ verdict_tables read_verdict(const H5::Group& root) {
   v.cost_kind = h5::string_attr(g, "cost_kind");
   v.findings = stored_list(h5::string_attr(g, "findings"), '\n');  // a finding is one sentence, never empty
   v.equal_error = equal_error_columns().read(g, "equal_error");
+  if (h5::is_dataset(g, "plugin_equal_error"))
+    v.plugin_equal_error = plugin_equal_error_columns().read(g, "plugin_equal_error");
   v.frame_rate = frame_rate_columns.read(g, "frame_rate");
   v.frame_answers = frame_answer_columns.read(g, "frame_answer");
   return v;

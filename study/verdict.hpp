@@ -46,6 +46,20 @@ struct equal_error_verdict {
   double best_error = 0.0;
 };
 
+// A plugin's answer to "how does my method compare?": for each problem and target, the
+// fastest plugin method at equal error against the fastest of ours and the fastest
+// library peer (each as equal_error_verdict ranks them), with the same rule and noise band.
+// Present only in a study that loaded plugins (--plugin).
+struct plugin_at_error {
+  std::string problem, unit;
+  double target = 0.0;
+  cost_at_error plugin;
+  double vs_ours = 0.0, vs_peer = 0.0;  // plugin / ours, plugin / peer; NaN unless both found
+  // As equal_error_verdict's verdict, from the plugin's side: "ahead" = the plugin's cheaper;
+  // "plugin only" where the other side reaches no target, "others only", "not reached".
+  std::string verdict_ours, verdict_peer;
+};
+
 struct frame_stability {
   std::string problem, unit, method, note;
   double hz = 0.0;
@@ -63,6 +77,7 @@ struct frame_answer {
 struct verdict_tables {
   std::string cost_kind;  // "time_ns" or "force_evals"
   std::vector<equal_error_verdict> equal_error;
+  std::vector<plugin_at_error> plugin_equal_error;
   std::vector<frame_stability> frame_rate;
   std::vector<frame_answer> frame_answers;
   std::vector<std::string> findings;

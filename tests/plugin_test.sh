@@ -88,15 +88,59 @@ PY
 expect_error "The following argument was not expected: --isolate" loop --plugin "$plugins/librk4.so" --isolate --problem pendulum \
   --integrator plugin_rk4 --design fixed
 
+# The plugins' line of the verdict: the plugin RK4 against the fastest of ours (rk4 alone
+# here, whose rows it equals bit for bit) and the fastest peer (odeint_rk4), at each target:
+# its cost is rk4's, so it is 1x ours, within the rounding, and what ours is to the peer.
+"$bin" sweep --plugin "$work/libmy.so" --problem pendulum --method rk4 --method my_rk4 --method odeint_rk4 \
+  --parts sweep,verdict --out "$work/verdict.h5" >"$work/verdict.txt" 2>"$work/err" || bad "sweep, verdict: $(cat "$work/err")"
+/usr/bin/python3 - "$work/verdict.h5" <<'PY' && ok || bad "the plugins' verdict table"
+import h5py, math, sys
+v = h5py.File(sys.argv[1], "r")["verdict"]
+pe, ee = v["plugin_equal_error"][()], v["equal_error"][()]
+assert len(pe) == len(ee) > 0, (len(pe), len(ee))
+reached = 0
+for p, e in zip(pe, ee):
+    assert p["target"] == e["target"] and p["problem"] == e["problem"] == b"pendulum"
+    if not e["ours_method"]:
+        assert not p["plugin_method"] and p["verdict_ours"] == b"not reached", p  # rk4's rows, the plugin's
+        continue
+    reached += 1
+    assert e["ours_method"] == b"rk4" and p["plugin_method"] == b"my_rk4", (e, p)
+    assert p["plugin_cost"] == e["ours_cost"] and p["vs_ours"] == 1.0 and p["verdict_ours"] == b"within spread", p
+    if e["peer_method"]:
+        assert math.isclose(p["vs_peer"], e["ratio"], rel_tol=1e-15) and p["verdict_peer"] == e["verdict"], (p, e)
+assert reached >= 3, reached
+PY
+# The report's first page shows it after the equal-error table.
+/usr/bin/python3 "$src/scripts/report" "$work/verdict.h5" --out "$work/report" >/dev/null 2>"$work/err" \
+  || bad "report of the plugin study: $(cat "$work/err")"
+grep -q "Your plugin&#x27;s methods at equal error\|Your plugin's methods at equal error" "$work/report/index.html" \
+  && grep -q "my_rk4" "$work/report/index.html" && ok || bad "the report shows no plugin table"
+# A study without plugins has no such table.
+"$bin" sweep --problem pendulum --method rk4 --method odeint_rk4 --parts sweep,verdict --out "$work/none.h5" \
+  >/dev/null 2>&1 || bad "sweep without plugins"
+/usr/bin/python3 -c 'import h5py, sys; assert "plugin_equal_error" not in h5py.File(sys.argv[1], "r")["verdict"]' \
+  "$work/none.h5" && ok || bad "a study without plugins has a plugin table"
+
 # Shards that loaded different plugins (by path or bytes) are not one study: merge refuses
 # them in one line (the sweep's options name each plugin and its hash); the same plugin joins.
 for k in 1 2; do
   "$bin" sweep --plugin "$plugins/libruth3.so" --problem pendulum --problem damped_spring --method rk4 \
-    --parts sweep --shard $k/2 --quiet --out "$work/s$k.h5" 2>/dev/null || bad "shard $k"
+    --method ruth3 --parts sweep,verdict --shard $k/2 --quiet --out "$work/s$k.h5" 2>/dev/null || bad "shard $k"
 done
-"$bin" sweep --plugin "$plugins/librk4.so" --problem pendulum --problem damped_spring --method rk4 \
-  --parts sweep --shard 2/2 --quiet --out "$work/other.h5" 2>/dev/null || bad "shard 2 with another plugin"
-expect_error "has plugin: $plugins/librk4.so fnv1a_64" merge "$work/s1.h5" "$work/other.h5" --out "$work/never.h5"
+# Another build of ruth3: the same library with one byte more (it loads the same).
+cp "$plugins/libruth3.so" "$work/libruth3_other.so" && printf '\0' >>"$work/libruth3_other.so"
+"$bin" sweep --plugin "$work/libruth3_other.so" --problem pendulum --problem damped_spring --method rk4 \
+  --method ruth3 --parts sweep,verdict --shard 2/2 --quiet --out "$work/other.h5" 2>/dev/null \
+  || bad "shard 2 with another plugin"
+expect_error "has plugin: $work/libruth3_other.so fnv1a_64" merge "$work/s1.h5" "$work/other.h5" --out "$work/never.h5"
 "$bin" merge "$work/s1.h5" "$work/s2.h5" --out "$work/merged.h5" >/dev/null 2>&1 && ok || bad "merge of shards with one plugin"
+# The plugins' verdict rows of both shards' problems, joined.
+/usr/bin/python3 - "$work/merged.h5" <<'PY' && ok || bad "the merged study's plugin verdict"
+import h5py, sys
+pe = h5py.File(sys.argv[1], "r")["verdict/plugin_equal_error"][()]
+assert {p.decode() for p in pe["problem"]} == {"pendulum", "damped_spring"}, set(pe["problem"])
+assert {m.decode() for m in pe["plugin_method"] if m} == {"ruth3"}, set(pe["plugin_method"])
+PY
 
 finish plugin_test

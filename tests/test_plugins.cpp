@@ -112,10 +112,13 @@ TEST(plugins, bad_plugins_are_refused_in_one_line) {
   expect_refused(plugin_path("bad/libbad_reserved.so"), "method 1 (rk4): the name is taken");
   expect_refused(plugin_path("bad/libbad_fields.so"), "method 1 (bad_fields): its order is 0, not 1 to 16");
   EXPECT_EQ(all_methods().size(), methods_before);
+  // ruth3 may be loaded already (the cases share a process when the executable runs whole).
+  const auto& all = all_methods();
+  const bool had_ruth3 = std::any_of(all.begin(), all.end(), [](const method_info& m) { return m.name == "ruth3"; });
   ensure_loaded(plugin_path("libruth3.so"));
   // The same plugin twice: its names are taken by the first.
   expect_refused(plugin_path("libruth3.so"), "method 1 (ruth3): the name is taken");
-  EXPECT_EQ(all_methods().size(), methods_before + 1);
+  EXPECT_EQ(all_methods().size(), methods_before + (had_ruth3 ? 0 : 1));
 }
 
 // One run of a bad plugin's method on the pendulum at dt = 0.01 s (552 steps).

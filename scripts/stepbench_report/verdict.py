@@ -15,6 +15,7 @@ from .render import Cell, esc
 
 VERDICT_ATTRS = ("metric", "targets", "frame_hz", "cost_kind", "findings", "rule")
 VERDICTS = ("ahead", "behind", "within spread", "bounded", "ours only", "peers only", "not reached")
+PLUGIN_VERDICTS = ("ahead", "behind", "within spread", "bounded", "plugin only", "others only", "not reached")
 COST_KINDS = ("time_ns", "force_evals")
 # The cell's class in index.html: green ahead, red behind, grey within the timing noise; none
 # (white) for "bounded", "ours only".
@@ -31,6 +32,7 @@ class Verdict:
     equal_error: np.ndarray  # one row per (problem, target), strings decoded
     frame_rate: np.ndarray  # one row per (problem, hz, method)
     frame_answer: np.ndarray  # one row per (problem, hz, target)
+    plugin_equal_error: np.ndarray = None  # one row per (problem, target); None: the study loaded no plugin
 
     @property
     def targets(self):
@@ -62,13 +64,22 @@ class Verdict:
 
     def only(self, problem):
         """The verdict of one problem."""
+        pe = self.plugin_equal_error
         return replace(self, equal_error=self.equal_error[self.equal_error["problem"] == problem],
+                       plugin_equal_error=None if pe is None else pe[pe["problem"] == problem],
                        frame_rate=self.frame_rate[self.frame_rate["problem"] == problem],
                        frame_answer=self.frame_answer[self.frame_answer["problem"] == problem])
 
     def equal(self, problem, target):
         rows = self.equal_error[(self.equal_error["problem"] == problem)
                                 & np.isclose(self.equal_error["target"], target, rtol=1e-9, atol=0)]
+        return rows[0] if len(rows) else None
+
+    def plugin(self, problem, target):
+        pe = self.plugin_equal_error
+        if pe is None:
+            return None
+        rows = pe[(pe["problem"] == problem) & np.isclose(pe["target"], target, rtol=1e-9, atol=0)]
         return rows[0] if len(rows) else None
 
     def answer(self, problem, hz, target):
@@ -95,8 +106,13 @@ def read(reader, f):
     reader.need_value(g, "cost_kind", attrs["cost_kind"], COST_KINDS)
     ee = reader.need_table(g, "equal_error", schema.fields("verdict_equal_error"))
     reader.need_column(g, "equal_error", ee, "verdict", VERDICTS)
+    pe = None
+    if "plugin_equal_error" in g:  # only in a study that loaded plugins
+        pe = reader.need_table(g, "plugin_equal_error", schema.fields("verdict_plugin_equal_error"))
+        for column in ("verdict_ours", "verdict_peer"):
+            reader.need_column(g, "plugin_equal_error", pe, column, PLUGIN_VERDICTS)
     return Verdict(attrs, ee, reader.need_table(g, "frame_rate", schema.fields("verdict_frame_rate")),
-                   reader.need_table(g, "frame_answer", schema.fields("verdict_frame_answer")))
+                   reader.need_table(g, "frame_answer", schema.fields("verdict_frame_answer")), pe)
 
 
 # --- text ----------------------------------------------------------------------------------------
@@ -152,6 +168,22 @@ def equal_error_cell(r, kind):
         return Cell(f"none of ours; peer {peer} {param}, {cost}",
                     f'<span class="small">none of ours</span><br>{esc(peer)} {esc(param)} &middot; {esc(cost)}', cls)
     return Cell("not reached", "&ndash;", cls)
+
+
+def plugin_cell(r, kind):
+    """One (problem, target) of the plugins' table: their fastest method, its dt or tolerance
+    and cost; under it its cost as a multiple of the fastest of ours's and the fastest peer's."""
+    if r is None or not r["plugin_method"]:
+        return Cell("not reached", "&ndash;", "none")
+    method = r["plugin_method"]
+    param, cost = param_text(r["plugin_kind"], r["plugin_param"]), cost_text(kind, r["plugin_cost"])
+    against = " &middot; ".join(f"{ratio_text(r[f'vs_{side}'])} {name}" for side, name in (("ours", "ours"), ("peer", "peer"))
+                                if np.isfinite(r[f"vs_{side}"]))
+    plain = ", ".join(f"{ratio_text(r[f'vs_{side}'])} {side}" for side in ("ours", "peer") if np.isfinite(r[f"vs_{side}"]))
+    return Cell(f"{method} {param}, {cost}" + (f" ({plain})" if plain else ""),
+                f"<b>{esc(method)}</b> {esc(param)} &middot; {esc(cost)}"
+                + (f'<br><span class="small">{against}</span>' if against else ""),
+                VERDICT_CLASS.get(r["verdict_ours"], ""))
 
 
 def problem_cell(verdict, problem):
@@ -335,6 +367,15 @@ def opening(doc, verdict):
           "measured row already under the target: its ladder does not bracket it) or no peer runs on the problem; "
           f"best: the lowest error any method reached. Rule: {verdict.attrs['rule']}.",
           cls="caption")
+    if verdict.plugin_equal_error is not None:
+        doc.h(2, "Your plugin's methods at equal error")
+        doc.table(head, [[problem_cell(verdict, p)] + [plugin_cell(verdict.plugin(p, t), kind) for t in shown]
+                         for p in verdict.problems], cls="verdict")
+        doc.p("Each cell: the fastest method the study's plugins brought (--plugin) at the column's target, by the "
+              f"same rule, its dt or tolerance and its cost by {by}; under it, that cost as a multiple of the fastest "
+              "of ours's and of the fastest library peer's at the same error (0.5x: half theirs). The colour is its "
+              "verdict against ours: green the plugin's is cheaper, red dearer, grey within the timing noise.",
+              cls="caption")
     doc.h(2, "At a frame rate")
     doc.table(["problem [unit]"] + [f"{hz:g} Hz" for hz in verdict.frame_hz],
               [[problem_cell(verdict, p)] + [frame_cell(verdict, p, hz) for hz in verdict.frame_hz]
@@ -368,6 +409,19 @@ def problem_section(doc, verdict, problem):
     cost = "time" if kind == "time_ns" else "force evals"
     doc.table([f"target [{unit}]", "fastest of ours", "its dt or tolerance", f"{cost} (spread)", "fastest peer",
                "its dt or tolerance", f"{cost} (spread)", "ours / peer", "verdict"], rows)
+    if v.plugin_equal_error is not None:
+        rows = []
+        for t in v.targets:
+            r = v.plugin(problem, t)
+            if r is None:
+                continue
+            mine = [r["plugin_method"], param_text(r["plugin_kind"], r["plugin_param"]), _spread(kind, r, "plugin")] \
+                if r["plugin_method"] else ["none", "", ""]
+            ratios = [ratio_text(r[c]) if np.isfinite(r[c]) else "" for c in ("vs_ours", "vs_peer")]
+            rows.append([target_text(t)] + mine + [ratios[0], r["verdict_ours"], ratios[1], r["verdict_peer"]])
+        doc.table([f"target [{unit}]", "fastest plugin method", "its dt or tolerance", f"{cost} (spread)",
+                   "plugin / ours", "against ours", "plugin / peer", "against the peer"], rows,
+                  caption="The plugins' fastest method at the same targets (the verdicts from its side):")
     doc.h(3, f"{problem}: at a frame rate")
     rows = []
     for hz in v.frame_hz:
@@ -418,6 +472,8 @@ def summary(study):
                           "targets": v.targets, "frame_hz": v.frame_hz, "findings": v.findings,
                           "equal_error": _records(v.equal_error), "frame_rate": _records(v.frame_rate),
                           "frame_answer": _records(v.frame_answer)}
+        if v.plugin_equal_error is not None:
+            out["verdict"]["plugin_equal_error"] = _records(v.plugin_equal_error)
     return out
 
 

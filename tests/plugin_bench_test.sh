@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# A plugin in the timed study, as docs/plugins.md shows it: `stepbench_bench --plugin=PATH
+# --quick` on the pendulum times the example RK4 beside rk4, fits its order, ranks it in the
+# plugins' verdict by measured time, and `stepbench ratios` prints its time a step against
+# rk4's; a bad --plugin is refused in one line before anything runs.
+# usage: plugin_bench_test.sh path/to/stepbench path/to/stepbench_bench PLUGIN_DIR (build/plugins)
+set -u
+bin=${1:?usage: plugin_bench_test.sh stepbench stepbench_bench plugin-dir}
+bench=${2:?}
+plugins=${3:?}
+. "$(dirname "${BASH_SOURCE[0]}")/expect.sh"
+
+"$bench" --plugin="$plugins/librk4.so" --quick --problem=pendulum --parts=sweep,verdict \
+  --study_out="$work/timed.h5" >"$work/out" 2>"$work/err" || bad "stepbench_bench --plugin: $(tail -3 "$work/err")"
+/usr/bin/python3 - "$work/timed.h5" <<'PY' && ok || bad "the timed study with the plugin"
+import h5py, json, sys
+f = h5py.File(sys.argv[1], "r")
+assert [p["methods"] for p in json.loads(f.attrs["plugins"])] == [["plugin_rk4"]], f.attrs["plugins"]
+m = f["problems/pendulum/methods"]
+mine, ours = m["plugin_rk4"], m["rk4"]
+assert mine.attrs["origin"] == "plugin" and mine.attrs["fit_status"] == "fitted", dict(mine.attrs)
+assert mine.attrs["fit_slope"] == ours.attrs["fit_slope"]
+runs = mine["runs"][()]
+assert (runs["err_pos_max"] == ours["runs"]["err_pos_max"]).all()
+assert (runs["time_ns"] > 0).any(), "the plugin's rows are not timed"
+v = f["verdict"]
+assert v.attrs["cost_kind"] == "time_ns"
+pe = v["plugin_equal_error"][()]
+reached = [p for p in pe if p["plugin_method"] == b"plugin_rk4"]
+assert len(reached) >= 3, pe
+assert all(p["plugin_cost"] > 0 and p["vs_ours"] > 0 for p in reached), reached
+assert any("plugins' fastest method" in line for line in v.attrs["findings"].split("\n")), v.attrs["findings"]
+PY
+grep -q "Fastest plugin method at equal error" "$work/out" "$work/err" && ok || bad "the printed verdict has no plugin table"
+"$bin" ratios --study "$work/timed.h5" >"$work/ratios" 2>&1 || bad "ratios: $(cat "$work/ratios")"
+grep -q "Step cost, the example plugin RK4" "$work/ratios" && ok || bad "ratios prints no plugin step cost: $(cat "$work/ratios")"
+
+# A bad plugin: one line, exit 2, no study.
+"$bench" --plugin="$work/none.so" --quick --problem=pendulum --study_out="$work/never.h5" >/dev/null 2>"$work/err"
+rc=$?
+[ "$rc" -eq 2 ] && [ "$(wc -l <"$work/err")" -eq 1 ] && grep -q "none.so" "$work/err" && [ ! -e "$work/never.h5" ] \
+  && ok || bad "a missing plugin file: exit $rc, $(cat "$work/err")"
+
+finish plugin_bench_test

@@ -46,16 +46,17 @@ cost_at_error cost_of(const std::vector<wp_method>& methods, const wp_pick* p) {
   return {m.name, std::string(to_string(m.kind)), p->param, p->cost, p->cost_lo, p->cost_hi, p->interpolated};
 }
 
-// `mine` against `other` at equal error; the one-sided outcomes are named by the caller.
-std::string verdict_of(const cost_at_error& ours, const cost_at_error& peer, bool timed,
-                       const char* ours_only = "ours only", const char* peers_only = "peers only") {
-  if (!ours.found() && !peer.found()) return "not reached";
-  if (!peer.found()) return ours_only;
-  if (!ours.found()) return peers_only;
-  const std::string v =
-      compare_at_equal_error({ours.cost, ours.cost_lo, ours.cost_hi}, {peer.cost, peer.cost_lo, peer.cost_hi}, timed);
-  // An upper bound on the side found cheaper proves nothing: its true cost may be lower.
-  if ((v == "ahead" && !peer.interpolated) || (v == "behind" && !ours.interpolated)) return "bounded";
+// `mine` against `other` at equal error, "ahead" when mine is cheaper; the one-sided
+// outcomes are named by the caller (ours against a peer, a plugin's against either).
+std::string verdict_of(const cost_at_error& mine, const cost_at_error& other, bool timed,
+                       const char* mine_only = "ours only", const char* other_only = "peers only") {
+  if (!mine.found() && !other.found()) return "not reached";
+  if (!other.found()) return mine_only;
+  if (!mine.found()) return other_only;
+  const std::string v = compare_at_equal_error({mine.cost, mine.cost_lo, mine.cost_hi},
+                                               {other.cost, other.cost_lo, other.cost_hi}, timed);
+  // The side found dearer charged only an upper bound proves nothing: its true cost may be lower.
+  if ((v == "ahead" && !other.interpolated) || (v == "behind" && !mine.interpolated)) return "bounded";
   return v;
 }
 

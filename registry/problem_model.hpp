@@ -196,7 +196,7 @@ class problem_model final : public problem_instance {
 
   loop_result loop(std::string_view method, const loop_config& config) const override {
     const method_info& m = find_method(method);  // throws for an unknown name
-    const bool offered = m.origin == method_origin::ours || m.origin == method_origin::plugin;
+    const bool offered = offered_as_ours(m.origin);
     if (!offered || m.kind != method_kind::fixed_step)
       throw std::invalid_argument(
           fmt::format("the game loop runs fixed-step integrators, ours and the plugins'; {} is {}", method,

@@ -151,6 +151,11 @@ class column_map {
     bindings_.back().missing = value;
     return std::move(*this);
   }
+  // The table is written only when it has rows (schema::table::optional).
+  column_map&& optional() {
+    spec_.optional = true;
+    return std::move(*this);
+  }
   // The fields bound after this one form a timed-only group: present exactly when the study
   // was timed (stepbench_bench --study_out), as a whole.
   column_map&& timed_only() {

@@ -158,11 +158,16 @@ std::pair<std::string, std::string> first_difference(const std::string& a, const
 // study's problem order, each problem's rows in its shard's order; fields by the schema.
 void join_table(const std::vector<shard_file>& shards, H5::Group& dst, const std::string& where,
                 const std::string& name, const schema::table& spec, const std::vector<std::string>& order) {
-  // A table only some studies have (/verdict/plugin_equal_error: the shards loaded the same
-  // plugins, or merge refused them) is joined where the shards have it.
-  if (!h5::is_dataset(shards.front().file.openGroup(where), name)) return;
+  // An optional table (schema::table::optional) is joined from the shards that have it: a
+  // shard without its rows (no problem, or none a plugin's method ran on) has none.
   std::vector<h5::table_data> parts;
-  for (const auto& s : shards) parts.push_back(h5::read_table(s.file.openDataSet(where + "/" + name)));
+  std::vector<const shard_file*> from;  // the shard of each part
+  for (const auto& s : shards)
+    if (!spec.optional || h5::is_dataset(s.file.openGroup(where), name)) {
+      parts.push_back(h5::read_table(s.file.openDataSet(where + "/" + name)));
+      from.push_back(&s);
+    }
+  if (parts.empty()) return;
   std::map<std::string, std::size_t> rank;
   for (std::size_t i = 0; i < order.size(); ++i) rank[order[i]] = i;
   std::vector<std::tuple<std::size_t, std::size_t, std::size_t>> rows;  // (problem rank, part, row)
@@ -172,7 +177,7 @@ void join_table(const std::vector<shard_file>& shards, H5::Group& dst, const std
       const auto it = rank.find(problem[i]);
       if (it == rank.end())
         throw std::runtime_error(fmt::format("'{}': {}/{} has a row of problem '{}', which it does not hold",
-                                             shards[k].path, where, name, problem[i]));
+                                             from[k]->path, where, name, problem[i]));
       rows.emplace_back(it->second, k, i);
     }
   }

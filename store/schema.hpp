@@ -34,6 +34,9 @@ struct table {
   std::string_view name;   // the schema's name for it ("runs", "front")
   std::string_view where;  // where it lives in the file, for the reader and the docs
   std::span<const field_group> groups;
+  // Written only when the study has rows for it (/verdict/plugin_equal_error: only a study
+  // that swept a plugin's method): a reader or a merge takes its absence as no rows.
+  bool optional = false;
 };
 
 // Every table of the study file, the loop, energy and substeps studies included.

@@ -84,6 +84,7 @@ const column_map<plugin_at_error>& plugin_equal_error_columns() {
   using C = cost_at_error;
   static const auto columns =
       column_map<R>("verdict_plugin_equal_error", "/verdict/plugin_equal_error")
+          .optional()
           .member("problem", &R::problem)
           .member("unit", &R::unit)
           .member("target", &R::target)

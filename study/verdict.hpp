@@ -17,6 +17,7 @@
 //    step of the method on the problem times the steps of a frame (timed study), else the
 //    force evaluations of a frame.
 //  - Findings: a few sentences generated from these and the other studies' verdicts.
+#include <limits>
 #include <map>
 #include <set>
 #include <string>
@@ -54,7 +55,8 @@ struct plugin_at_error {
   std::string problem, unit;
   double target = 0.0;
   cost_at_error plugin;
-  double vs_ours = 0.0, vs_peer = 0.0;  // plugin / ours, plugin / peer; NaN unless both found
+  double vs_ours = std::numeric_limits<double>::quiet_NaN();  // plugin / ours; NaN unless both found
+  double vs_peer = std::numeric_limits<double>::quiet_NaN();  // plugin / peer; likewise
   // As equal_error_verdict's verdict, from the plugin's side: "ahead" = the plugin's cheaper;
   // "plugin only" where the other side reaches no target, "others only", "not reached".
   std::string verdict_ours, verdict_peer;

@@ -135,12 +135,38 @@ cp "$plugins/libruth3.so" "$work/libruth3_other.so" && printf '\0' >>"$work/libr
   || bad "shard 2 with another plugin"
 expect_error "has plugin: $work/libruth3_other.so fnv1a_64" merge "$work/s1.h5" "$work/other.h5" --out "$work/never.h5"
 "$bin" merge "$work/s1.h5" "$work/s2.h5" --out "$work/merged.h5" >/dev/null 2>&1 && ok || bad "merge of shards with one plugin"
-# The plugins' verdict rows of both shards' problems, joined.
+# The plugins' verdict rows of both shards' problems, joined; ruth3 (third order) against
+# rk4 by force evaluations: each ratio is ruth3's cost over rk4's at the same target, and
+# its verdict is from ruth3's side (ahead when cheaper).
 /usr/bin/python3 - "$work/merged.h5" <<'PY' && ok || bad "the merged study's plugin verdict"
-import h5py, sys
-pe = h5py.File(sys.argv[1], "r")["verdict/plugin_equal_error"][()]
+import h5py, math, sys
+v = h5py.File(sys.argv[1], "r")["verdict"]
+pe, ee = v["plugin_equal_error"][()], v["equal_error"][()]
 assert {p.decode() for p in pe["problem"]} == {"pendulum", "damped_spring"}, set(pe["problem"])
 assert {m.decode() for m in pe["plugin_method"] if m} == {"ruth3"}, set(pe["plugin_method"])
+seen = set()
+for p in pe:
+    e = next(e for e in ee if e["problem"] == p["problem"] and e["target"] == p["target"])
+    if p["plugin_method"] and e["ours_method"]:
+        assert math.isclose(p["vs_ours"], p["plugin_cost"] / e["ours_cost"], rel_tol=1e-15), (p, e)
+        want = "ahead" if p["vs_ours"] < 1 / (1 + 1e-9) else "behind" if p["vs_ours"] > 1 + 1e-9 else "within spread"
+        assert p["verdict_ours"].decode() in (want, "bounded"), (p["verdict_ours"], want, p["vs_ours"])
+    elif e["ours_method"]:
+        assert p["verdict_ours"] == b"others only" and math.isnan(p["vs_ours"]), p
+    seen.add(p["verdict_ours"].decode())
+assert "behind" in seen and "ahead" in seen, seen  # rk4 needs fewer evaluations at tight targets, not at loose ones
 PY
+# A shard that ran no problem has no plugin table: merged in either order, the table is
+# the other shard's rows.
+"$bin" sweep --plugin "$plugins/libruth3.so" --problem pendulum --method rk4 --method ruth3 --parts sweep,verdict \
+  --shard 1/2 --quiet --out "$work/p1.h5" 2>/dev/null || bad "shard 1 of one problem"
+"$bin" sweep --plugin "$plugins/libruth3.so" --problem pendulum --method rk4 --method ruth3 --parts sweep,verdict \
+  --shard 2/2 --quiet --out "$work/p2.h5" 2>/dev/null || bad "shard 2 of one problem (none)"
+for order in "p1 p2" "p2 p1"; do
+  set -- $order
+  "$bin" merge "$work/$1.h5" "$work/$2.h5" --out "$work/m_$1.h5" >/dev/null 2>"$work/err" || bad "merge $order: $(cat "$work/err")"
+  /usr/bin/python3 -c 'import h5py, sys; pe = h5py.File(sys.argv[1], "r")["verdict/plugin_equal_error"][()]
+assert len(pe) > 0 and set(pe["problem"]) == {b"pendulum"}, pe' "$work/m_$1.h5" && ok || bad "merge $order: the plugin table"
+done
 
 finish plugin_test

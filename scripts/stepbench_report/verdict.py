@@ -18,9 +18,9 @@ VERDICTS = ("ahead", "behind", "within spread", "bounded", "ours only", "peers o
 PLUGIN_VERDICTS = ("ahead", "behind", "within spread", "bounded", "plugin only", "others only", "not reached")
 COST_KINDS = ("time_ns", "force_evals")
 # The cell's class in index.html: green ahead, red behind, grey within the timing noise; none
-# (white) for "bounded", "ours only".
+# (white) for "bounded", "ours only", "plugin only"; a plugin's "others only" is red as "peers only" is.
 VERDICT_CLASS = {"ahead": "ahead", "behind": "behind", "within spread": "within", "peers only": "behind",
-                 "not reached": "none"}
+                 "others only": "behind", "not reached": "none"}
 # Names shortened in the frame-rate table, whose cells list several methods; the key is printed under it.
 SHORT = {"semi_implicit_euler": "sie", "velocity_verlet": "vv", "forest_ruth": "fr", "implicit_euler": "ie",
          "implicit_midpoint": "im"}
@@ -177,12 +177,10 @@ def plugin_cell(r, kind):
         return Cell("not reached", "&ndash;", "none")
     method = r["plugin_method"]
     param, cost = param_text(r["plugin_kind"], r["plugin_param"]), cost_text(kind, r["plugin_cost"])
-    against = " &middot; ".join(f"{ratio_text(r[f'vs_{side}'])} {name}" for side, name in (("ours", "ours"), ("peer", "peer"))
-                                if np.isfinite(r[f"vs_{side}"]))
-    plain = ", ".join(f"{ratio_text(r[f'vs_{side}'])} {side}" for side in ("ours", "peer") if np.isfinite(r[f"vs_{side}"]))
-    return Cell(f"{method} {param}, {cost}" + (f" ({plain})" if plain else ""),
+    ratios = [f"{ratio_text(r[f'vs_{side}'])} {side}" for side in ("ours", "peer") if np.isfinite(r[f"vs_{side}"])]
+    return Cell(f"{method} {param}, {cost}" + (f" ({', '.join(ratios)})" if ratios else ""),
                 f"<b>{esc(method)}</b> {esc(param)} &middot; {esc(cost)}"
-                + (f'<br><span class="small">{against}</span>' if against else ""),
+                + (f'<br><span class="small">{" &middot; ".join(esc(x) for x in ratios)}</span>' if ratios else ""),
                 VERDICT_CLASS.get(r["verdict_ours"], ""))
 
 
@@ -374,7 +372,9 @@ def opening(doc, verdict):
         doc.p("Each cell: the fastest method the study's plugins brought (--plugin) at the column's target, by the "
               f"same rule, its dt or tolerance and its cost by {by}; under it, that cost as a multiple of the fastest "
               "of ours's and of the fastest library peer's at the same error (0.5x: half theirs). The colour is its "
-              "verdict against ours: green the plugin's is cheaper, red dearer, grey within the timing noise.",
+              "verdict against ours: green the plugin's is cheaper, red dearer (or only ours reach the target), grey "
+              f"within the {'timing noise' if kind == 'time_ns' else 'rounding'}, white undecided (the dearer side "
+              "charged only an upper bound) or only the plugin reaches the target.",
               cls="caption")
     doc.h(2, "At a frame rate")
     doc.table(["problem [unit]"] + [f"{hz:g} Hz" for hz in verdict.frame_hz],

@@ -79,7 +79,7 @@ std::vector<std::string> findings_of(const verdict_tables& v, const finding_inpu
     std::string line = fmt::format(
         "At equal error ({}, interpolated on each method's measured curve), the fastest of ours against the "
         "fastest library peer: ahead on {}, behind on {}, within the {} on {}, undecided on {} (the side found "
-        "cheaper only bounded: its ladder does not bracket the target) of the {} problem-and-target pairs both "
+        "dearer only bounded: its ladder does not bracket the target) of the {} problem-and-target pairs both "
         "reach; only ours reach {}, only a peer {}.",
         timed ? "measured time" : "force evaluations", n["ahead"], n["behind"], timed ? "timing noise" : "rounding",
         n["within spread"], n["bounded"], n["ahead"] + n["behind"] + n["within spread"] + n["bounded"], n["ours only"],

@@ -61,7 +61,7 @@ std::string format_verdict_text(const verdict_tables& v) {
   };
   out += fmt::format(
       "Fastest of ours at equal error (err_pos_max in the problem's unit, m or rad), and its {} over the fastest "
-      "library peer's: + ahead, - behind, ~ within the {}, ? undecided (the cheaper side's cost only bounded: "
+      "library peer's: + ahead, - behind, ~ within the {}, ? undecided (the dearer side's cost only bounded: "
       "its ladder does not bracket the target); (peer) when none of ours reaches it.\n",
       timed ? "time" : "force evaluations",
       timed ? "timing noise (the larger of 15 %, 25 % from a single repetition, and 3x the repetitions' spread)"

@@ -361,7 +361,7 @@ def opening(doc, verdict):
           f"in the problem's unit) reaches the column's target, its dt or tolerance there and its cost by {by}; under "
           "it, that cost as a multiple of the fastest library peer's at the same error (0.5x: half the peer's). The "
           "colour is the stored verdict: green ours ahead, red behind (or none of ours reaches the target), grey "
-          "within the timing noise, white undecided (the side found cheaper is charged only an upper bound, a "
+          "within the timing noise, white undecided (the side found dearer is charged only an upper bound, a "
           "measured row already under the target: its ladder does not bracket it) or no peer runs on the problem; "
           f"best: the lowest error any method reached. Rule: {verdict.attrs['rule']}.",
           cls="caption")

@@ -252,7 +252,7 @@ def test_verdict_is_the_fastest_of_ours_against_the_fastest_peer(plain, timed, s
                 threshold = max(0.15 if both else 0.25, 3 * max(spread(ours[0]), spread(peer[0])))
             ratio = ours[0]["cost"] / peer[0]["cost"]
             want = "ahead" if ratio < 1 / (1 + threshold) else "behind" if ratio > 1 + threshold else "within spread"
-            # The side found cheaper charged only an upper bound decides nothing.
+            # The side found dearer charged only an upper bound decides nothing (its true cost may be lower).
             if (want == "ahead" and not peer[0]["interpolated"]) or (want == "behind" and not ours[0]["interpolated"]):
                 want = "bounded"
             assert text(row["verdict"]) == want

@@ -3,30 +3,36 @@
 # --quick` on the pendulum times the example RK4 beside rk4, fits its order, ranks it in the
 # plugins' verdict by measured time, and `stepbench ratios` prints its time a step against
 # rk4's; a bad --plugin is refused in one line before anything runs.
-# usage: plugin_bench_test.sh path/to/stepbench path/to/stepbench_bench PLUGIN_DIR (build/plugins)
+# A user's plugin is built outside the tree with docs/plugins.md's one cc line (a copy of the
+# example renamed my_rk4) and joins the example's own build (plugin_rk4, which `ratios` names).
+# usage: plugin_bench_test.sh path/to/stepbench path/to/stepbench_bench SOURCE_DIR PLUGIN_DIR (build/plugins)
 set -u
-bin=${1:?usage: plugin_bench_test.sh stepbench stepbench_bench plugin-dir}
+bin=${1:?usage: plugin_bench_test.sh stepbench stepbench_bench source-dir plugin-dir}
 bench=${2:?}
-plugins=${3:?}
+src=${3:?}
+plugins=${4:?}
 . "$(dirname "${BASH_SOURCE[0]}")/expect.sh"
 
-"$bench" --plugin="$plugins/librk4.so" --quick --problem=pendulum --parts=sweep,verdict \
+sed 's/"plugin_rk4"/"my_rk4"/' "$src/examples/plugins/rk4.c" >"$work/my.c"
+(cd "$work" && cc -shared -fPIC -O2 -I "$src/include" -o libmy.so my.c) || bad "the documented cc line failed"
+"$bench" --plugin="$work/libmy.so" --plugin="$plugins/librk4.so" --quick --problem=pendulum --parts=sweep,verdict \
   --study_out="$work/timed.h5" >"$work/out" 2>"$work/err" || bad "stepbench_bench --plugin: $(tail -3 "$work/err")"
-/usr/bin/python3 - "$work/timed.h5" <<'PY' && ok || bad "the timed study with the plugin"
+/usr/bin/python3 - "$work/timed.h5" <<'PY' && ok || bad "the timed study with the plugins"
 import h5py, json, sys
 f = h5py.File(sys.argv[1], "r")
-assert [p["methods"] for p in json.loads(f.attrs["plugins"])] == [["plugin_rk4"]], f.attrs["plugins"]
+assert [p["methods"] for p in json.loads(f.attrs["plugins"])] == [["my_rk4"], ["plugin_rk4"]], f.attrs["plugins"]
 m = f["problems/pendulum/methods"]
-mine, ours = m["plugin_rk4"], m["rk4"]
-assert mine.attrs["origin"] == "plugin" and mine.attrs["fit_status"] == "fitted", dict(mine.attrs)
-assert mine.attrs["fit_slope"] == ours.attrs["fit_slope"]
-runs = mine["runs"][()]
-assert (runs["err_pos_max"] == ours["runs"]["err_pos_max"]).all()
-assert (runs["time_ns"] > 0).any(), "the plugin's rows are not timed"
+for name in ("my_rk4", "plugin_rk4"):
+    mine, ours = m[name], m["rk4"]
+    assert mine.attrs["origin"] == "plugin" and mine.attrs["fit_status"] == "fitted", dict(mine.attrs)
+    assert mine.attrs["fit_slope"] == ours.attrs["fit_slope"]
+    runs = mine["runs"][()]
+    assert (runs["err_pos_max"] == ours["runs"]["err_pos_max"]).all()
+    assert (runs["time_ns"] > 0).any(), f"{name}'s rows are not timed"
 v = f["verdict"]
 assert v.attrs["cost_kind"] == "time_ns"
 pe = v["plugin_equal_error"][()]
-reached = [p for p in pe if p["plugin_method"] == b"plugin_rk4"]
+reached = [p for p in pe if p["plugin_method"] in (b"my_rk4", b"plugin_rk4")]
 assert len(reached) >= 3, pe
 assert all(p["plugin_cost"] > 0 and p["vs_ours"] > 0 for p in reached), reached
 assert any("plugins' fastest method" in line for line in v.attrs["findings"].split("\n")), v.attrs["findings"]

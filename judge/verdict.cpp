@@ -273,7 +273,7 @@ verdict_tables compute_verdict(const study& s) {
                       [](const wp_method& m) { return m.origin == method_origin::plugin; })) {
         const cost_at_error y = cost_of(methods, plugin);
         v.plugin_equal_error.push_back({ps.name, unit, target, y, plugin && ours ? plugin->cost / ours->cost : nan,
-                                        plugin && peer ? plugin->cost / peer->cost : nan,
+                                        plugin && peer ? plugin->cost / peer->cost : nan, r.cost,
                                         verdict_of(y, o, by_time, "plugin only", "others only"),
                                         verdict_of(y, q, by_time, "plugin only", "others only")});
       }

@@ -97,6 +97,7 @@ const column_map<plugin_at_error>& plugin_equal_error_columns() {
           .member("plugin_interpolated", &R::plugin, &C::interpolated)
           .member("vs_ours", &R::vs_ours)
           .member("vs_peer", &R::vs_peer)
+          .member("cost_kind", &R::cost_kind)
           .member("verdict_ours", &R::verdict_ours)
           .member("verdict_peer", &R::verdict_peer);
   return columns;

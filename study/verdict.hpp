@@ -57,6 +57,7 @@ struct plugin_at_error {
   cost_at_error plugin;
   double vs_ours = std::numeric_limits<double>::quiet_NaN();  // plugin / ours; NaN unless both found
   double vs_peer = std::numeric_limits<double>::quiet_NaN();  // plugin / peer; likewise
+  std::string cost_kind;                                      // as equal_error_verdict's at the same (problem, target)
   // As equal_error_verdict's verdict, from the plugin's side: "ahead" = the plugin's cheaper;
   // "plugin only" where the other side reaches no target, "others only", "not reached".
   std::string verdict_ours, verdict_peer;

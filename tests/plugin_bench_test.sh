@@ -35,6 +35,8 @@ pe = v["plugin_equal_error"][()]
 reached = [p for p in pe if p["plugin_method"] in (b"my_rk4", b"plugin_rk4")]
 assert len(reached) >= 3, pe
 assert all(p["plugin_cost"] > 0 and p["vs_ours"] > 0 for p in reached), reached
+ee = v["equal_error"][()]
+assert list(pe["cost_kind"]) == list(ee["cost_kind"]) and b"time_ns" in set(pe["cost_kind"]), pe["cost_kind"]
 assert any("plugins' fastest method" in line for line in v.attrs["findings"].split("\n")), v.attrs["findings"]
 PY
 grep -q "Fastest plugin method at equal error" "$work/out" "$work/err" && ok || bad "the printed verdict has no plugin table"

@@ -256,6 +256,8 @@ verdict_tables compute_verdict(const study& s) {
       if (m.origin != method_origin::baseline)
         for (const auto& r : m.rows)
           if (r.completed && std::isfinite(r.error)) best_error = std::min(best_error, r.error);
+    const bool has_plugin = std::any_of(methods.begin(), methods.end(),
+                                        [](const wp_method& m) { return m.origin == method_origin::plugin; });
     for (double target : verdict_targets()) {
       const auto r = cheapest(methods, target, timed, verdict_metric, unit,
                               timed ? wp_candidates::timed_methods : wp_candidates::every_method);
@@ -269,8 +271,7 @@ verdict_tables compute_verdict(const study& s) {
       const bool by_time = r.cost == "time_ns";
       v.equal_error.push_back({ps.name, unit, target, o, q, ours && peer ? ours->cost / peer->cost : nan, r.cost,
                                verdict_of(o, q, by_time), std::isfinite(best_error) ? best_error : nan});
-      if (std::any_of(methods.begin(), methods.end(),
-                      [](const wp_method& m) { return m.origin == method_origin::plugin; })) {
+      if (has_plugin) {
         const cost_at_error y = cost_of(methods, plugin);
         v.plugin_equal_error.push_back({ps.name, unit, target, y, plugin && ours ? plugin->cost / ours->cost : nan,
                                         plugin && peer ? plugin->cost / peer->cost : nan, r.cost,

@@ -174,7 +174,9 @@ class column_map {
       }
     return t;
   }
+  // An optional table without rows is not written (schema::table::optional).
   void write(H5::Group& g, const std::string& dataset, std::span<const Row> rows, bool timed = false) const {
+    if (spec_.optional && rows.empty()) return;
     table(rows, timed).write(g, dataset, spec());
   }
 
@@ -198,8 +200,12 @@ class column_map {
     }
     return out;
   }
+  // An optional table that is absent has no rows.
   std::vector<Row> read(const H5::Group& g, const std::string& dataset) const {
-    if (!h5::is_dataset(g, dataset)) throw std::runtime_error("missing dataset '" + dataset + "' in " + g.getObjName());
+    if (!h5::is_dataset(g, dataset)) {
+      if (spec_.optional) return {};
+      throw std::runtime_error("missing dataset '" + dataset + "' in " + g.getObjName());
+    }
     return read(h5::read_table(g.openDataSet(dataset)));
   }
 

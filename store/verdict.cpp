@@ -160,8 +160,7 @@ void write_verdict(H5::Group& root, const study& s) {
        "lies outside the timing noise: the larger of 15 % (25 % from one repetition) and 3 x the repetitions' "
        "relative spread, the band stepbench compare uses between two runs");
   equal_error_columns().write(g, "equal_error", v.equal_error);
-  // Only in a study that loaded plugins: a study without has no table rather than an empty one.
-  if (!v.plugin_equal_error.empty()) plugin_equal_error_columns().write(g, "plugin_equal_error", v.plugin_equal_error);
+  plugin_equal_error_columns().write(g, "plugin_equal_error", v.plugin_equal_error);  // optional: none without plugins
   frame_rate_columns.write(g, "frame_rate", v.frame_rate);
   frame_answer_columns.write(g, "frame_answer", v.frame_answers);
 }
@@ -215,8 +214,7 @@ verdict_tables read_verdict(const H5::Group& root) {
   v.cost_kind = h5::string_attr(g, "cost_kind");
   v.findings = stored_list(h5::string_attr(g, "findings"), '\n');  // a finding is one sentence, never empty
   v.equal_error = equal_error_columns().read(g, "equal_error");
-  if (h5::is_dataset(g, "plugin_equal_error"))
-    v.plugin_equal_error = plugin_equal_error_columns().read(g, "plugin_equal_error");
+  v.plugin_equal_error = plugin_equal_error_columns().read(g, "plugin_equal_error");
   v.frame_rate = frame_rate_columns.read(g, "frame_rate");
   v.frame_answers = frame_answer_columns.read(g, "frame_answer");
   return v;

@@ -2,7 +2,10 @@
 // digest of a study file, committed beside the README (results/summary.json, written by
 // scripts/study.sh after the main study): per problem, the game programmer's answer at 60 Hz
 // for 1e-2, 1e-3 and 1e-4 in the problem's unit (method, substeps, cost a frame), how many of
-// our methods stay stable at one step a frame, and the scene as the study ran it. Every value
+// our methods stay stable at one step a frame, and the scene as the study ran it; and the
+// equal-error verdict against the library peers at 1e-6 .. 1e-12 (ratio, the noise band it
+// was judged against, the verdict, and the ratio's two factors: force evaluations at equal
+// error and time an evaluation). Every value
 // is the study's own verdict tables (study/verdict.hpp), which `advise --hz` and the report
 // read too: scripts/report --readme renders the README's block from this file, and a test
 // fails when the README differs from that render.
@@ -33,6 +36,9 @@ using ordered = nlohmann::ordered_json;
 // a coarser and a finer one beside it).
 constexpr double summary_hz = 60.0;
 constexpr std::array summary_targets{1e-2, 1e-3, 1e-4};
+// The numerical-methods reader's question: ours against the fastest library peer at equal
+// error, at the tight targets where the high-order methods compete.
+constexpr std::array peer_targets{1e-6, 1e-8, 1e-10, 1e-12};
 
 struct summary_args {
   std::string study = "results/study.h5", out = "results/summary.json";
@@ -56,7 +62,9 @@ ordered summarize(const study& s, const std::string& path) {
                    {"cost_kind", v->cost_kind}}},
                  {"hz", summary_hz},
                  {"targets", summary_targets},
-                 {"problems", ordered::array()}};
+                 {"problems", ordered::array()},
+                 {"peer_targets", peer_targets},
+                 {"against_peers", ordered::array()}};
   // In the registry's order (`stepbench list`), as the report's tables are; the file's
   // groups come back in name order.
   std::vector<const problem_study*> order;
@@ -86,6 +94,20 @@ ordered summarize(const study& s, const std::string& path) {
     p["stable_at_one_step"] = stable;
     p["methods_at_one_step"] = methods;
     out["problems"].push_back(std::move(p));
+    // The equal-error verdict at the tight targets, for a problem where both sides reach one.
+    ordered cells = ordered::array();
+    for (double target : peer_targets)
+      for (const auto& e : v->equal_error)
+        if (e.problem == ps.name && same_target(e.target, target) && e.ours.found() && e.peer.found())
+          cells.push_back({{"target", target},
+                           {"ours", e.ours.method},
+                           {"peer", e.peer.method},
+                           {"ratio", e.ratio},
+                           {"noise_band", e.noise_band},
+                           {"verdict", e.verdict},
+                           {"evals_ratio", e.evals_ratio},
+                           {"per_eval_ratio", e.per_eval_ratio}});
+    if (!cells.empty()) out["against_peers"].push_back({{"name", ps.name}, {"unit", ps.unit}, {"cells", cells}});
   }
   return out;
 }
@@ -117,9 +139,11 @@ int run_summary(const summary_args& a) {
 
 command add_summary(CLI::App& app) {
   auto a = std::make_shared<summary_args>();
-  auto* sub = app.add_subcommand("summary",
-                                 "the README's answer as data: a small JSON digest of a study file (per problem, the "
-                                 "cheapest method and substeps a frame at 60 Hz for 1e-2, 1e-3 and 1e-4)");
+  auto* sub = app.add_subcommand(
+      "summary",
+      "the README's answer as data: a small JSON digest of a study file (per problem, the "
+      "cheapest method and substeps a frame at 60 Hz for 1e-2, 1e-3 and 1e-4; ours against the fastest "
+      "peer at 1e-6 .. 1e-12)");
   sub->add_option("--study", a->study, "study file to read")->capture_default_str();
   sub->add_option("--out", a->out, "JSON file to write (-: stdout)")->capture_default_str();
   return {sub, [a] { return run_summary(*a); }};

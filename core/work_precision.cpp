@@ -105,14 +105,16 @@ std::optional<wp_pick> at_equal_error(const wp_method& m, double target, bool by
   return best;
 }
 
+double equal_error_threshold(const cost_band& a, const cost_band& b, bool timed) {
+  if (!timed) return 1e-9;
+  const auto spread = [](const cost_band& c) { return c.hi > c.lo ? (c.hi - c.lo) / c.cost : 0.0; };
+  const bool both_spread = a.hi > a.lo && b.hi > b.lo;
+  return std::max(both_spread ? timing_noise_floor : timing_single_run_floor,
+                  timing_spread_multiple * std::max(spread(a), spread(b)));
+}
+
 const char* compare_at_equal_error(const cost_band& a, const cost_band& b, bool timed) {
-  double threshold = 1e-9;
-  if (timed) {
-    const auto spread = [](const cost_band& c) { return c.hi > c.lo ? (c.hi - c.lo) / c.cost : 0.0; };
-    const bool both_spread = a.hi > a.lo && b.hi > b.lo;
-    threshold = std::max(both_spread ? timing_noise_floor : timing_single_run_floor,
-                         timing_spread_multiple * std::max(spread(a), spread(b)));
-  }
+  const double threshold = equal_error_threshold(a, b, timed);
   const double ratio = a.cost / b.cost;
   if (ratio < 1.0 / (1.0 + threshold)) return "ahead";
   if (ratio > 1.0 + threshold) return "behind";

@@ -116,6 +116,8 @@ struct cost_band {
   double cost = 0.0, lo = 0.0, hi = 0.0;
 };
 const char* compare_at_equal_error(const cost_band& a, const cost_band& b, bool timed);
+// The threshold of that comparison: a / b is decided only outside [1 / (1 + t), 1 + t].
+double equal_error_threshold(const cost_band& a, const cost_band& b, bool timed);
 inline cost_band band_of(const wp_pick& p) { return {p.cost, p.cost_lo, p.cost_hi}; }
 
 // Which methods compete. The two callers genuinely differ:

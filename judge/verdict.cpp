@@ -43,7 +43,8 @@ std::string ratio_text(double r) { return r >= 100 ? fmt::format("{:.0f}", r) : 
 cost_at_error cost_of(const std::vector<wp_method>& methods, const wp_pick* p) {
   if (!p) return {};
   const auto& m = methods[p->method];
-  return {m.name, std::string(to_string(m.kind)), p->param, p->cost, p->cost_lo, p->cost_hi, p->interpolated};
+  return {m.name,        std::string(to_string(m.kind)), p->param, p->cost, p->cost_lo, p->cost_hi, p->interpolated,
+          p->force_evals};
 }
 
 // `mine` against `other` at equal error, "ahead" when mine is cheaper; the one-sided
@@ -269,8 +270,14 @@ verdict_tables compute_verdict(const study& s) {
       }
       const cost_at_error o = cost_of(methods, ours), q = cost_of(methods, peer);
       const bool by_time = r.cost == "time_ns";
-      v.equal_error.push_back({ps.name, unit, target, o, q, ours && peer ? ours->cost / peer->cost : nan, r.cost,
-                               verdict_of(o, q, by_time), std::isfinite(best_error) ? best_error : nan});
+      auto& e = v.equal_error.emplace_back(
+          equal_error_verdict{ps.name, unit, target, o, q, ours && peer ? ours->cost / peer->cost : nan, r.cost,
+                              verdict_of(o, q, by_time), std::isfinite(best_error) ? best_error : nan});
+      if (ours && peer) {
+        e.noise_band = equal_error_threshold(band_of(*ours), band_of(*peer), by_time);
+        e.evals_ratio = ours->force_evals / peer->force_evals;
+        if (by_time) e.per_eval_ratio = e.ratio / e.evals_ratio;
+      }
       if (has_plugin) {
         const cost_at_error y = cost_of(methods, plugin);
         v.plugin_equal_error.push_back({ps.name, unit, target, y, plugin && ours ? plugin->cost / ours->cost : nan,

@@ -75,7 +75,18 @@ const column_map<equal_error_verdict>& equal_error_columns() {
           .member("ratio", &R::ratio)
           .member("cost_kind", &R::cost_kind)
           .member("verdict", &R::verdict)
-          .member("best_error", &R::best_error);
+          .member("best_error", &R::best_error)
+          // Added within format 4: absent from the files written before them, read as unknown.
+          .field("ours_force_evals", figure_of<R, &R::ours, &C::force_evals>, set_figure<R, &R::ours, &C::force_evals>)
+          .missing_as(nan)
+          .field("peer_force_evals", figure_of<R, &R::peer, &C::force_evals>, set_figure<R, &R::peer, &C::force_evals>)
+          .missing_as(nan)
+          .member("noise_band", &R::noise_band)
+          .missing_as(nan)
+          .member("evals_ratio", &R::evals_ratio)
+          .missing_as(nan)
+          .member("per_eval_ratio", &R::per_eval_ratio)
+          .missing_as(nan);
   return columns;
 }
 

@@ -38,6 +38,18 @@ assert all(p["plugin_cost"] > 0 and p["vs_ours"] > 0 for p in reached), reached
 ee = v["equal_error"][()]
 assert list(pe["cost_kind"]) == list(ee["cost_kind"]) and b"time_ns" in set(pe["cost_kind"]), pe["cost_kind"]
 assert any("plugins' fastest method" in line for line in v.attrs["findings"].split("\n")), v.attrs["findings"]
+# Ours against the peer, timed: the stored band decides the verdict, and the ratio is the
+# product of its two stored factors (evaluations at equal error, time an evaluation).
+both = [e for e in ee if e["ours_method"] and e["peer_method"] and e["cost_kind"] == b"time_ns"]
+assert len(both) >= 3, ee
+for e in both:
+    band, r = e["noise_band"], e["ratio"]
+    assert band >= 0.15, e
+    assert abs(e["evals_ratio"] - e["ours_force_evals"] / e["peer_force_evals"]) <= 1e-12 * e["evals_ratio"], e
+    assert abs(e["evals_ratio"] * e["per_eval_ratio"] - r) <= 1e-12 * r, e
+    assert abs(r - e["ours_cost"] / e["peer_cost"]) <= 1e-12 * r, e
+    decided = b"ahead" if r < 1 / (1 + band) else b"behind" if r > 1 + band else b"within spread"
+    assert e["verdict"] in (decided, b"bounded"), e
 PY
 grep -q "Fastest plugin method at equal error" "$work/out" "$work/err" && ok || bad "the printed verdict has no plugin table"
 "$bin" ratios --study "$work/timed.h5" >"$work/ratios" 2>&1 || bad "ratios: $(cat "$work/ratios")"

@@ -353,6 +353,29 @@ TEST(sweep, xpbd_completes_on_rigid_links_at_every_dt_and_the_finding_says_so) {
   EXPECT_EQ(problems, 5);  // the scenes with a constraint view
 }
 
+// Each equal-error verdict where both sides reach the target carries why: in an untimed
+// study the cost is the force evaluations, so the evaluations' ratio is the ratio itself,
+// there is no time an evaluation, and the band is the interpolation's rounding; the
+// evaluations are the picks' own (ratio = ours / peer of the stored figures).
+TEST(sweep, equal_error_verdict_carries_its_band_and_its_evaluations) {
+  const auto v = compute_verdict(default_study());
+  int both = 0;
+  for (const auto& e : v.equal_error) {
+    if (!e.ours.found() || !e.peer.found()) {
+      EXPECT_TRUE(std::isnan(e.noise_band) && std::isnan(e.evals_ratio)) << e.problem << " " << e.target;
+      continue;
+    }
+    ++both;
+    EXPECT_EQ(e.cost_kind, "force_evals");
+    EXPECT_DOUBLE_EQ(e.ours.force_evals, e.ours.cost) << e.problem << " " << e.target;
+    EXPECT_DOUBLE_EQ(e.peer.force_evals, e.peer.cost) << e.problem << " " << e.target;
+    EXPECT_DOUBLE_EQ(e.evals_ratio, e.ratio) << e.problem << " " << e.target;
+    EXPECT_TRUE(std::isnan(e.per_eval_ratio));
+    EXPECT_DOUBLE_EQ(e.noise_band, 1e-9);
+  }
+  EXPECT_GT(both, 20);
+}
+
 // The finding's branches the default study does not reach: diverged and failed rungs
 // counted apart from the completed (and the dt range over all that ran), a NaN drift or
 // constraint error (a merged file without them) left unsaid, a scene whose every rung was

@@ -8,6 +8,7 @@ import math
 from dataclasses import dataclass, replace
 
 import numpy as np
+from numpy.lib import recfunctions as rfn
 
 from . import schema
 from .formatting import fmt_count, fmt_sci, fmt_seconds, fmt_time_ns
@@ -17,6 +18,8 @@ VERDICT_ATTRS = ("metric", "targets", "frame_hz", "cost_kind", "findings", "rule
 VERDICTS = ("ahead", "behind", "within spread", "bounded", "ours only", "peers only", "not reached")
 PLUGIN_VERDICTS = ("ahead", "behind", "within spread", "bounded", "plugin only", "others only", "not reached")
 COST_KINDS = ("time_ns", "force_evals")
+# Fields of /verdict/equal_error added within format 4: a study written before them reads them as NaN.
+EQUAL_ERROR_LATER = ("ours_force_evals", "peer_force_evals", "noise_band", "evals_ratio", "per_eval_ratio")
 # The cell's class in index.html: green ahead, red behind, grey within the timing noise; none
 # (white) for "bounded", "ours only", "plugin only"; a plugin's "others only" is red as "peers only" is.
 VERDICT_CLASS = {"ahead": "ahead", "behind": "behind", "within spread": "within", "peers only": "behind",
@@ -44,6 +47,12 @@ class Verdict:
         that they fit a screen; a problem's section has them all."""
         even = [t for t in self.targets if round(math.log10(t)) % 2 == 0]
         return even if len(even) >= 2 else self.targets
+
+    @property
+    def tight_targets(self):
+        """The targets of the table against the peers: 1e-6 and finer, where the high-order
+        methods compete, every second decade."""
+        return [t for t in self.shown_targets if t <= 1e-6 * (1 + 1e-9)]
 
     @property
     def frame_hz(self):
@@ -104,7 +113,11 @@ def read(reader, f):
         return None
     attrs = reader.need_attrs(g, VERDICT_ATTRS)
     reader.need_value(g, "cost_kind", attrs["cost_kind"], COST_KINDS)
-    ee = reader.need_table(g, "equal_error", schema.fields("verdict_equal_error"))
+    ee = reader.need_table(g, "equal_error",
+                           [n for n in schema.fields("verdict_equal_error") if n not in EQUAL_ERROR_LATER])
+    absent = [n for n in EQUAL_ERROR_LATER if n not in ee.dtype.names]
+    if absent:
+        ee = rfn.append_fields(ee, absent, [np.full(len(ee), np.nan) for _ in absent], usemask=False)
     reader.need_column(g, "equal_error", ee, "verdict", VERDICTS)
     pe = None
     if "plugin_equal_error" in g:  # only in a study that loaded plugins
@@ -168,6 +181,38 @@ def equal_error_cell(r, kind):
         return Cell(f"none of ours; peer {peer} {param}, {cost}",
                     f'<span class="small">none of ours</span><br>{esc(peer)} {esc(param)} &middot; {esc(cost)}', cls)
     return Cell("not reached", "&ndash;", cls)
+
+
+def noise_text(kind, band):
+    """The noise a ratio is judged against: +-15 % of timing; nothing for counted evaluations (exact)."""
+    return f"\u00b1{100 * band:.0f} %" if kind == "time_ns" and np.isfinite(band) else ""
+
+
+def factors_text(r):
+    """The ratio's two measured factors: force evaluations at equal error, time an evaluation."""
+    parts = []
+    if np.isfinite(r["evals_ratio"]):
+        parts.append(f"evaluations {ratio_text(r['evals_ratio'])}")
+    if np.isfinite(r["per_eval_ratio"]):
+        parts.append(f"time an evaluation {ratio_text(r['per_eval_ratio'])}")
+    return ", ".join(parts)
+
+
+def peer_cell(r, kind):
+    """One (problem, tight target) of the table against the peers: ours / peer with the noise it
+    is judged against and the verdict; the two methods; the ratio's two factors."""
+    if r is None:
+        return Cell("-", "&ndash;", "none")
+    verdict = r["verdict"]
+    cls = VERDICT_CLASS.get(verdict, "")
+    if not (r["ours_method"] and r["peer_method"]):
+        return Cell(verdict, f'<span class="small">{esc(verdict)}</span>', cls)
+    head = " ".join(x for x in (ratio_text(r["ratio"]), noise_text(kind, r["noise_band"])) if x) + f", {verdict}"
+    pair = f"{r['ours_method']} / {r['peer_method']}"
+    why = factors_text(r)
+    return Cell(f"{head}: {pair}" + (f"; {why}" if why else ""),
+                f"<b>{esc(head)}</b><br>{esc(pair)}" + (f'<br><span class="small">{esc(why)}</span>' if why else ""),
+                cls)
 
 
 def plugin_cell(r, kind):
@@ -365,6 +410,22 @@ def opening(doc, verdict):
           "measured row already under the target: its ladder does not bracket it) or no peer runs on the problem; "
           f"best: the lowest error any method reached. Rule: {verdict.attrs['rule']}.",
           cls="caption")
+    tight = verdict.tight_targets
+    faced = [p for p in verdict.problems if any(
+        (r := verdict.equal(p, t)) is not None and r["ours_method"] and r["peer_method"] for t in tight)]
+    if tight and faced:
+        doc.h(2, "Against the fastest library peer, " + " to ".join(target_text(t) for t in (tight[0], tight[-1])))
+        doc.table(["problem [unit]"] + [target_text(t) for t in tight],
+                  [[problem_cell(verdict, p)] + [peer_cell(verdict.equal(p, t), kind) for t in tight] for p in faced],
+                  cls="verdict")
+        doc.p(f"Each cell: the cost ({by}) of the fastest of ours over the fastest library peer's at the same "
+              f"`{verdict.attrs['metric']}`, by the rule above"
+              + (", with the timing noise it is judged against (ahead or behind only outside 1 / (1 + n) to 1 + n)"
+                 if kind == "time_ns" else "")
+              + ", and the verdict; the two methods; and why, in two measured factors whose product is the ratio: "
+              "the force evaluations each needs at that error and the time an evaluation takes (the force plus the "
+              "step's own arithmetic and bookkeeping). Problems where both sides reach one of these targets.",
+              cls="caption")
     if verdict.plugin_equal_error is not None:
         doc.h(2, "Your plugin's methods at equal error")
         doc.table(head, [[problem_cell(verdict, p)] + [plugin_cell(verdict.plugin(p, t), kind) for t in shown]

@@ -41,6 +41,20 @@ def test_the_summary_answers_every_problem_at_1e_3():
     assert rope["scene"].startswith("masses = 32, "), rope["scene"]
 
 
+def test_the_summary_sets_ours_against_the_peers_at_tight_error():
+    """The five smooth problems of the equal-error goal, at each of 1e-6 .. 1e-12: both sides
+    reach it, and the stored ratio is the product of its two stored factors."""
+    summary = readme.load(ROOT / "results" / "summary.json")
+    assert summary["peer_targets"] == [1e-6, 1e-8, 1e-10, 1e-12]
+    rows = {p["name"]: p for p in summary["against_peers"]}
+    for name in ("damped_spring", "pendulum", "n_pendulum", "kepler", "spring_chain"):
+        cells = rows[name]["cells"]
+        assert [c["target"] for c in cells] == summary["peer_targets"], name
+        for c in cells:
+            assert c["ours"] and c["peer"] and c["noise_band"] >= 0.15, (name, c)
+            assert abs(c["evals_ratio"] * c["per_eval_ratio"] / c["ratio"] - 1) < 1e-12, (name, c)
+
+
 def test_the_readme_is_a_front_page():
     lines = (ROOT / "README.md").read_text().splitlines()
     assert len(lines) <= 160, len(lines)

@@ -546,6 +546,42 @@ def test_findings_and_summary_json_are_the_files(reports, shape):
                     assert have[name] is None
 
 
+def ratio_head(r):
+    """A cell's head as verdict.py writes it: ours / peer, the noise band, the verdict."""
+    ratio = r["ratio"]
+    return f"{ratio:.2g}x" if abs(ratio) < 100 else f"{ratio:.0f}x"
+
+
+def test_against_the_peers_is_the_files(reports):
+    """The table against the fastest library peer at 1e-6 and finer (timed study): for each
+    problem where both sides reach one of them, the stored ratio, its noise band and verdict,
+    the two methods, and the ratio's two stored factors, whose product is the ratio."""
+    study, folder = reports["timed"]
+    md = report_text(folder)
+    attrs, v = verdict_of(study)
+    ee = v["equal_error"]
+    tight = [t for t in shown_targets(attrs) if t <= 1e-6 * (1 + 1e-9)]
+    head, rows = md_table(md, "## Against the fastest library peer, 1e-6 to 1e-12")
+    assert head[1:] == [target_head(t) for t in tight]
+    both = [r for r in ee if text(r["ours_method"]) and text(r["peer_method"]) and r["target"] <= 1.000001e-6]
+    assert {f"{text(r['problem'])} [{text(r['unit'])}]" for r in both} == {row[0] for row in rows}
+    checked = 0
+    for row in rows:
+        problem = row[0].split(" [")[0]
+        for t, cell in zip(tight, row[1:]):
+            r = rows_of(ee, problem=problem, target=t)[0]
+            if not (text(r["ours_method"]) and text(r["peer_method"])):
+                assert cell == text(r["verdict"]), (problem, t, cell)
+                continue
+            band = f"\u00b1{100 * r['noise_band']:.0f} %"
+            assert cell.startswith(f"{ratio_head(r)} {band}, {text(r['verdict'])}: "
+                                   f"{text(r['ours_method'])} / {text(r['peer_method'])}; evaluations "), cell
+            assert r["evals_ratio"] * r["per_eval_ratio"] == pytest.approx(r["ratio"], rel=1e-12)
+            assert r["evals_ratio"] == pytest.approx(r["ours_force_evals"] / r["peer_force_evals"], rel=1e-12)
+            checked += 1
+    assert checked >= 3
+
+
 def test_problem_sections_hold_the_problems_verdict(reports):
     study, folder = reports["timed"]
     md = report_text(folder)
@@ -671,7 +707,17 @@ def test_markdown_and_readme(reports, stepbench, tmp_path):
     assert "old table" not in block
     assert "| problem | 60 Hz, error 1e-2 | 60 Hz, error 1e-3 | 60 Hz, error 1e-4 | stable at one step a frame |" \
         in block
-    assert "| pendulum (rad) | " in block and "`spring_chain`: masses = 32, " in block
+    assert "| pendulum (rad) | " in block and "`spring_chain`: masses = 32, " in " ".join(block.splitlines())
+    # Against the peers at 1e-6 and finer: the summary's cells, each its ratio, band and verdict.
+    peers = json.loads(summary.read_text())
+    assert peers["peer_targets"] == [1e-6, 1e-8, 1e-10, 1e-12]
+    assert "| ours / fastest peer | error 1e-6 | error 1e-8 | error 1e-10 | error 1e-12 |" in block
+    table = block[block.index("| ours / fastest peer |"):].splitlines()
+    for p in peers["against_peers"]:
+        line = next(x for x in table if x.startswith(f"| {p['name']} ({p['unit']}) | "))
+        for c in p["cells"]:
+            ratio = f"{c['ratio']:.2g}x" if abs(c["ratio"]) < 100 else f"{c['ratio']:.0f}x"
+            assert f"| {ratio} \u00b1{100 * c['noise_band']:.0f} % {c['verdict']} |" in line + " |", (line, c)
     assert all(w in block for w in where) and str(study) in block
     # A front page: the block's lines fit in 160 characters (the paths aside, here long
     # temporary ones); the rest is in docs/results.md, which the block names.

@@ -3,12 +3,12 @@
 // scripts/study.sh after the main study): per problem, the game programmer's answer at 60 Hz
 // for 1e-2, 1e-3 and 1e-4 in the problem's unit (method, substeps, cost a frame), how many of
 // our methods stay stable at one step a frame, and the scene as the study ran it; and the
-// equal-error verdict against the library peers at 1e-6 .. 1e-12 (ratio, the noise band it
-// was judged against, the verdict, and the ratio's two factors: force evaluations at equal
-// error and time an evaluation). Every value
-// is the study's own verdict tables (study/verdict.hpp), which `advise --hz` and the report
-// read too: scripts/report --readme renders the README's block from this file, and a test
-// fails when the README differs from that render.
+// equal-error verdict against the library peers at 1e-6 .. 1e-12 (the verdict, its cost
+// kind, the ratio, the noise factor it was judged against, and the ratio's two factors: force
+// evaluations at equal error and time an evaluation). Every value is the study's own verdict
+// tables (study/verdict.hpp), which `advise --hz` and the report read too: scripts/report
+// --readme renders the README's block from this file, and a test fails when the README
+// differs from that render.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -18,6 +18,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <vector>
 
 #include "cli/commands.hpp"
 #include "judge/scan.hpp"
@@ -63,8 +64,16 @@ ordered summarize(const study& s, const std::string& path) {
                  {"hz", summary_hz},
                  {"targets", summary_targets},
                  {"problems", ordered::array()},
-                 {"peer_targets", peer_targets},
-                 {"against_peers", ordered::array()}};
+                 {"peer_targets", ordered::array()},
+                 {"against_peers", ordered::array()},
+                 {"against_peers_left_out", ordered::array()}};
+  // The tight targets the study's verdict holds.
+  std::vector<double> tight;
+  for (double target : peer_targets)
+    if (std::any_of(v->equal_error.begin(), v->equal_error.end(),
+                    [&](const equal_error_verdict& e) { return same_target(e.target, target); }))
+      tight.push_back(target);
+  out["peer_targets"] = tight;
   // In the registry's order (`stepbench list`), as the report's tables are; the file's
   // groups come back in name order.
   std::vector<const problem_study*> order;
@@ -94,20 +103,30 @@ ordered summarize(const study& s, const std::string& path) {
     p["stable_at_one_step"] = stable;
     p["methods_at_one_step"] = methods;
     out["problems"].push_back(std::move(p));
-    // The equal-error verdict at the tight targets, for a problem where both sides reach one.
+    // The equal-error verdict at the tight targets, every cell (a one-sided one carries its
+    // verdict word: "ours only", "peers only", "not reached"), for a problem where both
+    // sides reach one of them; the others are named as left out.
+    const auto text_or_null = [](const std::string& t) { return t.empty() ? ordered(nullptr) : ordered(t); };
     ordered cells = ordered::array();
-    for (double target : peer_targets)
+    bool faced = false;
+    for (double target : tight)
       for (const auto& e : v->equal_error)
-        if (e.problem == ps.name && same_target(e.target, target) && e.ours.found() && e.peer.found())
+        if (e.problem == ps.name && same_target(e.target, target)) {
+          faced = faced || (e.ours.found() && e.peer.found());
           cells.push_back({{"target", target},
-                           {"ours", e.ours.method},
-                           {"peer", e.peer.method},
-                           {"ratio", e.ratio},
-                           {"noise_band", e.noise_band},
                            {"verdict", e.verdict},
+                           {"cost_kind", e.cost_kind},
+                           {"ours", text_or_null(e.ours.method)},
+                           {"peer", text_or_null(e.peer.method)},
+                           {"ratio", e.ratio},
+                           {"noise_factor", e.noise_factor},
                            {"evals_ratio", e.evals_ratio},
                            {"per_eval_ratio", e.per_eval_ratio}});
-    if (!cells.empty()) out["against_peers"].push_back({{"name", ps.name}, {"unit", ps.unit}, {"cells", cells}});
+        }
+    if (faced)
+      out["against_peers"].push_back({{"name", ps.name}, {"unit", ps.unit}, {"cells", cells}});
+    else
+      out["against_peers_left_out"].push_back(ps.name);
   }
   return out;
 }

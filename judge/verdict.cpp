@@ -274,7 +274,7 @@ verdict_tables compute_verdict(const study& s) {
           equal_error_verdict{ps.name, unit, target, o, q, ours && peer ? ours->cost / peer->cost : nan, r.cost,
                               verdict_of(o, q, by_time), std::isfinite(best_error) ? best_error : nan});
       if (ours && peer) {
-        e.noise_band = equal_error_threshold(band_of(*ours), band_of(*peer), by_time);
+        e.noise_factor = 1.0 + equal_error_threshold(band_of(*ours), band_of(*peer), by_time);
         e.evals_ratio = ours->force_evals / peer->force_evals;
         if (by_time) e.per_eval_ratio = e.ratio / e.evals_ratio;
       }

@@ -81,7 +81,7 @@ const column_map<equal_error_verdict>& equal_error_columns() {
           .missing_as(nan)
           .field("peer_force_evals", figure_of<R, &R::peer, &C::force_evals>, set_figure<R, &R::peer, &C::force_evals>)
           .missing_as(nan)
-          .member("noise_band", &R::noise_band)
+          .member("noise_factor", &R::noise_factor)
           .missing_as(nan)
           .member("evals_ratio", &R::evals_ratio)
           .missing_as(nan)

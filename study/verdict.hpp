@@ -31,9 +31,10 @@ struct cost_at_error {
   std::string method, kind;  // empty method: none reaches the target
   double param = 0.0, cost = 0.0, cost_lo = 0.0, cost_hi = 0.0;
   bool interpolated = false;  // false: an upper bound (a measured row under the target)
-  // Force evaluations at equal error, interpolated the same way: a time ratio is this
-  // ratio times the ratio of time an evaluation (the step's overhead included).
-  double force_evals = 0.0;
+  // Force evaluations at equal error, interpolated the same way (a bound's own row's): a
+  // time ratio is this ratio times the ratio of time an evaluation (the step's overhead
+  // included). NaN when none reaches the target, and for a plugin (not stored).
+  double force_evals = std::numeric_limits<double>::quiet_NaN();
   bool found() const { return !method.empty(); }
 };
 
@@ -48,12 +49,14 @@ struct equal_error_verdict {
   // comparison cannot be decided), "ours only", "peers only", "not reached".
   std::string verdict;
   double best_error = 0.0;
-  // The timing noise the ratio was judged against (core/work_precision.hpp): "ahead" or
-  // "behind" only outside [1 / (1 + noise_band), 1 + noise_band]. NaN unless both found.
-  double noise_band = std::numeric_limits<double>::quiet_NaN();
-  // Why the ratio is what it is, in a timed study: ratio = evals_ratio x per_eval_ratio,
-  // ours / peer in force evaluations at equal error, and in time an evaluation (the force
-  // plus the step's own work). NaN unless both found.
+  // The noise the ratio was judged against, as a factor b = 1 + core/work_precision.hpp's
+  // threshold: "ahead" or "behind" only outside [1 / b, b]; the timing noise by measured
+  // time (b >= 1.15), 1 + 1e-9 (rounding) by counted force evaluations. NaN unless both found.
+  double noise_factor = std::numeric_limits<double>::quiet_NaN();
+  // Why the ratio is what it is: ratio = evals_ratio x per_eval_ratio, ours / peer in force
+  // evaluations at equal error, and in time an evaluation (the force plus the step's own
+  // work). evals_ratio NaN unless both found; per_eval_ratio also NaN when this target was
+  // ranked by force evaluations (cost_kind), where the ratio is evals_ratio itself.
   double evals_ratio = std::numeric_limits<double>::quiet_NaN();
   double per_eval_ratio = std::numeric_limits<double>::quiet_NaN();
 };

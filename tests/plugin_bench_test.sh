@@ -17,7 +17,7 @@ sed 's/"plugin_rk4"/"my_rk4"/' "$src/examples/plugins/rk4.c" >"$work/my.c"
 (cd "$work" && cc -shared -fPIC -O2 -I "$src/include" -o libmy.so my.c) || bad "the documented cc line failed"
 "$bench" --plugin="$work/libmy.so" --plugin="$plugins/librk4.so" --quick --problem=pendulum --parts=sweep,verdict \
   --study_out="$work/timed.h5" >"$work/out" 2>"$work/err" || bad "stepbench_bench --plugin: $(tail -3 "$work/err")"
-/usr/bin/python3 - "$work/timed.h5" <<'PY' && ok || bad "the timed study with the plugins"
+/usr/bin/python3 - "$work/timed.h5" "$src/tests/python" <<'PY' && ok || bad "the timed study with the plugins"
 import h5py, json, sys
 f = h5py.File(sys.argv[1], "r")
 assert [p["methods"] for p in json.loads(f.attrs["plugins"])] == [["my_rk4"], ["plugin_rk4"]], f.attrs["plugins"]
@@ -38,18 +38,29 @@ assert all(p["plugin_cost"] > 0 and p["vs_ours"] > 0 for p in reached), reached
 ee = v["equal_error"][()]
 assert list(pe["cost_kind"]) == list(ee["cost_kind"]) and b"time_ns" in set(pe["cost_kind"]), pe["cost_kind"]
 assert any("plugins' fastest method" in line for line in v.attrs["findings"].split("\n")), v.attrs["findings"]
-# Ours against the peer, timed: the stored band decides the verdict, and the ratio is the
-# product of its two stored factors (evaluations at equal error, time an evaluation).
+# Ours against the peer, timed: the noise factor is the rule's (the larger of 1.15, or 1.25
+# with a side of one repetition, and 1 + 3 x either side's relative spread) and decides the
+# verdict; each side's force evaluations at equal error are its own curve's, interpolated
+# log-log between the rows that bracket the target (or a bounding row's); the ratio is the
+# two costs' and splits into the evaluations' ratio and the time an evaluation's.
 both = [e for e in ee if e["ours_method"] and e["peer_method"] and e["cost_kind"] == b"time_ns"]
 assert len(both) >= 3, ee
+sys.path.insert(0, sys.argv[2])
+import curve_reading
+def evals_at(method, target, interpolated):
+    return curve_reading.at_target(m[method.decode()]["runs"][()], target, interpolated)
 for e in both:
-    band, r = e["noise_band"], e["ratio"]
-    assert band >= 0.15, e
-    assert abs(e["evals_ratio"] - e["ours_force_evals"] / e["peer_force_evals"]) <= 1e-12 * e["evals_ratio"], e
-    assert abs(e["evals_ratio"] * e["per_eval_ratio"] - r) <= 1e-12 * r, e
-    assert abs(r - e["ours_cost"] / e["peer_cost"]) <= 1e-12 * r, e
-    decided = b"ahead" if r < 1 / (1 + band) else b"behind" if r > 1 + band else b"within spread"
+    b, r, t = e["noise_factor"], e["ratio"], e["target"]
+    spread = [(e[f"{k}_cost_hi"] - e[f"{k}_cost_lo"]) / e[f"{k}_cost"] for k in ("ours", "peer")]
+    floor = 1.15 if min(spread) > 0 else 1.25
+    assert abs(b - max(floor, 1 + 3 * max(spread))) <= 1e-12, e
+    decided = b"ahead" if r < 1 / b else b"behind" if r > b else b"within spread"
     assert e["verdict"] in (decided, b"bounded"), e
+    for k in ("ours", "peer"):
+        mine = evals_at(e[f"{k}_method"], t, e[f"{k}_interpolated"])
+        assert any(abs(x / e[f"{k}_force_evals"] - 1) < 1e-9 for x in mine), (k, e, mine)
+    assert abs(r / (e["ours_cost"] / e["peer_cost"]) - 1) < 1e-12, e
+    assert abs(e["evals_ratio"] * e["per_eval_ratio"] / r - 1) < 1e-12, e
 PY
 grep -q "Fastest plugin method at equal error" "$work/out" "$work/err" && ok || bad "the printed verdict has no plugin table"
 "$bin" ratios --study "$work/timed.h5" >"$work/ratios" 2>&1 || bad "ratios: $(cat "$work/ratios")"

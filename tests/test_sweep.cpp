@@ -362,7 +362,7 @@ TEST(sweep, equal_error_verdict_carries_its_band_and_its_evaluations) {
   int both = 0;
   for (const auto& e : v.equal_error) {
     if (!e.ours.found() || !e.peer.found()) {
-      EXPECT_TRUE(std::isnan(e.noise_band) && std::isnan(e.evals_ratio)) << e.problem << " " << e.target;
+      EXPECT_TRUE(std::isnan(e.noise_factor) && std::isnan(e.evals_ratio)) << e.problem << " " << e.target;
       continue;
     }
     ++both;
@@ -371,7 +371,7 @@ TEST(sweep, equal_error_verdict_carries_its_band_and_its_evaluations) {
     EXPECT_DOUBLE_EQ(e.peer.force_evals, e.peer.cost) << e.problem << " " << e.target;
     EXPECT_DOUBLE_EQ(e.evals_ratio, e.ratio) << e.problem << " " << e.target;
     EXPECT_TRUE(std::isnan(e.per_eval_ratio));
-    EXPECT_DOUBLE_EQ(e.noise_band, 1e-9);
+    EXPECT_DOUBLE_EQ(e.noise_factor, 1.0 + 1e-9);
   }
   EXPECT_GT(both, 20);
 }

@@ -140,7 +140,7 @@ TEST(work_precision, cost_at_equal_error_is_interpolated_never_extrapolated) {
   // Counted costs are exact: equal up to the interpolation's rounding, else decided.
   EXPECT_STREQ(compare_at_equal_error({100, 100, 100}, {100 * (1 + 1e-12), 100, 100}, false), "within spread");
   EXPECT_STREQ(compare_at_equal_error({100, 100, 100}, {101, 101, 101}, false), "ahead");
-  // The band itself, which the verdict stores beside each ratio (noise_band).
+  // The band itself, which the verdict stores beside each ratio (as noise_factor = 1 + band).
   EXPECT_DOUBLE_EQ(equal_error_threshold({100, 99, 101}, {114, 113, 115}, true), 0.15);
   EXPECT_NEAR(equal_error_threshold({100, 90, 110}, {140, 139, 141}, true), 0.6, 1e-15);
   EXPECT_NEAR(equal_error_threshold({140, 139, 141}, {100, 90, 110}, true), 0.6, 1e-15);  // either side's spread

@@ -31,6 +31,12 @@ def load(path):
         for p in summary["problems"]:
             for key in ("name", "unit", "scene", "answers", "stable_at_one_step", "methods_at_one_step"):
                 p[key]
+        for p in summary.get("against_peers", []):
+            for key in ("name", "unit", "cells"):
+                p[key]
+            for c in p["cells"]:
+                for key in ("target", "verdict", "cost_kind", "ratio", "noise_factor"):
+                    c[key]
     except (KeyError, TypeError) as e:
         raise SummaryError(f"summary '{path}' lacks {e} (written by another version of `stepbench summary`?)") \
             from None
@@ -45,34 +51,48 @@ def _answer_cell(answer, kind):
     return f"{answer['method']} x{answer['substeps']}, {cost_text(kind, answer['cost_per_frame'])}"
 
 
-def _peer_cell(cell, kind):
+# The README cell's short words for the verdicts (the study's words are in docs/results.md).
+SHORT_VERDICT = {"within spread": "within"}
+
+
+def _peer_cell(cell):
+    """ours / peer, the verdict and the noise factor it was judged against (by time), or the
+    one-sided verdict's word."""
     if cell is None:
         return "-"
-    band = cell["noise_band"]
-    noise = f" \u00b1{100 * band:.0f} %" if kind == "time_ns" and band is not None else ""
-    return f"{ratio_text(cell['ratio'])}{noise} {cell['verdict']}"
+    verdict = SHORT_VERDICT.get(cell["verdict"], cell["verdict"])
+    if cell["ratio"] is None:
+        return verdict
+    if cell["cost_kind"] != "time_ns":
+        by = "evaluations"
+    else:  # none in a summary of a study written before the noise factor was stored
+        by = f"noise {cell['noise_factor']:.3g}x" if cell["noise_factor"] is not None else ""
+    return f"{ratio_text(cell['ratio'])} {verdict}" + (f" ({by})" if by else "")
 
 
-def against_peers(summary, kind):
+def against_peers(summary):
     """The table against the fastest library peer at the tight targets, and what it means."""
     targets = summary.get("peer_targets", [])
     rows = summary.get("against_peers", [])
     if not targets or not rows:
         return []
-    lines = ["| ours / fastest peer | " + " | ".join(f"error {target_text(t)}" for t in targets) + " |",
+    lines = ["| problem (unit) | " + " | ".join(f"ours / peer, {target_text(t)}" for t in targets) + " |",
              "|---|" + "---|" * len(targets)]
     for p in rows:
         cells = [f"{p['name']} ({p['unit']})"]
-        cells += [_peer_cell(next((c for c in p["cells"] if math.isclose(c["target"], t, rel_tol=1e-9)), None), kind)
+        cells += [_peer_cell(next((c for c in p["cells"] if math.isclose(c["target"], t, rel_tol=1e-9)), None))
                   for t in targets]
         lines.append("| " + " | ".join(cells) + " |")
-    cost = "time" if kind == "time_ns" else "force evaluations"
-    prose = (f"At equal error, 1e-6 and finer: the {cost} of the fastest of our methods over the fastest library "
-             "peer's at the same `err_pos_max`, each interpolated on its measured curve"
-             + (", with the timing noise it is judged against (ahead or behind only outside it)"
-                if kind == "time_ns" else "")
-             + "; bounded: undecided, the dearer side is charged an upper bound. Which methods, and the ratio as "
-             "force evaluations times time an evaluation: [docs/results.md](docs/results.md).")
+    left_out = summary.get("against_peers_left_out", [])
+    by = "measured time" if summary["study"]["cost_kind"] == "time_ns" else "counted force evaluations"
+    span = target_text(targets[0]) if len(targets) == 1 else f"{target_text(targets[0])} to {target_text(targets[-1])}"
+    prose = (f"At equal `err_pos_max`, {span}: the cost of the fastest of our methods over the fastest library peer's "
+             f"(below 1: ours cheaper), by {by}, each read off its measured curve. Ahead or behind only "
+             "outside the noise factor b (1/b to b); within: inside it; bounded: undecided, the dearer side is charged "
+             "an upper bound (its ladder does not bracket the target)."
+             + (f" Left out, no peer reaching these targets there: {', '.join(left_out)}." if left_out else "")
+             + " Which methods, and each ratio as force evaluations times time an evaluation: "
+             "[docs/results.md](docs/results.md).")
     return [""] + lines + [""] + textwrap.wrap(prose, README_WIDTH - 10, break_long_words=False,
                                                break_on_hyphens=False)
 
@@ -80,7 +100,8 @@ def against_peers(summary, kind):
 def block(summary, command):
     """The table (per problem: at the summary's rate, the cheapest of our fixed-step methods
     and substeps a frame at each error, its cost a frame; how many stay stable at one step a
-    frame), what it means, the scenes as the study ran them, and the lines naming the study."""
+    frame), what it means, the table against the library peers at tight error (against_peers),
+    the scenes as the study ran them, and the lines naming the study."""
     s, hz = summary["study"], summary["hz"]
     kind = s["cost_kind"]
     targets = summary["targets"]
@@ -104,7 +125,7 @@ def block(summary, command):
              "The scenes as the study ran them (`stepbench list` says what each parameter is): "
              + "; ".join(f"`{p['name']}`: {p['scene']}" for p in summary["problems"]) + "."]
     lines += [""] + textwrap.wrap(prose[0], README_WIDTH - 10, break_long_words=False, break_on_hyphens=False)
-    lines += against_peers(summary, kind)
+    lines += against_peers(summary)
     lines += [""] + textwrap.wrap(prose[1], README_WIDTH - 10, break_long_words=False, break_on_hyphens=False)
     lines += ["", "Every target against the library peers, the findings, the pendulum challenge and the scans' "
               "range answers:", "[docs/results.md](docs/results.md), written from the same study.",

@@ -19,7 +19,7 @@ VERDICTS = ("ahead", "behind", "within spread", "bounded", "ours only", "peers o
 PLUGIN_VERDICTS = ("ahead", "behind", "within spread", "bounded", "plugin only", "others only", "not reached")
 COST_KINDS = ("time_ns", "force_evals")
 # Fields of /verdict/equal_error added within format 4: a study written before them reads them as NaN.
-EQUAL_ERROR_LATER = ("ours_force_evals", "peer_force_evals", "noise_band", "evals_ratio", "per_eval_ratio")
+EQUAL_ERROR_LATER = ("ours_force_evals", "peer_force_evals", "noise_factor", "evals_ratio", "per_eval_ratio")
 # The cell's class in index.html: green ahead, red behind, grey within the timing noise; none
 # (white) for "bounded", "ours only", "plugin only"; a plugin's "others only" is red as "peers only" is.
 VERDICT_CLASS = {"ahead": "ahead", "behind": "behind", "within spread": "within", "peers only": "behind",
@@ -183,9 +183,12 @@ def equal_error_cell(r, kind):
     return Cell("not reached", "&ndash;", cls)
 
 
-def noise_text(kind, band):
-    """The noise a ratio is judged against: +-15 % of timing; nothing for counted evaluations (exact)."""
-    return f"\u00b1{100 * band:.0f} %" if kind == "time_ns" and np.isfinite(band) else ""
+def noise_text(r):
+    """What a ratio is judged against: the timing noise factor b (ahead or behind only outside
+    1/b to b), or "evaluations" for a target ranked by counted force evaluations (exact)."""
+    if r["cost_kind"] != "time_ns":
+        return "evaluations"
+    return f"noise {r['noise_factor']:.3g}x" if np.isfinite(r["noise_factor"]) else ""
 
 
 def factors_text(r):
@@ -198,16 +201,17 @@ def factors_text(r):
     return ", ".join(parts)
 
 
-def peer_cell(r, kind):
-    """One (problem, tight target) of the table against the peers: ours / peer with the noise it
-    is judged against and the verdict; the two methods; the ratio's two factors."""
+def peer_cell(r):
+    """One (problem, tight target) of the table against the peers: ours / peer, the verdict and
+    the noise it was judged against; the two methods; the ratio's two factors."""
     if r is None:
         return Cell("-", "&ndash;", "none")
     verdict = r["verdict"]
     cls = VERDICT_CLASS.get(verdict, "")
     if not (r["ours_method"] and r["peer_method"]):
         return Cell(verdict, f'<span class="small">{esc(verdict)}</span>', cls)
-    head = " ".join(x for x in (ratio_text(r["ratio"]), noise_text(kind, r["noise_band"])) if x) + f", {verdict}"
+    noise = noise_text(r)
+    head = f"{ratio_text(r['ratio'])} {verdict}" + (f" ({noise})" if noise else "")
     pair = f"{r['ours_method']} / {r['peer_method']}"
     why = factors_text(r)
     return Cell(f"{head}: {pair}" + (f"; {why}" if why else ""),
@@ -414,17 +418,21 @@ def opening(doc, verdict):
     faced = [p for p in verdict.problems if any(
         (r := verdict.equal(p, t)) is not None and r["ours_method"] and r["peer_method"] for t in tight)]
     if tight and faced:
-        doc.h(2, "Against the fastest library peer, " + " to ".join(target_text(t) for t in (tight[0], tight[-1])))
+        span = target_text(tight[0]) if len(tight) == 1 else f"{target_text(tight[0])} to {target_text(tight[-1])}"
+        doc.h(2, f"Against the fastest library peer, {span}")
         doc.table(["problem [unit]"] + [target_text(t) for t in tight],
-                  [[problem_cell(verdict, p)] + [peer_cell(verdict.equal(p, t), kind) for t in tight] for p in faced],
+                  [[problem_cell(verdict, p)] + [peer_cell(verdict.equal(p, t)) for t in tight] for p in faced],
                   cls="verdict")
-        doc.p(f"Each cell: the cost ({by}) of the fastest of ours over the fastest library peer's at the same "
-              f"`{verdict.attrs['metric']}`, by the rule above"
-              + (", with the timing noise it is judged against (ahead or behind only outside 1 / (1 + n) to 1 + n)"
-                 if kind == "time_ns" else "")
-              + ", and the verdict; the two methods; and why, in two measured factors whose product is the ratio: "
-              "the force evaluations each needs at that error and the time an evaluation takes (the force plus the "
-              "step's own arithmetic and bookkeeping). Problems where both sides reach one of these targets.",
+        left_out = [p for p in verdict.problems if p not in faced]
+        doc.p(f"Each cell: the cost of the fastest of ours over the fastest library peer's at the same "
+              f"`{verdict.attrs['metric']}` (below 1: ours cheaper), by the rule above, and the verdict with what it "
+              "was judged against: the timing noise factor b (ahead or behind only outside 1/b to b; within spread "
+              "inside it), or the exact count of force evaluations where a target was ranked by them; the two "
+              "methods; and why, in two measured factors whose product is the ratio: the force evaluations each needs "
+              "at that error and the time an evaluation takes (the force plus the step's own arithmetic and "
+              "bookkeeping). In a bounded cell the side charged an upper bound is charged it in both factors too. "
+              + (f"Left out, no library peer reaching these targets there: {', '.join(left_out)}."
+                 if left_out else ""),
               cls="caption")
     if verdict.plugin_equal_error is not None:
         doc.h(2, "Your plugin's methods at equal error")

@@ -18,6 +18,8 @@ import numpy as np
 import pytest
 from conftest import PYTHON, REPORT, ROOT, run_study
 
+import curve_reading
+
 TARGETS = (1e-2, 1e-4, 1e-6)
 with open(os.path.join(ROOT, "scripts", "stepbench_report", "schema.json")) as _f:
     FORMAT_VERSION = json.load(_f)["format_version"]
@@ -547,15 +549,22 @@ def test_findings_and_summary_json_are_the_files(reports, shape):
 
 
 def ratio_head(r):
-    """A cell's head as verdict.py writes it: ours / peer, the noise band, the verdict."""
+    """A ratio as verdict.py writes it (two digits)."""
     ratio = r["ratio"]
     return f"{ratio:.2g}x" if abs(ratio) < 100 else f"{ratio:.0f}x"
 
 
+def evals_on_curve(study, problem, method, target, interpolated):
+    """A method's force evaluations at `target` read off its runs (curve_reading.py)."""
+    with h5py.File(study, "r") as f:
+        return curve_reading.at_target(f[f"problems/{problem}/methods/{method}/runs"][()], target, interpolated)
+
+
 def test_against_the_peers_is_the_files(reports):
     """The table against the fastest library peer at 1e-6 and finer (timed study): for each
-    problem where both sides reach one of them, the stored ratio, its noise band and verdict,
-    the two methods, and the ratio's two stored factors, whose product is the ratio."""
+    problem where both sides reach one of them, the stored ratio, verdict and noise factor,
+    the two methods and the ratio's two factors; each side's force evaluations are its own
+    curve's at the target, and the noise factor is the rule's from the stored spreads."""
     study, folder = reports["timed"]
     md = report_text(folder)
     attrs, v = verdict_of(study)
@@ -565,6 +574,8 @@ def test_against_the_peers_is_the_files(reports):
     assert head[1:] == [target_head(t) for t in tight]
     both = [r for r in ee if text(r["ours_method"]) and text(r["peer_method"]) and r["target"] <= 1.000001e-6]
     assert {f"{text(r['problem'])} [{text(r['unit'])}]" for r in both} == {row[0] for row in rows}
+    left_out = [p for p in dict.fromkeys(ee["problem"].astype(str)) if p not in {row[0].split(" [")[0] for row in rows}]
+    assert left_out and f"Left out, no library peer reaching these targets there: {', '.join(left_out)}." in md
     checked = 0
     for row in rows:
         problem = row[0].split(" [")[0]
@@ -573,13 +584,51 @@ def test_against_the_peers_is_the_files(reports):
             if not (text(r["ours_method"]) and text(r["peer_method"])):
                 assert cell == text(r["verdict"]), (problem, t, cell)
                 continue
-            band = f"\u00b1{100 * r['noise_band']:.0f} %"
-            assert cell.startswith(f"{ratio_head(r)} {band}, {text(r['verdict'])}: "
+            assert text(r["cost_kind"]) == "time_ns", r
+            assert cell.startswith(f"{ratio_head(r)} {text(r['verdict'])} (noise {r['noise_factor']:.3g}x): "
                                    f"{text(r['ours_method'])} / {text(r['peer_method'])}; evaluations "), cell
+            spread = [(r[f"{k}_cost_hi"] - r[f"{k}_cost_lo"]) / r[f"{k}_cost"] for k in ("ours", "peer")]
+            floor = 1.15 if min(spread) > 0 else 1.25
+            assert r["noise_factor"] == pytest.approx(max(floor, 1 + 3 * max(spread)), rel=1e-12)
+            for k in ("ours", "peer"):
+                mine = evals_on_curve(study, problem, text(r[f"{k}_method"]), t, bool(r[f"{k}_interpolated"]))
+                assert any(x == pytest.approx(r[f"{k}_force_evals"], rel=1e-9) for x in mine), (problem, t, k, mine)
             assert r["evals_ratio"] * r["per_eval_ratio"] == pytest.approx(r["ratio"], rel=1e-12)
-            assert r["evals_ratio"] == pytest.approx(r["ours_force_evals"] / r["peer_force_evals"], rel=1e-12)
             checked += 1
     assert checked >= 3
+
+
+def test_against_the_peers_of_an_older_file(reports, stepbench, tmp_path):
+    """A study written before the noise factor and the force evaluations were stored (their
+    five fields absent): the table still shows each stored ratio and verdict, without them;
+    `stepbench summary` reads them as unknown (null) and the README's block renders."""
+    study, _ = reports["timed"]
+    old = tmp_path / "old.h5"
+    shutil.copyfile(study, old)
+    for field in ("ours_force_evals", "peer_force_evals", "noise_factor", "evals_ratio", "per_eval_ratio"):
+        with h5py.File(old, "r+") as f:
+            drop_field("verdict/equal_error", field)(f)
+    out = tmp_path / "old.md"
+    p = subprocess.run([PYTHON, REPORT, str(old), "--markdown", str(out)], capture_output=True, text=True, timeout=60)
+    assert p.returncode == 0, p.stderr
+    head, rows = md_table(out.read_text(), "## Against the fastest library peer, 1e-6 to 1e-12")
+    cells = [c for row in rows for c in row[1:]]
+    assert cells and not any("noise" in c or "evaluations" in c for c in cells), cells
+    _, v = verdict_of(study)
+    r = next(r for r in v["equal_error"] if text(r["ours_method"]) and text(r["peer_method"]) and r["target"] == 1e-8)
+    row = next(row for row in rows if row[0].startswith(f"{text(r['problem'])} ["))
+    assert row[2] == f"{ratio_head(r)} {text(r['verdict'])}: {text(r['ours_method'])} / {text(r['peer_method'])}"
+    summary, readme = tmp_path / "old.json", tmp_path / "README.md"
+    subprocess.run([stepbench, "summary", "--study", str(old), "--out", str(summary)], check=True, timeout=60)
+    cells = [c for p in json.loads(summary.read_text())["against_peers"] for c in p["cells"]]
+    both = [c for c in cells if c["ratio"] is not None]
+    assert both and all(c[k] is None for c in both for k in ("noise_factor", "evals_ratio", "per_eval_ratio"))
+    readme.write_text(README)
+    p = subprocess.run([PYTHON, REPORT, "--readme", str(readme), "--summary", str(summary)], capture_output=True,
+                       text=True, timeout=60)
+    assert p.returncode == 0, p.stderr
+    c = both[0]
+    assert f"{c['ratio']:.2g}x {'within' if c['verdict'] == 'within spread' else c['verdict']} |" in readme.read_text()
 
 
 def test_problem_sections_hold_the_problems_verdict(reports):
@@ -711,13 +760,21 @@ def test_markdown_and_readme(reports, stepbench, tmp_path):
     # Against the peers at 1e-6 and finer: the summary's cells, each its ratio, band and verdict.
     peers = json.loads(summary.read_text())
     assert peers["peer_targets"] == [1e-6, 1e-8, 1e-10, 1e-12]
-    assert "| ours / fastest peer | error 1e-6 | error 1e-8 | error 1e-10 | error 1e-12 |" in block
-    table = block[block.index("| ours / fastest peer |"):].splitlines()
+    head = "| problem (unit) | " + " | ".join(f"ours / peer, 1e-{k}" for k in (6, 8, 10, 12)) + " |"
+    table = block[block.index(head):].splitlines()
+    assert peers["against_peers"] and peers["against_peers_left_out"]
+    assert f"no peer reaching these targets there: {', '.join(peers['against_peers_left_out'])}." in \
+        " ".join(block.splitlines())
     for p in peers["against_peers"]:
         line = next(x for x in table if x.startswith(f"| {p['name']} ({p['unit']}) | "))
         for c in p["cells"]:
+            word = "within" if c["verdict"] == "within spread" else c["verdict"]
+            if c["ratio"] is None:
+                assert f"| {word} |" in line + " |", (line, c)
+                continue
             ratio = f"{c['ratio']:.2g}x" if abs(c["ratio"]) < 100 else f"{c['ratio']:.0f}x"
-            assert f"| {ratio} \u00b1{100 * c['noise_band']:.0f} % {c['verdict']} |" in line + " |", (line, c)
+            by = f"noise {c['noise_factor']:.3g}x" if c["cost_kind"] == "time_ns" else "evaluations"
+            assert f"| {ratio} {word} ({by}) |" in line + " |", (line, c)
     assert all(w in block for w in where) and str(study) in block
     # A front page: the block's lines fit in 160 characters (the paths aside, here long
     # temporary ones); the rest is in docs/results.md, which the block names.

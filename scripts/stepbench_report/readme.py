@@ -7,7 +7,7 @@ import json
 import math
 import textwrap
 
-from .verdict import cost_text, ratio_text, target_text
+from .verdict import cost_text, ratio_text, target_text, targets_span
 
 # The README is a front page: no line of it over this many characters.
 README_WIDTH = 160
@@ -85,8 +85,7 @@ def against_peers(summary):
         lines.append("| " + " | ".join(cells) + " |")
     left_out = summary.get("against_peers_left_out", [])
     by = "measured time" if summary["study"]["cost_kind"] == "time_ns" else "counted force evaluations"
-    span = target_text(targets[0]) if len(targets) == 1 else f"{target_text(targets[0])} to {target_text(targets[-1])}"
-    prose = (f"At equal `err_pos_max`, {span}: the cost of the fastest of our methods over the fastest library peer's "
+    prose = (f"At equal `err_pos_max`, {targets_span(targets)}: the cost of the fastest of our methods over the fastest library peer's "
              f"(below 1: ours cheaper), by {by}, each read off its measured curve. Ahead or behind only "
              "outside the noise factor b (1/b to b); within: inside it; bounded: undecided, the dearer side is charged "
              "an upper bound (its ladder does not bracket the target)."

@@ -134,6 +134,12 @@ def target_text(t):
     return fmt_sci(t, 1) if math.isclose(10 ** round(math.log10(t)), t, rel_tol=1e-9) else fmt_sci(t)
 
 
+def targets_span(targets):
+    """A run of targets as a heading says it: "1e-6" or "1e-6 to 1e-12"."""
+    first, last = target_text(targets[0]), target_text(targets[-1])
+    return first if len(targets) == 1 else f"{first} to {last}"
+
+
 def param_text(kind, value):
     """An interpolated dt (a fixed-step method) or relative tolerance (an adaptive one)."""
     return f"tol {fmt_sci(value)}" if kind == "adaptive" else f"dt {fmt_seconds(value)}"
@@ -418,8 +424,7 @@ def opening(doc, verdict):
     faced = [p for p in verdict.problems if any(
         (r := verdict.equal(p, t)) is not None and r["ours_method"] and r["peer_method"] for t in tight)]
     if tight and faced:
-        span = target_text(tight[0]) if len(tight) == 1 else f"{target_text(tight[0])} to {target_text(tight[-1])}"
-        doc.h(2, f"Against the fastest library peer, {span}")
+        doc.h(2, f"Against the fastest library peer, {targets_span(tight)}")
         doc.table(["problem [unit]"] + [target_text(t) for t in tight],
                   [[problem_cell(verdict, p)] + [peer_cell(verdict.equal(p, t)) for t in tight] for p in faced],
                   cls="verdict")
